@@ -1,0 +1,257 @@
+//! Coning (attitude) and sculling (velocity) compensation over N sensor samples
+//! (mechanization.md §3.1–§3.2 and §4.1–§4.2).
+//!
+//! For a coefficient set `k_ij` the rotation vector over the update interval is
+//! `Δφ = Σ Δθ_j + Σ_{i<j} k_ij Δθ_i × Δθ_j` (§3.1), and by the Ignagni duality the
+//! sculling term is `ΔV_scul = Σ_{i<j} k_ij (Δθ_i × Δv_j + Δv_i × Δθ_j)` (§4.2; for
+//! `three_poly` this is exactly S1 eq. (27)).
+
+use crate::math::Vec3;
+
+/// One sensor sample: body-frame integrals of the raw gyro and accelerometer outputs
+/// over the sample interval (mechanization.md §1.3).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Increment {
+    /// Δθ = ∫ ω_ib^b dt [rad]
+    pub dtheta_b_rad: Vec3,
+    /// Δv = ∫ f^b dt [m/s]
+    pub dv_b_mps: Vec3,
+}
+
+impl Increment {
+    /// Build from the two vectors.
+    pub const fn new(dtheta_b_rad: Vec3, dv_b_mps: Vec3) -> Self {
+        Self { dtheta_b_rad, dv_b_mps }
+    }
+}
+
+/// Coning/sculling coefficient set (mechanization.md §3.2 table).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum ConingSet {
+    /// no compensation: Δφ = ΣΔθ
+    None,
+    /// one-sample with the previous update: + (1/12) Δθ_{k−1} × Δθ_k
+    OnePrev,
+    /// two-sample, k12 = 2/3 (polynomial fit = coning-optimal)
+    Two,
+    /// three-sample polynomial fit (S1 eq. 4): k13 = 33/80, k12 = k23 = 57/80
+    ThreePoly,
+    /// three-sample coning-optimal (Miller 1983): k13 = 9/20, k12 = k23 = 27/40
+    ThreeOpt,
+    /// four-sample polynomial fit (exact for cubic ω)
+    FourPoly,
+    /// four-sample coning-optimal (Lee et al. 1990)
+    FourOpt,
+}
+
+const TWO: [(usize, usize, f64); 1] = [(0, 1, 2.0 / 3.0)];
+const THREE_POLY: [(usize, usize, f64); 3] = [(0, 1, 57.0 / 80.0), (1, 2, 57.0 / 80.0), (0, 2, 33.0 / 80.0)];
+const THREE_OPT: [(usize, usize, f64); 3] = [(0, 1, 27.0 / 40.0), (1, 2, 27.0 / 40.0), (0, 2, 9.0 / 20.0)];
+const FOUR_POLY: [(usize, usize, f64); 6] = [
+    (0, 1, 736.0 / 945.0),
+    (2, 3, 736.0 / 945.0),
+    (0, 2, 334.0 / 945.0),
+    (1, 3, 334.0 / 945.0),
+    (0, 3, 526.0 / 945.0),
+    (1, 2, 654.0 / 945.0),
+];
+const FOUR_OPT: [(usize, usize, f64); 6] = [
+    (0, 1, 214.0 / 315.0),
+    (1, 2, 214.0 / 315.0),
+    (2, 3, 214.0 / 315.0),
+    (0, 2, 46.0 / 105.0),
+    (1, 3, 46.0 / 105.0),
+    (0, 3, 54.0 / 105.0),
+];
+
+impl ConingSet {
+    /// Every set, in table order.
+    pub const ALL: [ConingSet; 7] = [
+        ConingSet::None,
+        ConingSet::OnePrev,
+        ConingSet::Two,
+        ConingSet::ThreePoly,
+        ConingSet::ThreeOpt,
+        ConingSet::FourPoly,
+        ConingSet::FourOpt,
+    ];
+
+    /// The spec's name (`none`, `1prev`, `two`, `three_poly`, `three_opt`, `four_poly`, `four_opt`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            ConingSet::None => "none",
+            ConingSet::OnePrev => "1prev",
+            ConingSet::Two => "two",
+            ConingSet::ThreePoly => "three_poly",
+            ConingSet::ThreeOpt => "three_opt",
+            ConingSet::FourPoly => "four_poly",
+            ConingSet::FourOpt => "four_opt",
+        }
+    }
+
+    /// Parse a spec name, or the aliases `polynomial` / `optimal` for the N-sample set
+    /// (`samples` = N; for N = 2 both aliases are `two`, for N = 1 `polynomial` is `none`
+    /// and `optimal` is `1prev`).
+    pub fn parse(name: &str, samples: usize) -> Option<ConingSet> {
+        Some(match (name, samples) {
+            ("polynomial" | "poly", 1) => ConingSet::None,
+            ("optimal" | "opt", 1) => ConingSet::OnePrev,
+            ("polynomial" | "poly" | "optimal" | "opt", 2) => ConingSet::Two,
+            ("polynomial" | "poly", 3) => ConingSet::ThreePoly,
+            ("optimal" | "opt", 3) => ConingSet::ThreeOpt,
+            ("polynomial" | "poly", 4) => ConingSet::FourPoly,
+            ("optimal" | "opt", 4) => ConingSet::FourOpt,
+            (n, _) => return ConingSet::ALL.iter().copied().find(|s| s.name() == n),
+        })
+    }
+
+    /// Number of samples the set is derived for; `None` and `OnePrev` work with any N
+    /// (they act on the summed increment) and report 1.
+    pub const fn samples(self) -> usize {
+        match self {
+            ConingSet::None | ConingSet::OnePrev => 1,
+            ConingSet::Two => 2,
+            ConingSet::ThreePoly | ConingSet::ThreeOpt => 3,
+            ConingSet::FourPoly | ConingSet::FourOpt => 4,
+        }
+    }
+
+    /// Whether the set can be used with `n` samples per update.
+    pub const fn accepts(self, n: usize) -> bool {
+        match self {
+            ConingSet::None | ConingSet::OnePrev => n >= 1,
+            _ => self.samples() == n,
+        }
+    }
+
+    /// The `(i, j, k_ij)` cross-product coefficients (0-based sample indices).
+    pub const fn coefficients(self) -> &'static [(usize, usize, f64)] {
+        match self {
+            ConingSet::None | ConingSet::OnePrev => &[],
+            ConingSet::Two => &TWO,
+            ConingSet::ThreePoly => &THREE_POLY,
+            ConingSet::ThreeOpt => &THREE_OPT,
+            ConingSet::FourPoly => &FOUR_POLY,
+            ConingSet::FourOpt => &FOUR_OPT,
+        }
+    }
+
+    /// Default (polynomial) set for N samples, as in S1 (`three_poly` for N = 3).
+    pub const fn default_for(n: usize) -> ConingSet {
+        match n {
+            2 => ConingSet::Two,
+            3 => ConingSet::ThreePoly,
+            4 => ConingSet::FourPoly,
+            _ => ConingSet::None,
+        }
+    }
+}
+
+/// Result of combining the N samples of one update.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Compensated {
+    /// Δθ = Σ Δθ_j [rad]
+    pub dtheta_b_rad: Vec3,
+    /// Δv = Σ Δv_j [m/s]
+    pub dv_b_mps: Vec3,
+    /// rotation vector Δφ of the body over the interval (coning-compensated) [rad]
+    pub dphi_b_rad: Vec3,
+    /// sculling term ΔV_scul [m/s]
+    pub dv_scul_b_mps: Vec3,
+}
+
+/// Combine the samples of one update with the coefficient set (§3.1 and §4.2).
+/// `prev` is the previous update's summed increment (used by `1prev` only).
+#[inline]
+pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Compensated {
+    let mut dth = Vec3::zeros();
+    let mut dv = Vec3::zeros();
+    for s in samples {
+        dth += s.dtheta_b_rad;
+        dv += s.dv_b_mps;
+    }
+    let mut cone = Vec3::zeros();
+    let mut scul = Vec3::zeros();
+    match set {
+        ConingSet::None => {}
+        ConingSet::OnePrev => {
+            cone = prev.dtheta_b_rad.cross(&dth) / 12.0;
+            scul = (prev.dtheta_b_rad.cross(&dv) + prev.dv_b_mps.cross(&dth)) / 12.0;
+        }
+        _ => {
+            for &(i, j, k) in set.coefficients() {
+                if let (Some(a), Some(b)) = (samples.get(i), samples.get(j)) {
+                    cone += k * a.dtheta_b_rad.cross(&b.dtheta_b_rad);
+                    scul += k * (a.dtheta_b_rad.cross(&b.dv_b_mps) + a.dv_b_mps.cross(&b.dtheta_b_rad));
+                }
+            }
+        }
+    }
+    Compensated { dtheta_b_rad: dth, dv_b_mps: dv, dphi_b_rad: dth + cone, dv_scul_b_mps: scul }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn three_poly_sculling_is_s1_eq_27() {
+        let s = [
+            Increment::new(Vec3::new(0.01, -0.02, 0.03), Vec3::new(0.5, 0.1, -9.0)),
+            Increment::new(Vec3::new(0.015, -0.01, 0.02), Vec3::new(0.4, 0.3, -9.1)),
+            Increment::new(Vec3::new(0.02, 0.005, 0.01), Vec3::new(0.2, 0.5, -9.3)),
+        ];
+        let c = compensate(ConingSet::ThreePoly, &s, &Increment::default());
+        let (t1, t2, t3) = (s[0].dtheta_b_rad, s[1].dtheta_b_rad, s[2].dtheta_b_rad);
+        let (v1, v2, v3) = (s[0].dv_b_mps, s[1].dv_b_mps, s[2].dv_b_mps);
+        let eq27 = (57.0 / 80.0) * ((t1 - t3).cross(&v2) + (v1 - v3).cross(&t2))
+            + (33.0 / 80.0) * (t1.cross(&v3) + v1.cross(&t3));
+        assert!((c.dv_scul_b_mps - eq27).norm() < 1e-16);
+        let eq4 = t1 + t2 + t3 + (33.0 / 80.0) * t1.cross(&t3) + (57.0 / 80.0) * t2.cross(&(t3 - t1));
+        assert!((c.dphi_b_rad - eq4).norm() < 1e-17);
+    }
+
+    #[test]
+    fn constant_rates_give_zero_sculling_and_coning() {
+        // §7.4 item 5: for constant ω and f the sculling term is exactly zero (catches the
+        // (30)-OCR coefficients, which would give (11/120)ΔT² f×ω).
+        let inc = Increment::new(Vec3::new(1e-4, -2e-4, 3e-4), Vec3::new(0.01, 0.02, -0.0196));
+        for set in ConingSet::ALL {
+            let n = set.samples().max(1);
+            let samples = [inc; 4];
+            let c = compensate(set, &samples[..n], &Increment::new(inc.dtheta_b_rad * n as f64, inc.dv_b_mps * n as f64));
+            assert!(c.dv_scul_b_mps.norm() < 1e-20, "{}", set.name());
+            assert!((c.dphi_b_rad - c.dtheta_b_rad).norm() < 1e-21, "{}", set.name());
+        }
+    }
+
+    #[test]
+    fn coefficient_sums_match_spec() {
+        // Classical coning constrains S_d = Σ_{j−i=d} k_ij (§3.1–§3.2).
+        let sums = |set: ConingSet| {
+            let mut s = [0.0; 3];
+            for &(i, j, k) in set.coefficients() {
+                s[j - i - 1] += k;
+            }
+            s
+        };
+        let t = sums(ConingSet::ThreeOpt);
+        assert!((t[0] - 27.0 / 20.0).abs() < 1e-15 && (t[1] - 9.0 / 20.0).abs() < 1e-15);
+        let f = sums(ConingSet::FourOpt);
+        assert!((f[0] - 214.0 / 105.0).abs() < 1e-15);
+        assert!((f[1] - 92.0 / 105.0).abs() < 1e-15);
+        assert!((f[2] - 18.0 / 35.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn names_and_aliases() {
+        for set in ConingSet::ALL {
+            assert_eq!(ConingSet::parse(set.name(), set.samples()), Some(set));
+        }
+        assert_eq!(ConingSet::parse("polynomial", 3), Some(ConingSet::ThreePoly));
+        assert_eq!(ConingSet::parse("optimal", 3), Some(ConingSet::ThreeOpt));
+        assert_eq!(ConingSet::parse("optimal", 4), Some(ConingSet::FourOpt));
+        assert_eq!(ConingSet::parse("bogus", 3), None);
+    }
+}

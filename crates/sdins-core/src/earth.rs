@@ -1,0 +1,304 @@
+//! Earth model (mechanization.md §2): ellipsoid radii, normal gravity, earth rate,
+//! transport rate, geodetic ↔ ECEF and `C_e^n`.
+//!
+//! The model is a value ([`EarthModel`]) so that the WGS-84 default, the PSINS constant
+//! set (for PSINS data) and a flat, non-rotating model (for flat-NED fixtures) can be
+//! selected per run. Truth and navigation must use the same model.
+
+use crate::math::{Mat3, Vec3};
+
+/// Normal-gravity formula of an [`EarthModel`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Gravity {
+    /// Somigliana closed form with the NIMA TR8350.2 eq. 4-3 height series:
+    /// `γ(L) = γ_e (1 + k sin²L)/√(1 − e² sin²L)`,
+    /// `g = γ(L)[1 − (2/a)(1 + f + m − 2f sin²L) h + (3/a²) h²]`.
+    Somigliana {
+        /// equatorial normal gravity γ_e [m/s²]
+        gamma_e: f64,
+        /// Somigliana constant k
+        k: f64,
+        /// m = ω²a²b/GM
+        m: f64,
+    },
+    /// PSINS: `g = g0 (1 + c2 sin²L + c4 sin⁴L) − dh · h`.
+    Psins {
+        /// g0 [m/s²]
+        g0: f64,
+        /// coefficient of sin²L
+        c2: f64,
+        /// coefficient of sin⁴L
+        c4: f64,
+        /// height gradient [1/s²]
+        dh: f64,
+    },
+    /// Constant magnitude (flat-earth fixtures).
+    Constant {
+        /// g [m/s²]
+        g_mps2: f64,
+    },
+}
+
+/// An earth model: ellipsoid, rotation rate and gravity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthModel {
+    /// semi-major axis a [m]
+    pub a_m: f64,
+    /// flattening f
+    pub f: f64,
+    /// first eccentricity squared e² = f(2 − f)
+    pub e2: f64,
+    /// earth rotation rate Ω_e [rad/s]
+    pub omega_ie_rps: f64,
+    /// gravity model
+    pub gravity: Gravity,
+    /// whether the navigation frame turns with the vehicle's motion over the ellipsoid
+    /// (transport rate ω_en). `false` only for the flat model.
+    pub transport: bool,
+}
+
+/// Radii of curvature at a latitude.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Radii {
+    /// meridian radius R_M [m]
+    pub r_m_m: f64,
+    /// prime-vertical radius R_N [m]
+    pub r_n_m: f64,
+}
+
+impl EarthModel {
+    /// WGS-84 (mechanization.md §2): a = 6378137, f = 1/298.257223563,
+    /// Ω = 7.292115e-5 rad/s, Somigliana gravity with the TR8350.2 height series.
+    pub const WGS84: EarthModel = EarthModel {
+        a_m: 6_378_137.0,
+        f: 1.0 / 298.257_223_563,
+        e2: (1.0 / 298.257_223_563) * (2.0 - 1.0 / 298.257_223_563),
+        omega_ie_rps: 7.292_115e-5,
+        gravity: Gravity::Somigliana {
+            gamma_e: 9.780_325_335_9,
+            k: 1.931_852_652_41e-3,
+            m: 3.449_786_506_84e-3,
+        },
+        transport: true,
+    };
+
+    /// PSINS toolbox constant set: Re = 6378137, f = 1/298.257, wie = 7.2921151467e-5,
+    /// g = 9.7803267714 (1 + 5.27094e-3 sin²L + 2.32718e-5 sin⁴L) − 3.086e-6 h.
+    pub const PSINS: EarthModel = EarthModel {
+        a_m: 6_378_137.0,
+        f: 1.0 / 298.257,
+        e2: (1.0 / 298.257) * (2.0 - 1.0 / 298.257),
+        omega_ie_rps: 7.292_115_146_7e-5,
+        gravity: Gravity::Psins { g0: 9.780_326_771_4, c2: 5.270_94e-3, c4: 2.327_18e-5, dh: 3.086e-6 },
+        transport: true,
+    };
+
+    /// Flat, non-rotating earth with constant gravity `g_mps2` (e.g. 9.80665). Positions are
+    /// still carried as latitude/longitude on the WGS-84 ellipsoid, but the navigation frame
+    /// neither rotates with the earth nor with the vehicle's motion.
+    pub const fn flat(g_mps2: f64) -> EarthModel {
+        EarthModel {
+            a_m: 6_378_137.0,
+            f: 1.0 / 298.257_223_563,
+            e2: (1.0 / 298.257_223_563) * (2.0 - 1.0 / 298.257_223_563),
+            omega_ie_rps: 0.0,
+            gravity: Gravity::Constant { g_mps2 },
+            transport: false,
+        }
+    }
+
+    /// Meridian and prime-vertical radii:
+    /// `R_N = a/√(1 − e² sin²L)`, `R_M = a(1 − e²)/(1 − e² sin²L)^{3/2}`.
+    #[inline]
+    pub fn radii(&self, lat_rad: f64) -> Radii {
+        let s = libm::sin(lat_rad);
+        let w2 = 1.0 - self.e2 * s * s;
+        let w = libm::sqrt(w2);
+        let r_n_m = self.a_m / w;
+        Radii { r_m_m: r_n_m * (1.0 - self.e2) / w2, r_n_m }
+    }
+
+    /// Magnitude of normal gravity g(L, h) [m/s²] (positive down).
+    #[inline]
+    pub fn gravity(&self, lat_rad: f64, h_m: f64) -> f64 {
+        let s = libm::sin(lat_rad);
+        let s2 = s * s;
+        match self.gravity {
+            Gravity::Somigliana { gamma_e, k, m } => {
+                let gamma = gamma_e * (1.0 + k * s2) / libm::sqrt(1.0 - self.e2 * s2);
+                let a = self.a_m;
+                gamma
+                    * (1.0 - (2.0 / a) * (1.0 + self.f + m - 2.0 * self.f * s2) * h_m
+                        + (3.0 / (a * a)) * h_m * h_m)
+            }
+            Gravity::Psins { g0, c2, c4, dh } => g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h_m,
+            Gravity::Constant { g_mps2 } => g_mps2,
+        }
+    }
+
+    /// Gravity vector in NED, `g_n = [0, 0, g(L, h)]` (plumb bob, no deflection).
+    #[inline]
+    pub fn gravity_n(&self, lat_rad: f64, h_m: f64) -> Vec3 {
+        Vec3::new(0.0, 0.0, self.gravity(lat_rad, h_m))
+    }
+
+    /// Earth rate in NED: `ω_ie^n = Ω [cos L, 0, −sin L]`.
+    #[inline]
+    pub fn omega_ie_n(&self, lat_rad: f64) -> Vec3 {
+        Vec3::new(
+            self.omega_ie_rps * libm::cos(lat_rad),
+            0.0,
+            -self.omega_ie_rps * libm::sin(lat_rad),
+        )
+    }
+
+    /// Transport rate in NED:
+    /// `ω_en^n = [v_E/(R_N+h), −v_N/(R_M+h), −v_E tan L/(R_N+h)]` (zero for the flat model).
+    #[inline]
+    pub fn omega_en_n(&self, lat_rad: f64, h_m: f64, v_n_mps: &Vec3) -> Vec3 {
+        if !self.transport {
+            return Vec3::zeros();
+        }
+        let r = self.radii(lat_rad);
+        let rn = r.r_n_m + h_m;
+        Vec3::new(v_n_mps.y / rn, -v_n_mps.x / (r.r_m_m + h_m), -v_n_mps.y * libm::tan(lat_rad) / rn)
+    }
+
+    /// ECEF position of a geodetic point:
+    /// `r^e = [(R_N+h) cosL cosλ, (R_N+h) cosL sinλ, (R_N(1−e²)+h) sinL]`.
+    pub fn ecef_from_geodetic(&self, lat_rad: f64, lon_rad: f64, h_m: f64) -> Vec3 {
+        let rn = self.radii(lat_rad).r_n_m;
+        let (sl, cl) = (libm::sin(lat_rad), libm::cos(lat_rad));
+        let (so, co) = (libm::sin(lon_rad), libm::cos(lon_rad));
+        Vec3::new((rn + h_m) * cl * co, (rn + h_m) * cl * so, (rn * (1.0 - self.e2) + h_m) * sl)
+    }
+
+    /// Geodetic (lat, lon, h) of an ECEF position, by the fixed iteration of
+    /// mechanization.md §2 (10 iterations from `L = atan2(z, p(1 − e²))`).
+    /// Near the poles (p below 1 mm) the height is taken from |z|.
+    pub fn geodetic_from_ecef(&self, r_e: &Vec3) -> (f64, f64, f64) {
+        let lon = libm::atan2(r_e.y, r_e.x);
+        let p = libm::sqrt(r_e.x * r_e.x + r_e.y * r_e.y);
+        if p < 1e-3 {
+            let lat = if r_e.z >= 0.0 { core::f64::consts::FRAC_PI_2 } else { -core::f64::consts::FRAC_PI_2 };
+            let b = self.a_m * libm::sqrt(1.0 - self.e2);
+            return (lat, lon, libm::fabs(r_e.z) - b);
+        }
+        let mut lat = libm::atan2(r_e.z, p * (1.0 - self.e2));
+        for _ in 0..10 {
+            let rn = self.radii(lat).r_n_m;
+            let h = p / libm::cos(lat) - rn;
+            lat = libm::atan2(r_e.z, p * (1.0 - self.e2 * rn / (rn + h)));
+        }
+        // Well-conditioned at every latitude: h = p cosL + z sinL − a√(1 − e² sin²L).
+        let (sl, cl) = (libm::sin(lat), libm::cos(lat));
+        let h = p * cl + r_e.z * sl - self.a_m * libm::sqrt(1.0 - self.e2 * sl * sl);
+        (lat, lon, h)
+    }
+
+    /// `C_e^n(L, λ)`, ECEF to NED (mechanization.md §2).
+    pub fn c_e_n(lat_rad: f64, lon_rad: f64) -> Mat3 {
+        let (sl, cl) = (libm::sin(lat_rad), libm::cos(lat_rad));
+        let (so, co) = (libm::sin(lon_rad), libm::cos(lon_rad));
+        Mat3::new(-sl * co, -sl * so, cl, -so, co, 0.0, -cl * co, -cl * so, -sl)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f64::consts::FRAC_PI_4;
+
+    const D2R: f64 = core::f64::consts::PI / 180.0;
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    #[test]
+    fn wgs84_radii_published_values() {
+        // NIMA TR8350.2 Table 3.1 / 3.3: b = 6356752.3142 m; R_M(0) = b²/a, R_M(90°) = a²/b.
+        let e = EarthModel::WGS84;
+        let b = 6_356_752.314_245_18_f64;
+        let eq = e.radii(0.0);
+        let pole = e.radii(90.0 * D2R);
+        assert!(rel(eq.r_n_m, 6_378_137.0) < 1e-12);
+        assert!(rel(eq.r_m_m, b * b / 6_378_137.0) < 1e-9);
+        assert!(rel(pole.r_n_m, 6_378_137.0 * 6_378_137.0 / b) < 1e-9);
+        assert!(rel(pole.r_m_m, 6_378_137.0 * 6_378_137.0 / b) < 1e-9);
+        // 45°: R_N = a/√(1 − e²/2)
+        let r45 = e.radii(FRAC_PI_4);
+        assert!(rel(r45.r_n_m, 6_378_137.0 / (1.0 - e.e2 / 2.0).sqrt()) < 1e-12);
+        assert!(rel(r45.r_n_m, 6_388_838.290_121_148) < 1e-9);
+    }
+
+    #[test]
+    fn wgs84_gravity_published_values() {
+        // TR8350.2: γ_e = 9.7803253359, γ_p = 9.8321849378 m/s²; spec §7.1 value at 37.5°.
+        let e = EarthModel::WGS84;
+        assert!(rel(e.gravity(0.0, 0.0), 9.780_325_335_9) < 1e-9);
+        assert!(rel(e.gravity(90.0 * D2R, 0.0), 9.832_184_937_8) < 1e-9);
+        assert!(rel(e.gravity(37.5 * D2R, 0.0), 9.799_490_523_606_893) < 1e-12);
+        // 45°: evaluated independently with
+        // python3 -c "import math;a=6378137.0;f=1/298.257223563;e2=f*(2-f);s2=0.5;
+        //   print(repr(9.7803253359*(1+1.93185265241e-3*s2)/math.sqrt(1-e2*s2)))"
+        // -> 9.806197769373238
+        assert!(rel(e.gravity(FRAC_PI_4, 0.0), 9.806_197_769_373_238) < 1e-12);
+        // Height term: dg/dh ≈ −3.086e-6 /s² near the surface.
+        let dgdh = (e.gravity(FRAC_PI_4, 100.0) - e.gravity(FRAC_PI_4, 0.0)) / 100.0;
+        assert!((dgdh + 3.086e-6).abs() < 0.005e-6);
+    }
+
+    #[test]
+    fn ecef_round_trip_all_heights() {
+        // ECEF → geodetic → ECEF. The f64 floor is the quantisation of the latitude itself
+        // (one ulp of a latitude near 1 rad is 2.2e-16 rad = 1.4e-9 m on the ground) plus the
+        // rounding of r (ulp of 6.4e6 m = 9.3e-10 m): the spec's 1e-9 m holds only where the
+        // latitude ulp is small, so the bound is that floor, evaluated per point.
+        let e = EarthModel::WGS84;
+        for &lat in &[-89.9, -60.0, -1.0, 0.0, 37.5, 80.0, 89.99] {
+            for &h in &[-1000.0, 0.0, 380.0, 10_000.0, 100_000.0] {
+                for &lon in &[-179.5, 0.0, 127.0] {
+                    let (lat_r, lon_r) = (lat * D2R, lon * D2R);
+                    let r = e.ecef_from_geodetic(lat_r, lon_r, h);
+                    let (l2, o2, h2) = e.geodetic_from_ecef(&r);
+                    let r2 = e.ecef_from_geodetic(l2, o2, h2);
+                    let err = (r2 - r).abs().max();
+                    let ulp = |x: f64| f64::EPSILON * x.abs().max(f64::MIN_POSITIVE);
+                    let floor = ulp(lat_r) * (e.radii(lat_r).r_m_m + h) + 2.0 * ulp(r.norm());
+                    assert!(err <= floor.max(1e-9), "lat {lat} lon {lon} h {h}: {err}");
+                    // geodetic → ECEF → geodetic: latitude within 2 ulp; height within a few
+                    // ulp of |r| (it is a difference of numbers of size 6.4e6 m)
+                    assert!((l2 - lat_r).abs() <= 2.0 * f64::EPSILON * lat_r.abs().max(1e-3));
+                    assert!((h2 - h).abs() <= 4.0 * ulp(r.norm()), "h {h}: {}", h2 - h);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn c_e_n_maps_up_to_minus_down() {
+        let (lat, lon) = (0.6, 2.2);
+        let c = EarthModel::c_e_n(lat, lon);
+        assert!((c * c.transpose() - Mat3::identity()).abs().max() < 1e-15);
+        // The ellipsoid normal (geodetic up) in ECEF maps to [0, 0, −1].
+        let up = Vec3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin());
+        assert!((c * up - Vec3::new(0.0, 0.0, -1.0)).norm() < 1e-15);
+        // Earth rate ω_ie^e = [0,0,Ω] maps to ω_ie^n.
+        let e = EarthModel::WGS84;
+        let w = c * Vec3::new(0.0, 0.0, e.omega_ie_rps);
+        assert!((w - e.omega_ie_n(lat)).norm() < 1e-20);
+    }
+
+    #[test]
+    fn psins_and_flat_variants() {
+        let p = EarthModel::PSINS;
+        let s2 = (34.25 * D2R).sin().powi(2);
+        let g = 9.780_326_771_4 * (1.0 + 5.270_94e-3 * s2 + 2.327_18e-5 * s2 * s2) - 3.086e-6 * 380.0;
+        assert_eq!(p.gravity(34.25 * D2R, 380.0), g);
+        let f = EarthModel::flat(9.80665);
+        assert_eq!(f.gravity(1.0, 1000.0), 9.80665);
+        assert_eq!(f.omega_ie_n(0.5), Vec3::zeros());
+        assert_eq!(f.omega_en_n(0.5, 0.0, &Vec3::new(10.0, 5.0, 0.0)), Vec3::zeros());
+    }
+}

@@ -1,0 +1,225 @@
+//! Local-level (NED) mechanizations: Savage baseline (SAV), Song–Lee paper mode (SL)
+//! and Song–Lee complete (SLC) (mechanization.md §5).
+//!
+//! Computation order per update (S1 §IV, spec §5.4): velocity, then position, then
+//! attitude; every rate term is evaluated at t_{k−1}.
+
+use super::{transport_matrix, wrap_pi, InitialState, Mechanization, NavState};
+use crate::coning::{compensate, ConingSet, Increment};
+use crate::earth::EarthModel;
+use crate::math::{Mat3, Quat, Vec3};
+
+/// Velocity-update formula (spec §5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VelocityMode {
+    /// `v_k = v_{k−1} + C(Δv + ½Δθ×Δv + ΔV_scul) + ΔT[g − (2ω_ie + ω_en)×v_{k−1}]`
+    Savage,
+    /// SL: Savage's terms (with ½Δφ×Δv) plus S1's (29), (19), (17), signs corrected:
+    /// `− (ΔT/2)[(3ω_ie + 2ω_en)×](CΔv) − (ΔT²/2)(2ω_ie + ω_en)×g`
+    SongLee,
+    /// SLC: SL plus the second-order homogeneous term `+ (ΔT²/2) W×(W×v_{k−1})`, W = 2ω_ie + ω_en
+    SongLeeComplete,
+}
+
+/// Attitude-update formula (spec §5.1, §5.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AttitudeMode {
+    /// S1 eq. (6)/(32): gyro-only quaternion `Q_k = Q_{k−1} ⊗ q(Δφ)`, `C_b^n = T(L, l, t) C(Q)`
+    Transport,
+    /// S1 eq. (5) method: n-relative increments `Δθ_j − C_n^b ω_in ΔT/N`, then coning
+    Five,
+    /// Savage Part 1: `q_k = q(−ζ) ⊗ q_{k−1} ⊗ q(Δφ)`, `ζ = (ω_ie + ω_en)_{k−1} ΔT`
+    Savage,
+}
+
+/// Configuration of a [`LocalLevel`] mechanization.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalLevelConfig {
+    /// velocity formula
+    pub velocity: VelocityMode,
+    /// attitude formula
+    pub attitude: AttitudeMode,
+    /// coning/sculling coefficient set
+    pub coning: ConingSet,
+    /// samples per update N
+    pub samples: usize,
+    /// third-order rotation compensation `+ (1/6) Δφ×(Δφ×Δv)` (spec §4.1)
+    pub rot3: bool,
+    /// earth model (must equal the truth's)
+    pub earth: EarthModel,
+    /// sensor sample period δt [s]
+    pub dt_s: f64,
+}
+
+/// Local-level NED strapdown mechanization (SAV, SL, SLC).
+#[derive(Clone, Debug)]
+pub struct LocalLevel {
+    cfg: LocalLevelConfig,
+    dt_update_s: f64,
+    // position carried as offsets from the start (spec §5.3 roundoff recommendation)
+    lat0_rad: f64,
+    lon0_rad: f64,
+    s_lat0: f64,
+    c_lat0: f64,
+    dlat_rad: f64,
+    dlon_rad: f64,
+    h_m: f64,
+    v_n_mps: Vec3,
+    /// gyro-only quaternion Q_b^{n0ⁱ} (Transport mode) or q_b^n (Five, Savage modes)
+    q: Quat,
+    c_b_n: Mat3,
+    updates: u64,
+    prev: Increment,
+}
+
+impl LocalLevel {
+    /// Initialise at t = 0 from the given state.
+    pub fn new(cfg: LocalLevelConfig, init: &InitialState) -> Self {
+        let q = Quat::from_dcm(&init.c_b_n);
+        Self {
+            dt_update_s: cfg.dt_s * cfg.samples as f64,
+            cfg,
+            lat0_rad: init.lat_rad,
+            lon0_rad: init.lon_rad,
+            s_lat0: libm::sin(init.lat_rad),
+            c_lat0: libm::cos(init.lat_rad),
+            dlat_rad: 0.0,
+            dlon_rad: 0.0,
+            h_m: init.h_m,
+            v_n_mps: init.v_n_mps,
+            q,
+            c_b_n: q.to_dcm(),
+            updates: 0,
+            prev: Increment::default(),
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &LocalLevelConfig {
+        &self.cfg
+    }
+
+    #[inline]
+    fn lat(&self) -> f64 {
+        self.lat0_rad + self.dlat_rad
+    }
+}
+
+impl Mechanization for LocalLevel {
+    #[inline]
+    fn samples_per_update(&self) -> usize {
+        self.cfg.samples
+    }
+
+    fn update(&mut self, samples: &[Increment]) {
+        let n = self.cfg.samples.min(samples.len());
+        let samples = &samples[..n];
+        let e = &self.cfg.earth;
+        let dt = self.dt_update_s;
+        let lat = self.lat();
+        let h = self.h_m;
+        let v = self.v_n_mps;
+        let c = self.c_b_n;
+
+        // 1.–2. increments and rates at t_{k−1}
+        let comp = compensate(self.cfg.coning, samples, &self.prev);
+        let w_ie = e.omega_ie_n(lat);
+        let w_en = e.omega_en_n(lat, h, &v);
+        let g_n = e.gravity_n(lat, h);
+        let w_in = w_ie + w_en;
+        let w_cor = 2.0 * w_ie + w_en;
+
+        // 3. velocity
+        let dphi_rot = match self.cfg.velocity {
+            VelocityMode::Savage => comp.dtheta_b_rad,
+            _ => comp.dphi_b_rad,
+        };
+        let mut dv_rot = 0.5 * dphi_rot.cross(&comp.dv_b_mps);
+        if self.cfg.rot3 {
+            dv_rot += dphi_rot.cross(&dphi_rot.cross(&comp.dv_b_mps)) / 6.0;
+        }
+        let c_dv = c * comp.dv_b_mps;
+        let mut v_new = v + c * (comp.dv_b_mps + dv_rot + comp.dv_scul_b_mps) + dt * (g_n - w_cor.cross(&v));
+        match self.cfg.velocity {
+            VelocityMode::Savage => {}
+            VelocityMode::SongLee | VelocityMode::SongLeeComplete => {
+                // (29) + (19): −(ΔT/2)[(3ω_ie + 2ω_en)×](CΔv); (17): −(ΔT²/2)(2ω_ie+ω_en)×g
+                v_new -= (0.5 * dt) * (w_in + w_cor).cross(&c_dv);
+                v_new -= (0.5 * dt * dt) * w_cor.cross(&g_n);
+                if self.cfg.velocity == VelocityMode::SongLeeComplete {
+                    v_new += (0.5 * dt * dt) * w_cor.cross(&w_cor.cross(&v));
+                }
+            }
+        }
+
+        // 4. position, trapezoid with a latitude predictor (spec §5.3)
+        let h_new = h - 0.5 * (v.z + v_new.z) * dt;
+        let h_bar = 0.5 * (h + h_new);
+        let vn_bar = 0.5 * (v.x + v_new.x);
+        let ve_bar = 0.5 * (v.y + v_new.y);
+        let dlat_new = if e.transport {
+            let lat_pred = lat + vn_bar * dt / (e.radii(lat).r_m_m + h_bar);
+            self.dlat_rad + vn_bar * dt / (e.radii(0.5 * (lat + lat_pred)).r_m_m + h_bar)
+        } else {
+            self.dlat_rad + vn_bar * dt / (e.radii(self.lat0_rad).r_m_m + h_bar)
+        };
+        let lat_bar = self.lat0_rad + 0.5 * (self.dlat_rad + dlat_new);
+        let lat_for_lon = if e.transport { lat_bar } else { self.lat0_rad };
+        let dlon_new =
+            self.dlon_rad + ve_bar * dt / ((e.radii(lat_for_lon).r_n_m + h_bar) * libm::cos(lat_for_lon));
+
+        // 5. attitude
+        match self.cfg.attitude {
+            AttitudeMode::Transport => {
+                self.q = self.q.mul(&Quat::from_rotvec(&comp.dphi_b_rad)).normalized();
+                self.updates += 1;
+                let t = self.updates as f64 * dt;
+                let tm = if e.transport {
+                    transport_matrix(self.lat0_rad + dlat_new, self.s_lat0, self.c_lat0, dlon_new + e.omega_ie_rps * t)
+                } else {
+                    transport_matrix(self.lat0_rad, self.s_lat0, self.c_lat0, e.omega_ie_rps * t)
+                };
+                self.c_b_n = tm * self.q.to_dcm();
+            }
+            AttitudeMode::Savage => {
+                let zeta = w_in * dt;
+                self.q = Quat::from_rotvec(&(-zeta)).mul(&self.q).mul(&Quat::from_rotvec(&comp.dphi_b_rad)).normalized();
+                self.updates += 1;
+                self.c_b_n = self.q.to_dcm();
+            }
+            AttitudeMode::Five => {
+                let w_in_b = c.transpose() * w_in * (dt / n.max(1) as f64);
+                let mut rel = [Increment::default(); 4];
+                for (r, s) in rel.iter_mut().zip(samples.iter()) {
+                    *r = Increment::new(s.dtheta_b_rad - w_in_b, s.dv_b_mps);
+                }
+                let prev_rel = Increment::new(self.prev.dtheta_b_rad - w_in_b * n as f64, self.prev.dv_b_mps);
+                let comp_rel = compensate(self.cfg.coning, &rel[..n.min(4)], &prev_rel);
+                self.q = self.q.mul(&Quat::from_rotvec(&comp_rel.dphi_b_rad)).normalized();
+                self.updates += 1;
+                self.c_b_n = self.q.to_dcm();
+            }
+        }
+        self.v_n_mps = v_new;
+        self.h_m = h_new;
+        self.dlat_rad = dlat_new;
+        self.dlon_rad = dlon_new;
+        self.prev = Increment::new(comp.dtheta_b_rad, comp.dv_b_mps);
+    }
+
+    fn state(&self) -> NavState {
+        NavState {
+            t_s: self.updates as f64 * self.dt_update_s,
+            lat_rad: self.lat(),
+            lon_rad: wrap_pi(self.lon0_rad + self.dlon_rad),
+            h_m: self.h_m,
+            v_n_mps: self.v_n_mps,
+            c_b_n: self.c_b_n,
+        }
+    }
+
+    fn hold_vertical(&mut self, h_m: f64, v_d_mps: f64) {
+        self.h_m = h_m;
+        self.v_n_mps.z = v_d_mps;
+    }
+}

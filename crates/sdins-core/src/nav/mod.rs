@@ -1,0 +1,232 @@
+//! Navigation mechanizations sharing one trait, [`Mechanization`], so that the simulator,
+//! benchmarks and Monte Carlo pick an algorithm by name ([`AlgorithmSpec::from_name`]).
+//!
+//! * [`LocalLevel`]: local-level NED mechanizations: the Savage baseline (`savage`), the
+//!   Song–Lee three-sample algorithm (`songlee`) and our complete version
+//!   (`songlee-complete`) (mechanization.md §5).
+//! * [`DualQuatNav`]: Wu's dual-quaternion mechanization (`dualquat`, §6).
+
+mod dual;
+mod dualquat;
+mod local_level;
+mod transport;
+
+pub use dual::DualQuat;
+pub use dualquat::DualQuatNav;
+pub use local_level::{AttitudeMode, LocalLevel, LocalLevelConfig, VelocityMode};
+pub use transport::transport_matrix;
+
+use crate::coning::{ConingSet, Increment};
+use crate::earth::EarthModel;
+use crate::math::{euler_from_c_b_n, Euler, Mat3, Quat, Vec3};
+
+/// Navigation state at one update epoch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NavState {
+    /// time since start [s]
+    pub t_s: f64,
+    /// geodetic latitude [rad]
+    pub lat_rad: f64,
+    /// longitude [rad], wrapped to (−π, π]
+    pub lon_rad: f64,
+    /// height above the ellipsoid [m]
+    pub h_m: f64,
+    /// velocity over the earth in NED [m/s]
+    pub v_n_mps: Vec3,
+    /// attitude, body to NED
+    pub c_b_n: Mat3,
+}
+
+impl NavState {
+    /// Euler angles of the attitude.
+    pub fn euler(&self) -> Euler {
+        euler_from_c_b_n(&self.c_b_n)
+    }
+    /// Attitude quaternion `q_b_n` (w ≥ 0).
+    pub fn q_b_n(&self) -> Quat {
+        Quat::from_dcm(&self.c_b_n)
+    }
+}
+
+/// Initial conditions of a navigation run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InitialState {
+    /// latitude [rad]
+    pub lat_rad: f64,
+    /// longitude [rad]
+    pub lon_rad: f64,
+    /// height [m]
+    pub h_m: f64,
+    /// NED velocity [m/s]
+    pub v_n_mps: Vec3,
+    /// attitude body to NED
+    pub c_b_n: Mat3,
+}
+
+/// Vertical-channel mode (mechanization.md §2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum VerticalMode {
+    /// free inertial vertical channel (what the papers run)
+    #[default]
+    Free,
+    /// height and v_D replaced by a reference every update (see [`Mechanization::hold_vertical`])
+    Hold,
+}
+
+/// One strapdown mechanization: consumes the N sensor samples of each navigation update.
+pub trait Mechanization {
+    /// Sensor samples per navigation update (N).
+    fn samples_per_update(&self) -> usize;
+    /// Advance one navigation update with exactly N samples (fewer or more are a caller
+    /// bug; the implementation uses the first N and treats missing ones as zero).
+    fn update(&mut self, samples: &[Increment]);
+    /// Current navigation state.
+    fn state(&self) -> NavState;
+    /// Replace height and down velocity by a reference (vertical channel `hold`).
+    fn hold_vertical(&mut self, h_m: f64, v_d_mps: f64);
+}
+
+/// Which algorithm and options, by the CLI names (`savage`, `songlee`,
+/// `songlee-complete`, `dualquat`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlgorithmSpec {
+    /// algorithm family
+    pub kind: AlgorithmKind,
+    /// samples per update N (1..=4)
+    pub samples: usize,
+    /// coning/sculling coefficient set
+    pub coning: ConingSet,
+    /// attitude option override (local-level algorithms only)
+    pub attitude: Option<AttitudeMode>,
+    /// third-order rotation compensation override
+    pub rot3: Option<bool>,
+}
+
+/// Algorithm family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum AlgorithmKind {
+    /// Savage baseline (SAV)
+    Savage,
+    /// Song–Lee paper mode (SL)
+    SongLee,
+    /// Song–Lee complete + rot3 (SLC)
+    SongLeeComplete,
+    /// Wu dual quaternion (DQ)
+    DualQuat,
+}
+
+impl AlgorithmKind {
+    /// Every algorithm, in CLI order.
+    pub const ALL: [AlgorithmKind; 4] =
+        [AlgorithmKind::Savage, AlgorithmKind::SongLee, AlgorithmKind::SongLeeComplete, AlgorithmKind::DualQuat];
+
+    /// CLI name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            AlgorithmKind::Savage => "savage",
+            AlgorithmKind::SongLee => "songlee",
+            AlgorithmKind::SongLeeComplete => "songlee-complete",
+            AlgorithmKind::DualQuat => "dualquat",
+        }
+    }
+
+    /// Parse a CLI name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.iter().copied().find(|k| k.name() == name)
+    }
+}
+
+impl AlgorithmSpec {
+    /// Default options for an algorithm with N samples per update: the polynomial
+    /// coefficient set of N (S1's `three_poly` for N = 3).
+    pub const fn new(kind: AlgorithmKind, samples: usize) -> Self {
+        Self { kind, samples, coning: ConingSet::default_for(samples), attitude: None, rot3: None }
+    }
+
+    /// Look up by CLI name.
+    pub fn from_name(name: &str, samples: usize) -> Option<Self> {
+        AlgorithmKind::from_name(name).map(|k| Self::new(k, samples))
+    }
+}
+
+/// Any mechanization, dispatched statically (no allocation, usable on a flight computer).
+#[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)]
+pub enum AnyMechanization {
+    /// local-level (SAV, SL, SLC)
+    LocalLevel(LocalLevel),
+    /// dual quaternion (DQ)
+    DualQuat(DualQuatNav),
+}
+
+impl AnyMechanization {
+    /// Build the mechanization named by `spec`, with sensor period `dt_s` and the given
+    /// earth model and initial state.
+    pub fn new(spec: &AlgorithmSpec, earth: EarthModel, dt_s: f64, init: &InitialState) -> Self {
+        match spec.kind {
+            AlgorithmKind::DualQuat => {
+                AnyMechanization::DualQuat(DualQuatNav::new(earth, dt_s, spec.samples, spec.coning, init))
+            }
+            kind => {
+                let (velocity, attitude, rot3) = match kind {
+                    AlgorithmKind::Savage => (VelocityMode::Savage, AttitudeMode::Savage, false),
+                    AlgorithmKind::SongLee => (VelocityMode::SongLee, AttitudeMode::Transport, false),
+                    _ => (VelocityMode::SongLeeComplete, AttitudeMode::Transport, true),
+                };
+                let cfg = LocalLevelConfig {
+                    velocity,
+                    attitude: spec.attitude.unwrap_or(attitude),
+                    coning: spec.coning,
+                    samples: spec.samples,
+                    rot3: spec.rot3.unwrap_or(rot3),
+                    earth,
+                    dt_s,
+                };
+                AnyMechanization::LocalLevel(LocalLevel::new(cfg, init))
+            }
+        }
+    }
+}
+
+impl Mechanization for AnyMechanization {
+    #[inline]
+    fn samples_per_update(&self) -> usize {
+        match self {
+            AnyMechanization::LocalLevel(m) => m.samples_per_update(),
+            AnyMechanization::DualQuat(m) => m.samples_per_update(),
+        }
+    }
+    #[inline]
+    fn update(&mut self, samples: &[Increment]) {
+        match self {
+            AnyMechanization::LocalLevel(m) => m.update(samples),
+            AnyMechanization::DualQuat(m) => m.update(samples),
+        }
+    }
+    #[inline]
+    fn state(&self) -> NavState {
+        match self {
+            AnyMechanization::LocalLevel(m) => m.state(),
+            AnyMechanization::DualQuat(m) => m.state(),
+        }
+    }
+    #[inline]
+    fn hold_vertical(&mut self, h_m: f64, v_d_mps: f64) {
+        match self {
+            AnyMechanization::LocalLevel(m) => m.hold_vertical(h_m, v_d_mps),
+            AnyMechanization::DualQuat(m) => m.hold_vertical(h_m, v_d_mps),
+        }
+    }
+}
+
+/// Wrap a longitude to (−π, π].
+#[inline]
+pub fn wrap_pi(a: f64) -> f64 {
+    let two_pi = 2.0 * core::f64::consts::PI;
+    let mut x = libm::fmod(a + core::f64::consts::PI, two_pi);
+    if x <= 0.0 {
+        x += two_pi;
+    }
+    x - core::f64::consts::PI
+}
