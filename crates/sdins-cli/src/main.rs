@@ -1,1 +1,53 @@
-fn main() {}
+//! `sdins`: strapdown inertial navigation simulator and toolkit.
+//!
+//! Every command prints `--help` with an example; bad input exits with code 2 and a
+//! one-line message naming the file, line and field.
+
+mod cmd;
+#[allow(dead_code)]
+mod error;
+#[allow(dead_code)]
+mod output;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// sdins: exact strapdown inertial navigation simulation, algorithms and analysis.
+#[derive(Parser, Debug)]
+#[command(name = "sdins", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run the built-in showcase (the papers' comparisons) and print the tables.
+    Demo(cmd::demo::Args),
+    /// List the built-in scenarios, or print one as a scenario file.
+    Scenarios(cmd::scenarios::Args),
+    /// Write the exact truth trajectory and IMU increments of a scenario.
+    Truth(cmd::truth::Args),
+    /// Truth → IMU → navigation → errors for one or more algorithms side by side.
+    Run(cmd::run::Args),
+    /// Allan deviation of an IMU file with noise-parameter fits.
+    Allan(cmd::allan::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo(a) => cmd::demo::run(a),
+        Command::Scenarios(a) => cmd::scenarios::run(a),
+        Command::Truth(a) => cmd::truth::run(a),
+        Command::Run(a) => cmd::run::run(a),
+        Command::Allan(a) => cmd::allan::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("sdins: error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

@@ -1,1 +1,13 @@
-//! sdins-sim
+//! # sdins-sim
+//!
+//! Scenarios, the exact truth generator (trajectory and IMU increments), IMU error
+//! models and sensor grades, Allan variance, IMU file readers, error analysis and
+//! Monte Carlo. Builds on the `no_std` navigation core, `sdins-core`.
+
+pub mod allan;
+pub mod error_analysis;
+pub mod imu_error;
+pub mod imu_file;
+pub mod scenario;
+pub mod trajectory;
+pub mod truth;

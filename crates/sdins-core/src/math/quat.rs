@@ -62,7 +62,7 @@ impl Quat {
     #[inline]
     pub fn normalized(&self) -> Self {
         let n = self.norm();
-        if !(n > 0.0) || !n.is_finite() {
+        if n.is_nan() || n <= 0.0 || !n.is_finite() {
             return Self::IDENTITY;
         }
         self.scale(1.0 / n)

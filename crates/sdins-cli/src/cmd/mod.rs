@@ -1,0 +1,7 @@
+//! One module per command.
+
+pub mod allan;
+pub mod demo;
+pub mod run;
+pub mod scenarios;
+pub mod truth;

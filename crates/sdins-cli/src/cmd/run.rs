@@ -1,0 +1,12 @@
+//! `sdins run` (placeholder).
+
+use crate::error::CliError;
+
+/// Arguments.
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+/// Run the command.
+pub fn run(_args: Args) -> Result<(), CliError> {
+    Err(CliError::Other("run: not implemented yet".into()))
+}
