@@ -1,10 +1,712 @@
-//! Scenario files (placeholder).
+//! Scenario files (TOML): start state, IMU, navigation set-up and motion segments.
+//!
+//! Every key carries its unit in its name. Unknown keys, missing keys and impossible
+//! values are reported with the file, line and key, and a "did you mean" hint for
+//! misspelt keys. See `docs/scenarios.md` for the reference (a test checks that it lists
+//! exactly the keys accepted here: [`ACCEPTED_KEYS`]).
 
-/// Scenario error.
-#[derive(Debug, thiserror::Error)]
+use crate::trajectory::{Axis, Motion, Overlay, OverlayKind, Trajectory};
+use sdins_core::earth::EarthModel;
+use sdins_core::math::Euler;
+use serde::Deserialize;
+use std::path::Path;
+use toml::Spanned;
+
+const D2R: f64 = std::f64::consts::PI / 180.0;
+
+/// A scenario error: where and what.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum ScenarioError {
-    /// placeholder
-    #[error("{0}")]
-    Invalid(String),
+    /// The file could not be read.
+    #[error("{file}: cannot read: {reason}")]
+    Read {
+        /// file name
+        file: String,
+        /// OS message
+        reason: String,
+    },
+    /// Syntax error, unknown or missing key, wrong type, or an invalid value.
+    #[error("{file}:{line}: {key}: {message}")]
+    Invalid {
+        /// file name
+        file: String,
+        /// 1-based line
+        line: usize,
+        /// the key (dotted path)
+        key: String,
+        /// what is wrong and what is expected
+        message: String,
+    },
+    /// An unknown built-in scenario name.
+    #[error("unknown scenario `{name}`: not a file and not a built-in (built-ins: {known})")]
+    Unknown {
+        /// the name given
+        name: String,
+        /// the built-in names
+        known: String,
+    },
+}
+
+/// Every key the parser accepts, by table (the documentation test compares with
+/// `docs/scenarios.md`).
+pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
+    ("", &["name", "description", "start", "imu", "nav", "segment", "overlay"]),
+    ("start", &["lat_deg", "lon_deg", "h_m", "speed_mps", "climb_rate_mps", "roll_deg", "pitch_deg", "yaw_deg"]),
+    ("imu", &["rate_hz", "seed", "grade", "errors"]),
+    ("nav", &["samples", "algos", "coning", "earth", "vertical", "substeps"]),
+    ("segment", &["type", "duration_s", "accel_mps2", "rate_dps", "angle_deg", "profile", "amplitude_dps", "to_climb_rate_mps"]),
+    (
+        "overlay",
+        &["type", "axis", "half_angle_deg", "freq_hz", "angle_amp_deg", "accel_amp_mps2", "start_s", "end_s"],
+    ),
+];
+
+type S<T> = Spanned<T>;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileDoc {
+    name: Option<String>,
+    description: Option<String>,
+    start: S<StartDoc>,
+    imu: S<ImuDoc>,
+    nav: Option<NavDoc>,
+    #[serde(default)]
+    segment: Vec<S<SegmentDoc>>,
+    #[serde(default)]
+    overlay: Vec<S<OverlayDoc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StartDoc {
+    lat_deg: S<f64>,
+    lon_deg: S<f64>,
+    h_m: Option<S<f64>>,
+    speed_mps: Option<S<f64>>,
+    climb_rate_mps: Option<S<f64>>,
+    roll_deg: Option<S<f64>>,
+    pitch_deg: Option<S<f64>>,
+    yaw_deg: Option<S<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ImuDoc {
+    rate_hz: S<f64>,
+    seed: Option<u64>,
+    grade: Option<S<String>>,
+    errors: Option<toml::Table>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NavDoc {
+    samples: Option<S<i64>>,
+    algos: Option<Vec<String>>,
+    coning: Option<S<String>>,
+    earth: Option<S<String>>,
+    vertical: Option<S<String>>,
+    substeps: Option<S<i64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SegmentDoc {
+    #[serde(rename = "type")]
+    kind: S<String>,
+    duration_s: S<f64>,
+    accel_mps2: Option<S<f64>>,
+    rate_dps: Option<S<f64>>,
+    angle_deg: Option<S<f64>>,
+    profile: Option<S<String>>,
+    amplitude_dps: Option<S<f64>>,
+    to_climb_rate_mps: Option<S<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OverlayDoc {
+    #[serde(rename = "type")]
+    kind: S<String>,
+    axis: Option<S<String>>,
+    half_angle_deg: Option<S<f64>>,
+    freq_hz: Option<S<f64>>,
+    angle_amp_deg: Option<S<f64>>,
+    accel_amp_mps2: Option<S<f64>>,
+    start_s: Option<S<f64>>,
+    end_s: Option<S<f64>>,
+}
+
+/// Which earth model a scenario uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EarthChoice {
+    /// WGS-84 (default)
+    Wgs84,
+    /// PSINS constant set
+    Psins,
+    /// flat, non-rotating, g = 9.80665
+    Flat,
+}
+
+impl EarthChoice {
+    /// The model value.
+    pub fn model(self) -> EarthModel {
+        match self {
+            EarthChoice::Wgs84 => EarthModel::WGS84,
+            EarthChoice::Psins => EarthModel::PSINS,
+            EarthChoice::Flat => EarthModel::flat(9.806_65),
+        }
+    }
+    /// Name as written in scenario files.
+    pub fn name(self) -> &'static str {
+        match self {
+            EarthChoice::Wgs84 => "wgs84",
+            EarthChoice::Psins => "psins",
+            EarthChoice::Flat => "flat",
+        }
+    }
+}
+
+/// Start state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Start {
+    /// latitude [rad]
+    pub lat_rad: f64,
+    /// longitude [rad]
+    pub lon_rad: f64,
+    /// height [m]
+    pub h_m: f64,
+    /// horizontal speed along the heading [m/s]
+    pub speed_mps: f64,
+    /// climb rate [m/s], positive up (v_D = −climb)
+    pub climb_rate_mps: f64,
+    /// attitude
+    pub euler: Euler,
+}
+
+/// IMU set-up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImuConfig {
+    /// sample rate [Hz]
+    pub rate_hz: f64,
+    /// random seed (error models, Monte Carlo)
+    pub seed: u64,
+    /// sensor-grade preset name
+    pub grade: Option<String>,
+    /// error-model overrides (interpreted by the IMU error model)
+    pub errors: Option<toml::Table>,
+}
+
+impl ImuConfig {
+    /// Sample period δt [s].
+    pub fn dt_s(&self) -> f64 {
+        1.0 / self.rate_hz
+    }
+}
+
+/// Navigation set-up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NavConfig {
+    /// samples per update N
+    pub samples: usize,
+    /// algorithms to run by default
+    pub algos: Vec<String>,
+    /// coning/sculling set name (default: the polynomial set of N)
+    pub coning: Option<String>,
+    /// earth model
+    pub earth: EarthChoice,
+    /// vertical channel: `free` or `hold`
+    pub vertical_hold: bool,
+    /// truth RK4 substeps per sample
+    pub substeps: usize,
+}
+
+/// A validated scenario.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// name
+    pub name: String,
+    /// description
+    pub description: String,
+    /// start state
+    pub start: Start,
+    /// IMU
+    pub imu: ImuConfig,
+    /// navigation set-up
+    pub nav: NavConfig,
+    /// the trajectory
+    pub trajectory: Trajectory,
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+    text: &'a str,
+}
+
+impl Ctx<'_> {
+    fn line_of(&self, pos: usize) -> usize {
+        self.text.get(..pos.min(self.text.len())).map_or(1, |s| s.bytes().filter(|&b| b == b'\n').count() + 1)
+    }
+    fn err<T>(&self, span: std::ops::Range<usize>, key: &str, message: impl Into<String>) -> Result<T, ScenarioError> {
+        Err(ScenarioError::Invalid {
+            file: self.file.to_string(),
+            line: self.line_of(span.start),
+            key: key.to_string(),
+            message: message.into(),
+        })
+    }
+    fn finite(&self, v: &S<f64>, key: &str) -> Result<f64, ScenarioError> {
+        let x = *v.get_ref();
+        if !x.is_finite() {
+            return self.err(v.span(), key, "must be a finite number");
+        }
+        Ok(x)
+    }
+    fn range(&self, v: &S<f64>, key: &str, lo: f64, hi: f64, what: &str) -> Result<f64, ScenarioError> {
+        let x = self.finite(v, key)?;
+        if !(lo..=hi).contains(&x) {
+            return self.err(v.span(), key, format!("{x} is out of range: expected {what}"));
+        }
+        Ok(x)
+    }
+    fn positive(&self, v: &S<f64>, key: &str) -> Result<f64, ScenarioError> {
+        let x = self.finite(v, key)?;
+        if x <= 0.0 {
+            return self.err(v.span(), key, format!("{x} must be > 0"));
+        }
+        Ok(x)
+    }
+}
+
+fn levenshtein(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1];
+        for (j, cb) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(ca != *cb);
+            cur.push(sub.min(prev[j + 1] + 1).min(cur[j] + 1));
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// Closest accepted key to an unknown one (for "did you mean" hints).
+pub fn suggest(unknown: &str) -> Option<&'static str> {
+    ACCEPTED_KEYS
+        .iter()
+        .flat_map(|(_, keys)| keys.iter().copied())
+        .map(|k| (levenshtein(unknown, k), k))
+        .filter(|(d, k)| *d <= 3.max(k.len() / 3))
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, k)| k)
+}
+
+fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> ScenarioError {
+    let line = e.span().map_or(1, |s| text.get(..s.start).map_or(1, |p| p.matches('\n').count() + 1));
+    let msg = e.message().trim().to_string();
+    let mut key = String::from("(syntax)");
+    let mut message = msg.clone();
+    if let Some(rest) = msg.strip_prefix("unknown field `") {
+        if let Some(end) = rest.find('`') {
+            let name = &rest[..end];
+            key = name.to_string();
+            message = format!("unknown key{}", suggest(name).map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default());
+            if let Some(exp) = rest.find("expected") {
+                message.push_str(&format!("; {}", &rest[exp..]));
+            }
+        }
+    } else if let Some(rest) = msg.strip_prefix("missing field `") {
+        if let Some(end) = rest.find('`') {
+            key = rest[..end].to_string();
+            message = "missing required key".to_string();
+        }
+    }
+    ScenarioError::Invalid { file: file.to_string(), line, key, message }
+}
+
+impl Scenario {
+    /// Parse and validate scenario text; `file` names it in error messages.
+    pub fn from_toml(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
+        let doc: FileDoc = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;
+        let cx = Ctx { file, text };
+        let st = doc.start.get_ref();
+        let lat = cx.range(&st.lat_deg, "start.lat_deg", -90.0, 90.0, "latitude in [-90, 90] deg")?;
+        if lat.abs() > 89.0 {
+            // The local-level (NED) mechanization is singular at the poles: tan L and
+            // 1/cos L in the transport rate and longitude rate. We accept up to ±89.99°.
+            if lat.abs() > 89.99 {
+                return cx.err(st.lat_deg.span(), "start.lat_deg", format!("{lat} is too close to a pole: the local-level NED mechanization needs |lat| ≤ 89.99 deg"));
+            }
+        }
+        let lon = cx.range(&st.lon_deg, "start.lon_deg", -180.0, 360.0, "longitude in [-180, 360] deg")?;
+        let h = match &st.h_m {
+            Some(v) => cx.range(v, "start.h_m", -1000.0, 100_000.0, "height in [-1000, 100000] m")?,
+            None => 0.0,
+        };
+        let speed = match &st.speed_mps {
+            Some(v) => cx.range(v, "start.speed_mps", 0.0, 3000.0, "speed in [0, 3000] m/s")?,
+            None => 0.0,
+        };
+        let climb = match &st.climb_rate_mps {
+            Some(v) => cx.range(v, "start.climb_rate_mps", -500.0, 500.0, "climb rate in [-500, 500] m/s")?,
+            None => 0.0,
+        };
+        let ang = |v: &Option<S<f64>>, key: &str, lim: f64| -> Result<f64, ScenarioError> {
+            match v {
+                Some(v) => Ok(cx.range(v, key, -lim, lim, &format!("angle in [-{lim}, {lim}] deg"))? * D2R),
+                None => Ok(0.0),
+            }
+        };
+        let euler = Euler::new(
+            ang(&st.roll_deg, "start.roll_deg", 180.0)?,
+            ang(&st.pitch_deg, "start.pitch_deg", 89.9)?,
+            ang(&st.yaw_deg, "start.yaw_deg", 360.0)?,
+        );
+        let start = Start { lat_rad: lat * D2R, lon_rad: lon * D2R, h_m: h, speed_mps: speed, climb_rate_mps: climb, euler };
+
+        let im = doc.imu.get_ref();
+        let rate_hz = cx.positive(&im.rate_hz, "imu.rate_hz")?;
+        if rate_hz > 100_000.0 {
+            return cx.err(im.rate_hz.span(), "imu.rate_hz", format!("{rate_hz} Hz is beyond 100 kHz"));
+        }
+        let imu = ImuConfig {
+            rate_hz,
+            seed: im.seed.unwrap_or(1),
+            grade: im.grade.as_ref().map(|g| g.get_ref().clone()),
+            errors: im.errors.clone(),
+        };
+
+        let nav = parse_nav(&cx, doc.nav.as_ref())?;
+
+        let dt = 1.0 / rate_hz;
+        let mut motions = Vec::new();
+        let mut speed_now = speed;
+        for s in &doc.segment {
+            let sd = s.get_ref();
+            let kind = sd.kind.get_ref().as_str();
+            let dur = cx.positive(&sd.duration_s, "segment.duration_s")?;
+            let n = dur / dt;
+            if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
+                return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));
+            }
+            // keys allowed per type
+            let allowed: &[&str] = match kind {
+                "static" | "cruise" => &[],
+                "accelerate" => &["accel_mps2"],
+                "turn" => &["rate_dps", "angle_deg", "profile"],
+                "sturn" => &["amplitude_dps"],
+                "climb" => &["to_climb_rate_mps"],
+                other => {
+                    return cx.err(sd.kind.span(), "segment.type", format!("unknown segment type `{other}`: expected one of static, cruise, accelerate, turn, sturn, climb"));
+                }
+            };
+            let present: [(&str, Option<std::ops::Range<usize>>); 6] = [
+                ("accel_mps2", sd.accel_mps2.as_ref().map(|v| v.span())),
+                ("rate_dps", sd.rate_dps.as_ref().map(|v| v.span())),
+                ("angle_deg", sd.angle_deg.as_ref().map(|v| v.span())),
+                ("profile", sd.profile.as_ref().map(|v| v.span())),
+                ("amplitude_dps", sd.amplitude_dps.as_ref().map(|v| v.span())),
+                ("to_climb_rate_mps", sd.to_climb_rate_mps.as_ref().map(|v| v.span())),
+            ];
+            for (k, span) in present {
+                if let Some(span) = span {
+                    if !allowed.contains(&k) {
+                        return cx.err(span, &format!("segment.{k}"), format!("not a key of segment type `{kind}` (it takes: {})", if allowed.is_empty() { "duration_s only".to_string() } else { allowed.join(", ") }));
+                    }
+                }
+            }
+            let need = |v: &Option<S<f64>>, key: &str| -> Result<f64, ScenarioError> {
+                match v {
+                    Some(v) => cx.finite(v, key),
+                    None => cx.err(s.span(), key, format!("missing required key for segment type `{kind}`")),
+                }
+            };
+            let motion = match kind {
+                "static" => {
+                    if speed_now != 0.0 {
+                        return cx.err(sd.kind.span(), "segment.type", format!("a static segment needs zero speed, but the vehicle moves at {speed_now} m/s here (use `cruise`)"));
+                    }
+                    Motion::Static
+                }
+                "cruise" => Motion::Cruise,
+                "accelerate" => {
+                    let a = need(&sd.accel_mps2, "segment.accel_mps2")?;
+                    if a.abs() > 1000.0 * 9.80665 {
+                        return cx.err(s.span(), "segment.accel_mps2", format!("{a} m/s² exceeds 1000 g"));
+                    }
+                    speed_now += a * dur;
+                    if speed_now < -1e-9 {
+                        return cx.err(s.span(), "segment.accel_mps2", format!("the speed would become negative ({speed_now} m/s) by the end of this segment"));
+                    }
+                    Motion::Accelerate { accel_mps2: a }
+                }
+                "turn" => {
+                    let profile = sd.profile.as_ref().map_or("constant", |p| p.get_ref().as_str());
+                    match (profile, &sd.rate_dps, &sd.angle_deg) {
+                        ("constant", Some(r), None) => Motion::TurnRate { rate_rps: cx.finite(r, "segment.rate_dps")? * D2R },
+                        ("constant", None, Some(a)) => Motion::TurnRate { rate_rps: cx.finite(a, "segment.angle_deg")? * D2R / dur },
+                        ("smooth", None, Some(a)) => Motion::TurnSmooth { angle_rad: cx.finite(a, "segment.angle_deg")? * D2R },
+                        ("smooth", Some(r), None) => Motion::TurnSmooth { angle_rad: cx.finite(r, "segment.rate_dps")? * D2R * dur },
+                        ("constant" | "smooth", Some(_), Some(_)) => {
+                            return cx.err(s.span(), "segment.rate_dps", "give either rate_dps or angle_deg, not both");
+                        }
+                        ("constant" | "smooth", None, None) => {
+                            return cx.err(s.span(), "segment.angle_deg", "a turn needs rate_dps or angle_deg");
+                        }
+                        (other, _, _) => {
+                            let span = sd.profile.as_ref().map_or(s.span(), |p| p.span());
+                            return cx.err(span, "segment.profile", format!("unknown profile `{other}`: expected constant or smooth"));
+                        }
+                    }
+                }
+                "sturn" => Motion::STurn { amplitude_rps: need(&sd.amplitude_dps, "segment.amplitude_dps")? * D2R },
+                _ => Motion::Climb { to_climb_rate_mps: need(&sd.to_climb_rate_mps, "segment.to_climb_rate_mps")? },
+            };
+            motions.push((motion, (n.round()) * dt));
+        }
+        if motions.is_empty() {
+            return Err(ScenarioError::Invalid { file: file.into(), line: 1, key: "segment".into(), message: "a scenario needs at least one [[segment]]".into() });
+        }
+        let total: f64 = motions.iter().map(|m| m.1).sum();
+
+        let mut overlays = Vec::new();
+        for o in &doc.overlay {
+            let od = o.get_ref();
+            let kind = od.kind.get_ref().as_str();
+            let need_pos = |v: &Option<S<f64>>, key: &str| -> Result<f64, ScenarioError> {
+                match v {
+                    Some(v) => cx.positive(v, key),
+                    None => cx.err(o.span(), key, format!("missing required key for overlay type `{kind}`")),
+                }
+            };
+            let axis = |default: Axis| -> Result<Axis, ScenarioError> {
+                match &od.axis {
+                    None => Ok(default),
+                    Some(a) => match a.get_ref().as_str() {
+                        "x" => Ok(Axis::X),
+                        "y" => Ok(Axis::Y),
+                        "z" => Ok(Axis::Z),
+                        other => cx.err(a.span(), "overlay.axis", format!("unknown axis `{other}`: expected x, y or z")),
+                    },
+                }
+            };
+            let freq = need_pos(&od.freq_hz, "overlay.freq_hz")?;
+            if freq > 0.5 * rate_hz {
+                return cx.err(o.span(), "overlay.freq_hz", format!("{freq} Hz is above the Nyquist frequency {} Hz of the IMU", 0.5 * rate_hz));
+            }
+            let omega = 2.0 * std::f64::consts::PI * freq;
+            let k = match kind {
+                "coning" => {
+                    let a = need_pos(&od.half_angle_deg, "overlay.half_angle_deg")?;
+                    if a >= 90.0 {
+                        return cx.err(o.span(), "overlay.half_angle_deg", "half-angle must be below 90 deg");
+                    }
+                    OverlayKind::Coning { axis: axis(Axis::Z)?, half_angle_rad: a * D2R, omega_rps: omega }
+                }
+                "sculling" => OverlayKind::Sculling {
+                    angle_amp_rad: need_pos(&od.angle_amp_deg, "overlay.angle_amp_deg")? * D2R,
+                    accel_amp_mps2: need_pos(&od.accel_amp_mps2, "overlay.accel_amp_mps2")?,
+                    omega_rps: omega,
+                },
+                "vibration" => OverlayKind::Vibration {
+                    axis: axis(Axis::Z)?,
+                    accel_amp_mps2: need_pos(&od.accel_amp_mps2, "overlay.accel_amp_mps2")?,
+                    omega_rps: omega,
+                },
+                other => {
+                    return cx.err(od.kind.span(), "overlay.type", format!("unknown overlay type `{other}`: expected coning, sculling or vibration"));
+                }
+            };
+            let start_s = match &od.start_s {
+                Some(v) => cx.range(v, "overlay.start_s", 0.0, total, "a time within the scenario")?,
+                None => 0.0,
+            };
+            let end_s = match &od.end_s {
+                Some(v) => cx.range(v, "overlay.end_s", start_s, f64::INFINITY, "a time after start_s")?,
+                None => f64::INFINITY,
+            };
+            overlays.push(Overlay { kind: k, start_s, end_s });
+        }
+
+        let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
+        Ok(Scenario {
+            name: doc.name.unwrap_or_else(|| {
+                Path::new(file).file_stem().map_or_else(|| "scenario".into(), |s| s.to_string_lossy().into_owned())
+            }),
+            description: doc.description.unwrap_or_default(),
+            start,
+            imu,
+            nav,
+            trajectory,
+        })
+    }
+
+    /// Read and validate a scenario file.
+    pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read { file: file.clone(), reason: e.to_string() })?;
+        Scenario::from_toml(&text, &file)
+    }
+
+    /// A built-in name or a file path.
+    pub fn load(name_or_path: &str) -> Result<Scenario, ScenarioError> {
+        if let Some(b) = builtin(name_or_path) {
+            return Scenario::from_toml(b.toml, &format!("<built-in {}>", b.name));
+        }
+        let p = Path::new(name_or_path);
+        if p.exists() {
+            return Scenario::from_file(p);
+        }
+        Err(ScenarioError::Unknown {
+            name: name_or_path.to_string(),
+            known: BUILTINS.iter().map(|b| b.name).collect::<Vec<_>>().join(", "),
+        })
+    }
+
+    /// Duration [s].
+    pub fn duration_s(&self) -> f64 {
+        self.trajectory.duration_s
+    }
+}
+
+fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioError> {
+    let mut cfg = NavConfig {
+        samples: 3,
+        algos: vec!["savage".into(), "songlee".into(), "songlee-complete".into(), "dualquat".into()],
+        coning: None,
+        earth: EarthChoice::Wgs84,
+        vertical_hold: false,
+        substeps: 16,
+    };
+    let Some(n) = nav else { return Ok(cfg) };
+    if let Some(s) = &n.samples {
+        let v = *s.get_ref();
+        if !(1..=4).contains(&v) {
+            return cx.err(s.span(), "nav.samples", format!("{v}: expected 1, 2, 3 or 4 samples per update"));
+        }
+        cfg.samples = v as usize;
+    }
+    if let Some(s) = &n.substeps {
+        let v = *s.get_ref();
+        if !(1..=1024).contains(&v) {
+            return cx.err(s.span(), "nav.substeps", format!("{v}: expected 1..=1024"));
+        }
+        cfg.substeps = v as usize;
+    }
+    if let Some(a) = &n.algos {
+        cfg.algos = a.clone();
+    }
+    if let Some(c) = &n.coning {
+        cfg.coning = Some(c.get_ref().clone());
+    }
+    if let Some(e) = &n.earth {
+        cfg.earth = match e.get_ref().as_str() {
+            "wgs84" => EarthChoice::Wgs84,
+            "psins" => EarthChoice::Psins,
+            "flat" => EarthChoice::Flat,
+            other => return cx.err(e.span(), "nav.earth", format!("unknown earth model `{other}`: expected wgs84, psins or flat")),
+        };
+    }
+    if let Some(v) = &n.vertical {
+        cfg.vertical_hold = match v.get_ref().as_str() {
+            "free" => false,
+            "hold" => true,
+            other => return cx.err(v.span(), "nav.vertical", format!("unknown vertical mode `{other}`: expected free or hold")),
+        };
+    }
+    Ok(cfg)
+}
+
+/// A built-in scenario.
+#[derive(Clone, Copy, Debug)]
+pub struct Builtin {
+    /// name
+    pub name: &'static str,
+    /// one-line summary
+    pub summary: &'static str,
+    /// the scenario file text
+    pub toml: &'static str,
+}
+
+/// The built-in scenarios (every paper case of mechanization.md §7 and the alignment
+/// reference case).
+pub const BUILTINS: &[Builtin] = &[
+    Builtin { name: "stationary", summary: "A0: stationary 90 min at 37.5N 127E (spec §7.1)", toml: include_str!("../scenarios/stationary.toml") },
+    Builtin { name: "mach1-east", summary: "A1: Mach 1 due east, 90 min (Song-Lee Table 1, spec §7.2)", toml: include_str!("../scenarios/mach1-east.toml") },
+    Builtin { name: "turn-90dps", summary: "A2: 90 deg/s turn from east to south at Mach 1 (spec §7.3)", toml: include_str!("../scenarios/turn-90dps.toml") },
+    Builtin { name: "dq-paper", summary: "B: stationary, accelerate, S-turn with 1 Hz coning (dual-quaternion paper, spec §7.5)", toml: include_str!("../scenarios/dq-paper.toml") },
+    Builtin { name: "alignment", summary: "stationary alignment reference: roll/pitch/yaw 2/-3/40 deg at 37.5N (alignment spec §6)", toml: include_str!("../scenarios/alignment.toml") },
+];
+
+/// Look up a built-in scenario by name.
+pub fn builtin(name: &str) -> Option<&'static Builtin> {
+    BUILTINS.iter().find(|b| b.name == name)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn all_builtins_parse() {
+        for b in BUILTINS {
+            let s = Scenario::from_toml(b.toml, b.name);
+            assert!(s.is_ok(), "{}: {:?}", b.name, s.err());
+        }
+    }
+
+    fn err_of(text: &str) -> ScenarioError {
+        match Scenario::from_toml(text, "t.toml") {
+            Err(e) => e,
+            Ok(_) => panic!("expected an error for:\n{text}"),
+        }
+    }
+
+    const BASE: &str = "[start]\nlat_deg = 37.5\nlon_deg = 127.0\n[imu]\nrate_hz = 100.0\n[[segment]]\ntype = \"static\"\nduration_s = 10.0\n";
+
+    #[test]
+    fn unknown_key_names_line_and_suggests() {
+        let e = err_of(&BASE.replace("lon_deg = 127.0", "lon_deg = 127.0\nlat_dg = 3.0"));
+        let ScenarioError::Invalid { line, key, message, .. } = &e else { panic!("{e}") };
+        assert_eq!((*line, key.as_str()), (4, "lat_dg"));
+        assert!(message.contains("did you mean `lat_deg`"), "{message}");
+    }
+
+    #[test]
+    fn missing_key() {
+        let e = err_of(&BASE.replace("rate_hz = 100.0\n", ""));
+        assert!(e.to_string().contains("rate_hz") && e.to_string().contains("missing"), "{e}");
+    }
+
+    #[test]
+    fn impossible_values_name_line_and_key() {
+        for (from, to, line, key) in [
+            ("duration_s = 10.0", "duration_s = -1.0", 8, "segment.duration_s"),
+            ("rate_hz = 100.0", "rate_hz = 0.0", 5, "imu.rate_hz"),
+            ("lat_deg = 37.5", "lat_deg = 95.0", 2, "start.lat_deg"),
+            ("duration_s = 10.0", "duration_s = 10.001", 8, "segment.duration_s"),
+            ("lat_deg = 37.5", "lat_deg = nan", 2, "start.lat_deg"),
+        ] {
+            let e = err_of(&BASE.replace(from, to));
+            let ScenarioError::Invalid { line: l, key: k, .. } = &e else { panic!("{e}") };
+            assert_eq!((*l, k.as_str()), (line, key), "{e}");
+        }
+        let e = err_of(&format!("{BASE}[start2]\n"));
+        assert!(e.to_string().contains("start2"), "{e}");
+        let e = err_of(&BASE.replace("[start]\nlat_deg = 37.5\n", "[start]\nlat_deg = 37.5\nh_m = -2000.0\n"));
+        assert!(e.to_string().contains("start.h_m"), "{e}");
+    }
+
+    #[test]
+    fn wrong_segment_keys() {
+        let e = err_of(&BASE.replace("type = \"static\"", "type = \"staticc\""));
+        assert!(e.to_string().contains("unknown segment type"), "{e}");
+        let e = err_of(&BASE.replace("duration_s = 10.0", "duration_s = 10.0\nrate_dps = 3.0"));
+        assert!(e.to_string().contains("not a key of segment type `static`"), "{e}");
+    }
 }

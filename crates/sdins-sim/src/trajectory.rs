@@ -1,1 +1,422 @@
-//! Trajectory profiles (placeholder).
+//! Analytic trajectories: piecewise motion segments plus attitude/linear overlays,
+//! evaluated exactly (value and derivative) at any time (mechanization.md §7.0).
+//!
+//! The nominal vehicle moves with horizontal speed `s` along heading `ψ` (= yaw) and
+//! down velocity `v_D`: `v^n = [s cosψ, s sinψ, v_D]`. Roll and pitch stay at their start
+//! values (flat turns, as in the papers' scenarios). Overlays add body coning, sculling
+//! and vibration on top.
+
+use sdins_core::math::{c_b_n_from_euler, Euler, Mat3, Quat, Vec3};
+use std::f64::consts::PI;
+
+/// A motion segment (one of the `[[segment]]` tables of a scenario).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Motion {
+    /// everything constant (speed must be zero)
+    Static,
+    /// constant velocity and attitude
+    Cruise,
+    /// constant along-track acceleration [m/s²]
+    Accelerate {
+        /// acceleration along the heading [m/s²]
+        accel_mps2: f64,
+    },
+    /// level turn at a constant yaw rate [rad/s]
+    TurnRate {
+        /// yaw rate [rad/s] (positive = right turn)
+        rate_rps: f64,
+    },
+    /// level turn through an angle with a smooth (raised-cosine) rate:
+    /// `ψ = ψ0 + A(x − sin(2πx)/(2π))`, `ψ̇ = (A/T)(1 − cos 2πx)`, `x = τ/T`
+    /// (spec §7.3; peak rate 2A/T at mid-turn)
+    TurnSmooth {
+        /// total heading change A [rad]
+        angle_rad: f64,
+    },
+    /// S-turn: `ψ̇ = a sin(2πτ/T)`, `ψ = ψ0 + a(T/2π)(1 − cos(2πτ/T))` (spec §7.5)
+    STurn {
+        /// peak yaw rate a [rad/s]
+        amplitude_rps: f64,
+    },
+    /// linear change of the climb rate to `to_climb_rate_mps` (v_D = −climb rate)
+    Climb {
+        /// climb rate at the end of the segment [m/s], positive up
+        to_climb_rate_mps: f64,
+    },
+}
+
+/// A segment with its time span and its start state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Segment {
+    /// kind of motion
+    pub motion: Motion,
+    /// start time [s]
+    pub t0_s: f64,
+    /// duration [s]
+    pub duration_s: f64,
+    speed0: f64,
+    heading0: f64,
+    v_d0: f64,
+}
+
+/// Body axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    /// body x (forward, roll axis)
+    X,
+    /// body y (right, pitch axis)
+    Y,
+    /// body z (down, yaw axis)
+    Z,
+}
+
+impl Axis {
+    fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+    /// Place z-axis-form components `(a, b, c)` (cone about z) for a cone about this axis
+    /// (cyclic permutation, spec §3.3).
+    fn place(self, a: f64, b: f64, c: f64) -> Vec3 {
+        match self {
+            Axis::Z => Vec3::new(a, b, c),
+            Axis::X => Vec3::new(c, a, b),
+            Axis::Y => Vec3::new(b, c, a),
+        }
+    }
+}
+
+/// Overlay kind.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OverlayKind {
+    /// classical coning about a body axis, relative form `C_c = C(q_c(0)* ⊗ q_c(τ))`
+    /// (spec §3.3, §7.5)
+    Coning {
+        /// cone axis
+        axis: Axis,
+        /// half-angle α [rad]
+        half_angle_rad: f64,
+        /// angular frequency Ω [rad/s]
+        omega_rps: f64,
+    },
+    /// classical sculling: rotation θ0 sin Ωτ about body x, in phase with a specific-force
+    /// oscillation A0 sin Ωτ along the nominal body y (spec §4.3)
+    Sculling {
+        /// angular amplitude θ0 [rad]
+        angle_amp_rad: f64,
+        /// acceleration amplitude A0 [m/s²]
+        accel_amp_mps2: f64,
+        /// angular frequency Ω [rad/s]
+        omega_rps: f64,
+    },
+    /// sinusoidal linear vibration along a nominal body axis: acceleration A cos Ωτ,
+    /// velocity (A/Ω) sin Ωτ (zero at the start, bounded displacement)
+    Vibration {
+        /// axis of the nominal body frame
+        axis: Axis,
+        /// acceleration amplitude A [m/s²]
+        accel_amp_mps2: f64,
+        /// angular frequency Ω [rad/s]
+        omega_rps: f64,
+    },
+}
+
+/// An overlay active over `[start_s, end_s]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Overlay {
+    /// kind
+    pub kind: OverlayKind,
+    /// start time [s]
+    pub start_s: f64,
+    /// end time [s] (the overlay state is frozen afterwards)
+    pub end_s: f64,
+}
+
+/// Exact kinematics at one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Kinematics {
+    /// NED velocity [m/s]
+    pub v_n_mps: Vec3,
+    /// its time derivative [m/s²]
+    pub v_dot_n_mps2: Vec3,
+    /// attitude body→NED
+    pub c_b_n: Mat3,
+    /// body rate relative to the navigation frame, in body axes [rad/s]
+    pub omega_nb_b_rps: Vec3,
+}
+
+/// A piecewise-analytic trajectory.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trajectory {
+    roll0_rad: f64,
+    pitch0_rad: f64,
+    segments: Vec<Segment>,
+    overlays: Vec<Overlay>,
+    /// total duration [s]
+    pub duration_s: f64,
+}
+
+struct Nominal {
+    speed: f64,
+    speed_dot: f64,
+    heading: f64,
+    heading_dot: f64,
+    v_d: f64,
+    v_d_dot: f64,
+}
+
+impl Segment {
+    fn eval(&self, t: f64) -> Nominal {
+        let tau = t - self.t0_s;
+        let big_t = self.duration_s;
+        let mut n = Nominal {
+            speed: self.speed0,
+            speed_dot: 0.0,
+            heading: self.heading0,
+            heading_dot: 0.0,
+            v_d: self.v_d0,
+            v_d_dot: 0.0,
+        };
+        match self.motion {
+            Motion::Static | Motion::Cruise => {}
+            Motion::Accelerate { accel_mps2 } => {
+                n.speed = self.speed0 + accel_mps2 * tau;
+                n.speed_dot = accel_mps2;
+            }
+            Motion::TurnRate { rate_rps } => {
+                n.heading = self.heading0 + rate_rps * tau;
+                n.heading_dot = rate_rps;
+            }
+            Motion::TurnSmooth { angle_rad } => {
+                let x = tau / big_t;
+                n.heading = self.heading0 + angle_rad * (x - (2.0 * PI * x).sin() / (2.0 * PI));
+                n.heading_dot = angle_rad / big_t * (1.0 - (2.0 * PI * x).cos());
+            }
+            Motion::STurn { amplitude_rps } => {
+                let w = 2.0 * PI / big_t;
+                n.heading = self.heading0 + amplitude_rps / w * (1.0 - (w * tau).cos());
+                n.heading_dot = amplitude_rps * (w * tau).sin();
+            }
+            Motion::Climb { to_climb_rate_mps } => {
+                let rate = (-to_climb_rate_mps - self.v_d0) / big_t;
+                n.v_d = self.v_d0 + rate * tau;
+                n.v_d_dot = rate;
+            }
+        }
+        n
+    }
+
+    fn end_state(&self) -> (f64, f64, f64) {
+        let n = self.eval(self.t0_s + self.duration_s);
+        // Exact end values for the closed forms whose end is known analytically.
+        let heading = match self.motion {
+            Motion::TurnSmooth { angle_rad } => self.heading0 + angle_rad,
+            Motion::STurn { .. } => self.heading0,
+            _ => n.heading,
+        };
+        (n.speed, heading, n.v_d)
+    }
+}
+
+impl Trajectory {
+    /// Build from the start state and the segments `(motion, duration_s)` in order.
+    pub fn new(
+        start_speed_mps: f64,
+        start_v_d_mps: f64,
+        start_euler: Euler,
+        motions: &[(Motion, f64)],
+        overlays: Vec<Overlay>,
+    ) -> Self {
+        let mut segments = Vec::with_capacity(motions.len());
+        let (mut t, mut s, mut h, mut vd) = (0.0, start_speed_mps, start_euler.yaw_rad, start_v_d_mps);
+        for &(motion, duration_s) in motions {
+            let seg = Segment { motion, t0_s: t, duration_s, speed0: s, heading0: h, v_d0: vd };
+            (s, h, vd) = seg.end_state();
+            t += duration_s;
+            segments.push(seg);
+        }
+        Self { roll0_rad: start_euler.roll_rad, pitch0_rad: start_euler.pitch_rad, segments, overlays, duration_s: t }
+    }
+
+    /// The segments.
+    pub fn segments(&self) -> &[Segment] {
+        &self.segments
+    }
+
+    /// The overlays.
+    pub fn overlays(&self) -> &[Overlay] {
+        &self.overlays
+    }
+
+    /// Whether the kinematics are constant with v_N = v_D = 0 (no overlays, only static or
+    /// cruise segments): then the truth has the closed form of spec §7.0 (A0, A1).
+    pub fn is_constant_parallel(&self) -> bool {
+        self.overlays.is_empty()
+            && self.segments.iter().all(|s| matches!(s.motion, Motion::Static | Motion::Cruise))
+            && self.segments.first().is_none_or(|s| {
+                let k = self.kinematics(0.0, 0.0);
+                s.v_d0 == 0.0 && k.v_n_mps.x.abs() < 1e-12 * (1.0 + k.v_n_mps.y.abs())
+            })
+    }
+
+    fn segment_at(&self, t_sel: f64) -> Option<&Segment> {
+        // Segments are few; linear search from the end finds the last one starting ≤ t_sel.
+        self.segments.iter().rev().find(|s| s.t0_s <= t_sel).or(self.segments.first())
+    }
+
+    /// Exact kinematics at time `t`, with the analytic branch selected by `t_sel`
+    /// (the substep midpoint of the integrator, spec §7.0).
+    pub fn kinematics(&self, t: f64, t_sel: f64) -> Kinematics {
+        let n = match self.segment_at(t_sel) {
+            Some(seg) => seg.eval(t),
+            None => Nominal { speed: 0.0, speed_dot: 0.0, heading: 0.0, heading_dot: 0.0, v_d: 0.0, v_d_dot: 0.0 },
+        };
+        let (sh, ch) = n.heading.sin_cos();
+        let mut v = Vec3::new(n.speed * ch, n.speed * sh, n.v_d);
+        let mut v_dot = Vec3::new(
+            n.speed_dot * ch - n.speed * n.heading_dot * sh,
+            n.speed_dot * sh + n.speed * n.heading_dot * ch,
+            n.v_d_dot,
+        );
+        let c_nom = c_b_n_from_euler(&Euler::new(self.roll0_rad, self.pitch0_rad, n.heading));
+        let (sr, cr) = self.roll0_rad.sin_cos();
+        let (sp, cp) = self.pitch0_rad.sin_cos();
+        // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (spec §1.2)
+        let w_nom = Vec3::new(-n.heading_dot * sp, n.heading_dot * cp * sr, n.heading_dot * cp * cr);
+
+        // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (spec §7.0)
+        let mut c_c = Mat3::identity();
+        let mut w_c = Vec3::zeros();
+        for ov in &self.overlays {
+            // branch by t_sel: before the window the overlay is at rest, after it frozen
+            let active = t_sel >= ov.start_s && t_sel < ov.end_s;
+            let tau = if active {
+                t - ov.start_s
+            } else if t_sel < ov.start_s {
+                0.0
+            } else {
+                ov.end_s - ov.start_s
+            };
+            let (c_k, w_k) = match ov.kind {
+                OverlayKind::Coning { axis, half_angle_rad, omega_rps } => {
+                    let (sa2, ca2) = (0.5 * half_angle_rad).sin_cos();
+                    let (swt, cwt) = (omega_rps * tau).sin_cos();
+                    let v0 = axis.place(sa2, 0.0, 0.0);
+                    let vt = axis.place(sa2 * cwt, sa2 * swt, 0.0);
+                    let q0 = Quat::from_parts(ca2, &v0);
+                    let qt = Quat::from_parts(ca2, &vt);
+                    let c = q0.conj().mul(&qt).to_dcm();
+                    let (sa, ca) = half_angle_rad.sin_cos();
+                    let w = axis.place(-omega_rps * sa * swt, omega_rps * sa * cwt, -omega_rps * (1.0 - ca));
+                    (c, if active { w } else { Vec3::zeros() })
+                }
+                OverlayKind::Sculling { angle_amp_rad, accel_amp_mps2, omega_rps } => {
+                    let (swt, cwt) = (omega_rps * tau).sin_cos();
+                    let ang = angle_amp_rad * swt;
+                    let (sa, ca) = ang.sin_cos();
+                    let c = Mat3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca);
+                    // linear part: body-y velocity (A0/Ω)(1 − cos Ωτ) in the nominal frame
+                    let u = Vec3::new(0.0, accel_amp_mps2 / omega_rps * (1.0 - cwt), 0.0);
+                    let u_dot = if active { Vec3::new(0.0, accel_amp_mps2 * swt, 0.0) } else { Vec3::zeros() };
+                    v += c_nom * u;
+                    v_dot += c_nom * (w_nom.cross(&u) + u_dot);
+                    let w = Vec3::new(angle_amp_rad * omega_rps * cwt, 0.0, 0.0);
+                    (c, if active { w } else { Vec3::zeros() })
+                }
+                OverlayKind::Vibration { axis, accel_amp_mps2, omega_rps } => {
+                    let (swt, cwt) = (omega_rps * tau).sin_cos();
+                    let mut u = Vec3::zeros();
+                    let mut u_dot = Vec3::zeros();
+                    u[axis.index()] = accel_amp_mps2 / omega_rps * swt;
+                    if active {
+                        u_dot[axis.index()] = accel_amp_mps2 * cwt;
+                    }
+                    v += c_nom * u;
+                    v_dot += c_nom * (w_nom.cross(&u) + u_dot);
+                    (Mat3::identity(), Vec3::zeros())
+                }
+            };
+            // compose: C_c ← C_c C_k, ω_c ← C_kᵀ ω_c + ω_k
+            w_c = c_k.transpose() * w_c + w_k;
+            c_c *= c_k;
+        }
+        Kinematics {
+            v_n_mps: v,
+            v_dot_n_mps2: v_dot,
+            c_b_n: c_nom * c_c,
+            omega_nb_b_rps: c_c.transpose() * w_nom + w_c,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn num_deriv<F: Fn(f64) -> Vec3>(f: F, t: f64, h: f64) -> Vec3 {
+        (f(t - 2.0 * h) - 8.0 * f(t - h) + 8.0 * f(t + h) - f(t + 2.0 * h)) / (12.0 * h)
+    }
+
+    fn rich() -> Trajectory {
+        Trajectory::new(
+            10.0,
+            0.0,
+            Euler::new(0.02, -0.03, 0.4),
+            &[
+                (Motion::Accelerate { accel_mps2: 2.0 }, 5.0),
+                (Motion::TurnSmooth { angle_rad: 1.0 }, 4.0),
+                (Motion::STurn { amplitude_rps: 0.1 }, 6.0),
+                (Motion::Climb { to_climb_rate_mps: 3.0 }, 2.0),
+            ],
+            vec![
+                Overlay {
+                    kind: OverlayKind::Coning { axis: Axis::X, half_angle_rad: 0.01, omega_rps: 6.0 },
+                    start_s: 0.0,
+                    end_s: 100.0,
+                },
+                Overlay {
+                    kind: OverlayKind::Sculling { angle_amp_rad: 0.002, accel_amp_mps2: 0.5, omega_rps: 9.0 },
+                    start_s: 0.0,
+                    end_s: 100.0,
+                },
+                Overlay {
+                    kind: OverlayKind::Vibration { axis: Axis::Z, accel_amp_mps2: 0.3, omega_rps: 20.0 },
+                    start_s: 0.0,
+                    end_s: 100.0,
+                },
+            ],
+        )
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        // Inside each segment, v̇ and ω_nb^b (from Ċ = C[ω×]) agree with 4th-order central
+        // differences; truncation O(h⁴·|d⁵v|) with h = 1e-3 is ~1e-10, roundoff ~1e-12.
+        let tr = rich();
+        for &t in &[1.3, 6.7, 11.1, 16.2] {
+            let k = tr.kinematics(t, t);
+            let dv = num_deriv(|x| tr.kinematics(x, t).v_n_mps, t, 1e-3);
+            assert!((dv - k.v_dot_n_mps2).norm() < 1e-8, "t={t}: {}", (dv - k.v_dot_n_mps2).norm());
+            let h = 1e-4;
+            let cdot = (tr.kinematics(t + h, t).c_b_n - tr.kinematics(t - h, t).c_b_n) / (2.0 * h);
+            let w_skew = k.c_b_n.transpose() * cdot;
+            let w = sdins_core::math::vee_antisym(&w_skew);
+            assert!((w - k.omega_nb_b_rps).norm() < 1e-6, "t={t}: {}", (w - k.omega_nb_b_rps).norm());
+        }
+    }
+
+    #[test]
+    fn segments_are_continuous() {
+        let tr = rich();
+        for seg in tr.segments().iter().skip(1) {
+            let t = seg.t0_s;
+            let before = tr.kinematics(t, t - 1e-6);
+            let after = tr.kinematics(t, t + 1e-6);
+            assert!((before.v_n_mps - after.v_n_mps).norm() < 1e-12);
+            assert!((before.c_b_n - after.c_b_n).abs().max() < 1e-14);
+        }
+    }
+}
