@@ -32,6 +32,17 @@ pub enum AttitudeMode {
     Savage,
 }
 
+/// Which rotation vector the rotation compensation `½ x × Δv` uses (spec §4.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RotVector {
+    /// `½ Δθ × Δv`, Savage's `α_m × υ_m` (the summed gyro increment)
+    Theta,
+    /// `½ Δφ × Δv`, S1 eq. (30) (the coning-compensated rotation vector). Differs from
+    /// `Theta` by O(ΔT³)·coning; under 1 Hz coning (spec §7.5) it is the more exact one
+    /// (closer to the dual-quaternion screw exponential, which contains it).
+    Phi,
+}
+
 /// Configuration of a [`LocalLevel`] mechanization.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LocalLevelConfig {
@@ -43,6 +54,8 @@ pub struct LocalLevelConfig {
     pub coning: ConingSet,
     /// samples per update N
     pub samples: usize,
+    /// rotation vector of the rotation compensation
+    pub rot_vector: RotVector,
     /// third-order rotation compensation `+ (1/6) Δφ×(Δφ×Δv)` (spec §4.1)
     pub rot3: bool,
     /// earth model (must equal the truth's)
@@ -130,9 +143,9 @@ impl Mechanization for LocalLevel {
         let w_cor = 2.0 * w_ie + w_en;
 
         // 3. velocity
-        let dphi_rot = match self.cfg.velocity {
-            VelocityMode::Savage => comp.dtheta_b_rad,
-            _ => comp.dphi_b_rad,
+        let dphi_rot = match self.cfg.rot_vector {
+            RotVector::Theta => comp.dtheta_b_rad,
+            RotVector::Phi => comp.dphi_b_rad,
         };
         let mut dv_rot = 0.5 * dphi_rot.cross(&comp.dv_b_mps);
         if self.cfg.rot3 {

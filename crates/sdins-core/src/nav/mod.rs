@@ -13,7 +13,7 @@ mod transport;
 
 pub use dual::DualQuat;
 pub use dualquat::DualQuatNav;
-pub use local_level::{AttitudeMode, LocalLevel, LocalLevelConfig, VelocityMode};
+pub use local_level::{AttitudeMode, LocalLevel, LocalLevelConfig, RotVector, VelocityMode};
 pub use transport::transport_matrix;
 
 use crate::coning::{ConingSet, Increment};
@@ -100,6 +100,8 @@ pub struct AlgorithmSpec {
     pub attitude: Option<AttitudeMode>,
     /// third-order rotation compensation override
     pub rot3: Option<bool>,
+    /// rotation-compensation vector override (`Theta` = ½Δθ×Δv, `Phi` = ½Δφ×Δv)
+    pub rot_vector: Option<RotVector>,
 }
 
 /// Algorithm family.
@@ -141,7 +143,7 @@ impl AlgorithmSpec {
     /// Default options for an algorithm with N samples per update: the polynomial
     /// coefficient set of N (S1's `three_poly` for N = 3).
     pub const fn new(kind: AlgorithmKind, samples: usize) -> Self {
-        Self { kind, samples, coning: ConingSet::default_for(samples), attitude: None, rot3: None }
+        Self { kind, samples, coning: ConingSet::default_for(samples), attitude: None, rot3: None, rot_vector: None }
     }
 
     /// Look up by CLI name.
@@ -169,10 +171,10 @@ impl AnyMechanization {
                 AnyMechanization::DualQuat(DualQuatNav::new(earth, dt_s, spec.samples, spec.coning, init))
             }
             kind => {
-                let (velocity, attitude, rot3) = match kind {
-                    AlgorithmKind::Savage => (VelocityMode::Savage, AttitudeMode::Savage, false),
-                    AlgorithmKind::SongLee => (VelocityMode::SongLee, AttitudeMode::Transport, false),
-                    _ => (VelocityMode::SongLeeComplete, AttitudeMode::Transport, true),
+                let (velocity, attitude, rot3, rotv) = match kind {
+                    AlgorithmKind::Savage => (VelocityMode::Savage, AttitudeMode::Savage, false, RotVector::Theta),
+                    AlgorithmKind::SongLee => (VelocityMode::SongLee, AttitudeMode::Transport, false, RotVector::Phi),
+                    _ => (VelocityMode::SongLeeComplete, AttitudeMode::Transport, true, RotVector::Phi),
                 };
                 let cfg = LocalLevelConfig {
                     velocity,
@@ -180,6 +182,7 @@ impl AnyMechanization {
                     coning: spec.coning,
                     samples: spec.samples,
                     rot3: spec.rot3.unwrap_or(rot3),
+                    rot_vector: spec.rot_vector.unwrap_or(rotv),
                     earth,
                     dt_s,
                 };

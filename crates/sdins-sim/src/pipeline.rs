@@ -1,0 +1,203 @@
+//! Streaming truth → navigation → errors pipeline, in constant memory.
+//!
+//! Truth is generated once, in blocks of navigation updates, and every algorithm is
+//! fed the same block; each algorithm's time is measured around its own update loop only
+//! (the `wall_s` of `sdins run --json`).
+
+use crate::scenario::Scenario;
+use crate::truth::{lon_diff, TruthConfig, TruthGenerator, TruthSample};
+use sdins_core::coning::Increment;
+use sdins_core::earth::EarthModel;
+use sdins_core::math::{attitude_error, euler_from_c_b_n, Vec3};
+use sdins_core::nav::{AlgorithmSpec, AnyMechanization, Mechanization, NavState};
+use std::time::Instant;
+
+/// Navigation errors at one epoch (mechanization.md §1.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct NavError {
+    /// time [s]
+    pub t_s: f64,
+    /// position error N, E, D [m]: δN = δL(R_M+h), δE = δλ(R_N+h)cosL, δD = −δh
+    pub pos_err_ned_m: [f64; 3],
+    /// velocity error v_alg − v_true, NED [m/s]
+    pub vel_err_ned_mps: [f64; 3],
+    /// attitude error ε, NED [rad], C_alg C_trueᵀ = I + [ε×]
+    pub att_err_rad: [f64; 3],
+    /// height error h_alg − h_true [m]
+    pub height_err_m: f64,
+    /// Euler-angle differences roll, pitch, yaw, wrapped to (−π, π] [rad]
+    pub euler_err_rad: [f64; 3],
+}
+
+impl NavError {
+    /// Element-wise maximum of absolute values (`t_s` is the later time).
+    pub fn max_abs(&self, o: &NavError) -> NavError {
+        let m3 = |a: [f64; 3], b: [f64; 3]| [a[0].abs().max(b[0].abs()), a[1].abs().max(b[1].abs()), a[2].abs().max(b[2].abs())];
+        NavError {
+            t_s: self.t_s.max(o.t_s),
+            pos_err_ned_m: m3(self.pos_err_ned_m, o.pos_err_ned_m),
+            vel_err_ned_mps: m3(self.vel_err_ned_mps, o.vel_err_ned_mps),
+            att_err_rad: m3(self.att_err_rad, o.att_err_rad),
+            height_err_m: self.height_err_m.abs().max(o.height_err_m.abs()),
+            euler_err_rad: m3(self.euler_err_rad, o.euler_err_rad),
+        }
+    }
+}
+
+fn arr(v: &Vec3) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+/// Errors of a navigation state against the truth (spec §1.4).
+pub fn nav_error(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> NavError {
+    let r = earth.radii(truth.lat_rad);
+    let dlat = nav.lat_rad - truth.lat_rad;
+    let dlon = lon_diff(nav.lon_rad, truth.lon_rad);
+    let dh = nav.h_m - truth.h_m;
+    let pos = Vec3::new(dlat * (r.r_m_m + truth.h_m), dlon * (r.r_n_m + truth.h_m) * truth.lat_rad.cos(), -dh);
+    let ea = euler_from_c_b_n(&nav.c_b_n);
+    let et = euler_from_c_b_n(&truth.c_b_n);
+    let w = sdins_core::nav::wrap_pi;
+    NavError {
+        t_s: truth.t_s,
+        pos_err_ned_m: arr(&pos),
+        vel_err_ned_mps: arr(&(nav.v_n_mps - truth.v_n_mps)),
+        att_err_rad: arr(&attitude_error(&nav.c_b_n, &truth.c_b_n)),
+        height_err_m: dh,
+        euler_err_rad: [w(ea.roll_rad - et.roll_rad), w(ea.pitch_rad - et.pitch_rad), w(ea.yaw_rad - et.yaw_rad)],
+    }
+}
+
+/// Summary of one algorithm's run.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RunSummary {
+    /// algorithm CLI name
+    pub algo: String,
+    /// samples per update
+    pub samples: usize,
+    /// number of navigation updates
+    pub nav_updates: u64,
+    /// time spent in the navigation loop only [s]
+    pub wall_s: f64,
+    /// errors at the last update
+    #[serde(rename = "final")]
+    pub final_err: NavError,
+    /// maximum absolute errors over the run
+    pub max_abs: NavError,
+}
+
+/// Options of a pipeline run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunOptions {
+    /// algorithms to run side by side (all must share N)
+    pub algos: Vec<AlgorithmSpec>,
+    /// vertical channel held to the truth
+    pub vertical_hold: bool,
+    /// output decimation: call the observer every `every` updates (and at the end)
+    pub every: u64,
+    /// stop after this time [s] (None: whole scenario)
+    pub until_s: Option<f64>,
+}
+
+/// Run the scenario's truth through every algorithm; `observe(i, state, truth, err)` is
+/// called every `opts.every` updates for algorithm `i`. `progress(done, total)` is
+/// called once per block.
+pub fn run(
+    scn: &Scenario,
+    opts: &RunOptions,
+    mut observe: impl FnMut(usize, &NavState, &TruthSample, &NavError),
+    mut progress: impl FnMut(u64, u64),
+) -> Vec<RunSummary> {
+    let earth = scn.nav.earth.model();
+    let cfg = TruthConfig {
+        earth,
+        dt_s: scn.imu.dt_s(),
+        lat0_rad: scn.start.lat_rad,
+        lon0_rad: scn.start.lon_rad,
+        h0_m: scn.start.h_m,
+        substeps: scn.nav.substeps,
+    };
+    let mut truth = TruthGenerator::new(&scn.trajectory, cfg);
+    let init = truth.initial_state();
+    let n = opts.algos.first().map_or(scn.nav.samples, |a| a.samples).max(1);
+    let mut mechs: Vec<AnyMechanization> =
+        opts.algos.iter().map(|a| AnyMechanization::new(a, earth, cfg.dt_s, &init)).collect();
+    let mut total_updates = truth.len_samples() / n as u64;
+    if let Some(t) = opts.until_s {
+        total_updates = total_updates.min((t / (cfg.dt_s * n as f64)).round() as u64);
+    }
+    const BLOCK: usize = 2048;
+    let mut incs: Vec<Increment> = Vec::with_capacity(BLOCK * n);
+    let mut ends: Vec<TruthSample> = Vec::with_capacity(BLOCK);
+    let mut wall = vec![0.0_f64; mechs.len()];
+    let mut last = vec![NavError::default(); mechs.len()];
+    let mut maxes = vec![NavError::default(); mechs.len()];
+    let every = opts.every.max(1);
+    let mut done = 0_u64;
+    while done < total_updates {
+        let count = ((total_updates - done) as usize).min(BLOCK);
+        incs.clear();
+        ends.clear();
+        for _ in 0..count {
+            let mut end = None;
+            for _ in 0..n {
+                if let Some(s) = truth.next() {
+                    incs.push(s.inc);
+                    end = Some(s);
+                }
+            }
+            if let Some(e) = end {
+                ends.push(e);
+            }
+        }
+        let count = ends.len();
+        for (i, m) in mechs.iter_mut().enumerate() {
+            // timed update runs between observation epochs; observation is untimed
+            let mut u = 0;
+            while u < count {
+                let global = done + u as u64; // updates completed before this one
+                let to_epoch = every - (global % every); // updates until the next epoch
+                let stop = (u + to_epoch as usize).min(count);
+                let t0 = Instant::now();
+                if opts.vertical_hold {
+                    for (k, end) in ends.iter().enumerate().take(stop).skip(u) {
+                        m.update(&incs[k * n..(k + 1) * n]);
+                        m.hold_vertical(end.h_m, end.v_n_mps.z);
+                    }
+                } else {
+                    for k in u..stop {
+                        m.update(&incs[k * n..(k + 1) * n]);
+                    }
+                }
+                wall[i] += t0.elapsed().as_secs_f64();
+                let finished = done + stop as u64;
+                if finished % every == 0 || finished == total_updates {
+                    let tr = &ends[stop - 1];
+                    let st = m.state();
+                    let e = nav_error(&earth, &st, tr);
+                    last[i] = e;
+                    maxes[i] = maxes[i].max_abs(&e);
+                    observe(i, &st, tr, &e);
+                }
+                u = stop;
+            }
+        }
+        done += count as u64;
+        progress(done, total_updates);
+        if count == 0 {
+            break;
+        }
+    }
+    mechs
+        .iter()
+        .enumerate()
+        .map(|(i, _)| RunSummary {
+            algo: opts.algos[i].kind.name().to_string(),
+            samples: n,
+            nav_updates: done,
+            wall_s: wall[i],
+            final_err: last[i],
+            max_abs: maxes[i],
+        })
+        .collect()
+}
