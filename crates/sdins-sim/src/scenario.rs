@@ -219,7 +219,7 @@ pub struct NavConfig {
     pub earth: EarthChoice,
     /// vertical channel: `free` or `hold`
     pub vertical_hold: bool,
-    /// truth RK4 substeps per sample
+    /// truth RK4 substeps per sample (default: [`crate::truth::auto_substeps`])
     pub substeps: usize,
 }
 
@@ -533,6 +533,10 @@ impl Scenario {
         }
 
         let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
+        let mut nav = nav;
+        if nav.substeps == 0 {
+            nav.substeps = crate::truth::auto_substeps(dt, &trajectory);
+        }
         Ok(Scenario {
             name: doc.name.unwrap_or_else(|| {
                 Path::new(file).file_stem().map_or_else(|| "scenario".into(), |s| s.to_string_lossy().into_owned())
@@ -580,7 +584,7 @@ fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioEr
         coning: None,
         earth: EarthChoice::Wgs84,
         vertical_hold: false,
-        substeps: 16,
+        substeps: 0,
     };
     let Some(n) = nav else { return Ok(cfg) };
     if let Some(s) = &n.samples {

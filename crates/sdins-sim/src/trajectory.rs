@@ -246,6 +246,21 @@ impl Trajectory {
         &self.segments
     }
 
+    /// Highest angular frequency of any periodic motion (overlays, smooth turns,
+    /// S-turns) [rad/s]; zero if none.
+    pub fn max_frequency_rps(&self) -> f64 {
+        let seg = self.segments.iter().map(|s| match s.motion {
+            Motion::TurnSmooth { .. } | Motion::STurn { .. } => 2.0 * PI / s.duration_s,
+            _ => 0.0,
+        });
+        let ov = self.overlays.iter().map(|o| match o.kind {
+            OverlayKind::Coning { omega_rps, .. }
+            | OverlayKind::Sculling { omega_rps, .. }
+            | OverlayKind::Vibration { omega_rps, .. } => omega_rps,
+        });
+        seg.chain(ov).fold(0.0, f64::max)
+    }
+
     /// The overlays.
     pub fn overlays(&self) -> &[Overlay] {
         &self.overlays
@@ -270,6 +285,16 @@ impl Trajectory {
     /// Exact kinematics at time `t`, with the analytic branch selected by `t_sel`
     /// (the substep midpoint of the integrator, spec §7.0).
     pub fn kinematics(&self, t: f64, t_sel: f64) -> Kinematics {
+        self.kinematics_split(t, 0.0, t_sel)
+    }
+
+    /// As [`Trajectory::kinematics`] at `t = t_base + off`, with periodic overlay phases
+    /// formed as `Ω(t_base − start) + Ω·off` and combined by the angle-addition formulas,
+    /// so that the large part of the phase is rounded identically for every substep of a
+    /// sample (at t = 400 s one ulp of t is 5.7e-14 s, which would otherwise put ~1e-16 rad
+    /// of time-quantisation noise on each increment).
+    pub fn kinematics_split(&self, t_base: f64, off: f64, t_sel: f64) -> Kinematics {
+        let t = t_base + off;
         let n = match self.segment_at(t_sel) {
             Some(seg) => seg.eval(t),
             None => Nominal { speed: 0.0, speed_dot: 0.0, heading: 0.0, heading_dot: 0.0, v_d: 0.0, v_d_dot: 0.0 },
@@ -293,17 +318,22 @@ impl Trajectory {
         for ov in &self.overlays {
             // branch by t_sel: before the window the overlay is at rest, after it frozen
             let active = t_sel >= ov.start_s && t_sel < ov.end_s;
-            let tau = if active {
-                t - ov.start_s
+            let (tau_base, tau_off) = if active {
+                (t_base - ov.start_s, off)
             } else if t_sel < ov.start_s {
-                0.0
+                (0.0, 0.0)
             } else {
-                ov.end_s - ov.start_s
+                (ov.end_s - ov.start_s, 0.0)
+            };
+            let sincos = |w: f64| -> (f64, f64) {
+                let (sa, ca) = (w * tau_base).sin_cos();
+                let (sb, cb) = (w * tau_off).sin_cos();
+                (sa * cb + ca * sb, ca * cb - sa * sb)
             };
             let (c_k, w_k) = match ov.kind {
                 OverlayKind::Coning { axis, half_angle_rad, omega_rps } => {
                     let (sa2, ca2) = (0.5 * half_angle_rad).sin_cos();
-                    let (swt, cwt) = (omega_rps * tau).sin_cos();
+                    let (swt, cwt) = sincos(omega_rps);
                     let v0 = axis.place(sa2, 0.0, 0.0);
                     let vt = axis.place(sa2 * cwt, sa2 * swt, 0.0);
                     let q0 = Quat::from_parts(ca2, &v0);
@@ -314,7 +344,7 @@ impl Trajectory {
                     (c, if active { w } else { Vec3::zeros() })
                 }
                 OverlayKind::Sculling { angle_amp_rad, accel_amp_mps2, omega_rps } => {
-                    let (swt, cwt) = (omega_rps * tau).sin_cos();
+                    let (swt, cwt) = sincos(omega_rps);
                     let ang = angle_amp_rad * swt;
                     let (sa, ca) = ang.sin_cos();
                     let c = Mat3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca);
@@ -327,7 +357,7 @@ impl Trajectory {
                     (c, if active { w } else { Vec3::zeros() })
                 }
                 OverlayKind::Vibration { axis, accel_amp_mps2, omega_rps } => {
-                    let (swt, cwt) = (omega_rps * tau).sin_cos();
+                    let (swt, cwt) = sincos(omega_rps);
                     let mut u = Vec3::zeros();
                     let mut u_dot = Vec3::zeros();
                     u[axis.index()] = accel_amp_mps2 / omega_rps * swt;
