@@ -8,6 +8,7 @@ mod cmd;
 mod error;
 #[allow(dead_code)]
 mod output;
+mod progress;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -36,6 +37,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    progress::install_ctrlc();
     let result = match cli.command {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Scenarios(a) => cmd::scenarios::run(a),
