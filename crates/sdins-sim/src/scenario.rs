@@ -294,15 +294,28 @@ fn levenshtein(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
-/// Closest accepted key to an unknown one (for "did you mean" hints).
+fn is_subsequence(short: &str, long: &str) -> bool {
+    let mut it = long.chars();
+    short.chars().all(|c| it.any(|x| x == c))
+}
+
+/// Closest of `candidates` to an unknown key (for "did you mean" hints): the smallest
+/// edit distance within half the key's length, or a key whose letters appear in order in
+/// the unknown one (`heigth_m` → `h_m`).
+pub fn suggest_from<'a>(unknown: &str, candidates: &[&'a str]) -> Option<&'a str> {
+    let best = candidates.iter().copied().map(|k| (levenshtein(unknown, k), k)).min_by_key(|(d, _)| *d);
+    if let Some((d, k)) = best {
+        if d <= 3.max(unknown.len() / 2) {
+            return Some(k);
+        }
+    }
+    candidates.iter().copied().filter(|k| k.len() >= 3 && is_subsequence(k, unknown)).max_by_key(|k| k.len())
+}
+
+/// Closest accepted key (of any table) to an unknown one.
 pub fn suggest(unknown: &str) -> Option<&'static str> {
-    ACCEPTED_KEYS
-        .iter()
-        .flat_map(|(_, keys)| keys.iter().copied())
-        .map(|k| (levenshtein(unknown, k), k))
-        .filter(|(d, k)| *d <= 3.max(k.len() / 3))
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, k)| k)
+    let all: Vec<&'static str> = ACCEPTED_KEYS.iter().flat_map(|(_, keys)| keys.iter().copied()).collect();
+    suggest_from(unknown, &all)
 }
 
 fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> ScenarioError {
@@ -314,7 +327,10 @@ fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> ScenarioError {
         if let Some(end) = rest.find('`') {
             let name = &rest[..end];
             key = name.to_string();
-            message = format!("unknown key{}", suggest(name).map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default());
+            // candidates: the keys the parser listed as expected here
+            let expected: Vec<&str> = rest.split('`').skip(2).step_by(2).collect();
+            let hint = if expected.is_empty() { suggest(name) } else { suggest_from(name, &expected) };
+            message = format!("unknown key{}", hint.map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default());
             if let Some(exp) = rest.find("expected") {
                 message.push_str(&format!("; {}", &rest[exp..]));
             }
