@@ -19,13 +19,26 @@ impl AtomicFile {
     pub fn create(dest: &Path) -> Result<Self, CliError> {
         if let Some(dir) = dest.parent() {
             if !dir.as_os_str().is_empty() {
-                std::fs::create_dir_all(dir).map_err(|source| CliError::Io { path: dir.to_path_buf(), source })?;
+                std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
+                    path: dir.to_path_buf(),
+                    source,
+                })?;
             }
         }
-        let name = dest.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = dest
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
         let tmp = dest.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-        let f = File::create(&tmp).map_err(|source| CliError::Io { path: tmp.clone(), source })?;
-        Ok(Self { tmp, dest: dest.to_path_buf(), writer: Some(BufWriter::with_capacity(1 << 20, f)) })
+        let f = File::create(&tmp).map_err(|source| CliError::Io {
+            path: tmp.clone(),
+            source,
+        })?;
+        Ok(Self {
+            tmp,
+            dest: dest.to_path_buf(),
+            writer: Some(BufWriter::with_capacity(1 << 20, f)),
+        })
     }
 
     /// The buffered writer.
@@ -40,11 +53,23 @@ impl AtomicFile {
     /// Flush, sync and rename into place.
     pub fn commit(mut self) -> Result<(), CliError> {
         if let Some(mut w) = self.writer.take() {
-            w.flush().map_err(|source| CliError::Io { path: self.tmp.clone(), source })?;
-            let f = w.into_inner().map_err(|e| CliError::Io { path: self.tmp.clone(), source: e.into_error() })?;
-            f.sync_all().map_err(|source| CliError::Io { path: self.tmp.clone(), source })?;
+            w.flush().map_err(|source| CliError::Io {
+                path: self.tmp.clone(),
+                source,
+            })?;
+            let f = w.into_inner().map_err(|e| CliError::Io {
+                path: self.tmp.clone(),
+                source: e.into_error(),
+            })?;
+            f.sync_all().map_err(|source| CliError::Io {
+                path: self.tmp.clone(),
+                source,
+            })?;
         }
-        std::fs::rename(&self.tmp, &self.dest).map_err(|source| CliError::Io { path: self.dest.clone(), source })
+        std::fs::rename(&self.tmp, &self.dest).map_err(|source| CliError::Io {
+            path: self.dest.clone(),
+            source,
+        })
     }
 }
 
@@ -59,6 +84,11 @@ impl Drop for AtomicFile {
 /// Write a whole string atomically.
 pub fn write_string(dest: &Path, s: &str) -> Result<(), CliError> {
     let mut f = AtomicFile::create(dest)?;
-    f.writer().write_all(s.as_bytes()).map_err(|source| CliError::Io { path: dest.to_path_buf(), source })?;
+    f.writer()
+        .write_all(s.as_bytes())
+        .map_err(|source| CliError::Io {
+            path: dest.to_path_buf(),
+            source,
+        })?;
     f.commit()
 }

@@ -3,8 +3,15 @@
 use std::process::Command;
 
 fn sdins(args: &[&str]) -> (i32, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_sdins")).args(args).output().unwrap();
-    (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+    let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
 }
 
 fn tmp(name: &str) -> std::path::PathBuf {
@@ -20,19 +27,52 @@ const GOOD: &str = "[start]\nlat_deg = 37.5\nlon_deg = 127.0\n[imu]\nrate_hz = 1
 fn bad_scenario_files_exit_2_with_file_line_key() {
     let d = tmp("bad");
     for (name, text, line, key) in [
-        ("unknown.toml", GOOD.replace("lon_deg = 127.0", "lon_deg = 127.0\nheigth_m = 3.0"), 4, "heigth_m"),
-        ("missing.toml", GOOD.replace("lat_deg = 37.5\n", ""), 1, "lat_deg"),
-        ("negdur.toml", GOOD.replace("duration_s = 1.0", "duration_s = -5.0"), 8, "segment.duration_s"),
-        ("rate0.toml", GOOD.replace("rate_hz = 100.0", "rate_hz = 0.0"), 5, "imu.rate_hz"),
-        ("lat95.toml", GOOD.replace("lat_deg = 37.5", "lat_deg = 95.0"), 2, "start.lat_deg"),
+        (
+            "unknown.toml",
+            GOOD.replace("lon_deg = 127.0", "lon_deg = 127.0\nheigth_m = 3.0"),
+            4,
+            "heigth_m",
+        ),
+        (
+            "missing.toml",
+            GOOD.replace("lat_deg = 37.5\n", ""),
+            1,
+            "lat_deg",
+        ),
+        (
+            "negdur.toml",
+            GOOD.replace("duration_s = 1.0", "duration_s = -5.0"),
+            8,
+            "segment.duration_s",
+        ),
+        (
+            "rate0.toml",
+            GOOD.replace("rate_hz = 100.0", "rate_hz = 0.0"),
+            5,
+            "imu.rate_hz",
+        ),
+        (
+            "lat95.toml",
+            GOOD.replace("lat_deg = 37.5", "lat_deg = 95.0"),
+            2,
+            "start.lat_deg",
+        ),
         ("syntax.toml", GOOD.replace("[imu]", "[imu"), 4, ""),
     ] {
         let p = d.join(name);
         std::fs::write(&p, text).unwrap();
-        let (code, _out, err) = sdins(&["truth", p.to_str().unwrap(), "--out", d.join("o").to_str().unwrap()]);
+        let (code, _out, err) = sdins(&[
+            "truth",
+            p.to_str().unwrap(),
+            "--out",
+            d.join("o").to_str().unwrap(),
+        ]);
         assert_eq!(code, 2, "{name}: {err}");
         assert!(err.contains(name), "{name}: {err}");
-        assert!(err.contains(&format!(":{line}:")), "{name}: want line {line}: {err}");
+        assert!(
+            err.contains(&format!(":{line}:")),
+            "{name}: want line {line}: {err}"
+        );
         assert!(err.contains(key), "{name}: want key {key}: {err}");
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
@@ -56,17 +96,38 @@ fn truth_writes_both_files_and_run_json_shape() {
     let d = tmp("good");
     let p = d.join("s.toml");
     std::fs::write(&p, GOOD).unwrap();
-    let (code, _, err) = sdins(&["truth", p.to_str().unwrap(), "--out", d.to_str().unwrap(), "--quiet"]);
+    let (code, _, err) = sdins(&[
+        "truth",
+        p.to_str().unwrap(),
+        "--out",
+        d.to_str().unwrap(),
+        "--quiet",
+    ]);
     assert_eq!(code, 0, "{err}");
     let imu = std::fs::read_to_string(d.join("imu.csv")).unwrap();
     assert_eq!(imu.lines().count(), 101);
-    assert!(imu.starts_with("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps"));
+    assert!(
+        imu.starts_with("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps")
+    );
     let truth = std::fs::read_to_string(d.join("truth.csv")).unwrap();
-    assert!(truth.starts_with("t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg"));
+    assert!(truth
+        .starts_with("t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg"));
     // no temporary files left behind
-    assert!(std::fs::read_dir(&d).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().contains(".tmp")));
+    assert!(std::fs::read_dir(&d).unwrap().all(|e| !e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .contains(".tmp")));
 
-    let (code, out, err) = sdins(&["run", p.to_str().unwrap(), "--algo", "songlee,dualquat", "--json", "--out", d.to_str().unwrap()]);
+    let (code, out, err) = sdins(&[
+        "run",
+        p.to_str().unwrap(),
+        "--algo",
+        "songlee,dualquat",
+        "--json",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["results"].as_array().unwrap().len(), 2);
@@ -74,7 +135,12 @@ fn truth_writes_both_files_and_run_json_shape() {
     assert_eq!(r["algo"], "songlee");
     assert_eq!(r["samples"], 3);
     assert_eq!(r["nav_updates"], 33);
-    for key in ["pos_err_ned_m", "vel_err_ned_mps", "att_err_rad", "euler_err_rad"] {
+    for key in [
+        "pos_err_ned_m",
+        "vel_err_ned_mps",
+        "att_err_rad",
+        "euler_err_rad",
+    ] {
         assert_eq!(r["final"][key].as_array().unwrap().len(), 3, "{key}");
         assert_eq!(r["max_abs"][key].as_array().unwrap().len(), 3, "{key}");
     }
@@ -86,7 +152,13 @@ fn truth_writes_both_files_and_run_json_shape() {
 fn scenarios_lists_and_prints_parseable_files() {
     let (code, out, _) = sdins(&["scenarios"]);
     assert_eq!(code, 0);
-    for name in ["stationary", "mach1-east", "turn-90dps", "dq-paper", "alignment"] {
+    for name in [
+        "stationary",
+        "mach1-east",
+        "turn-90dps",
+        "dq-paper",
+        "alignment",
+    ] {
         assert!(out.contains(name), "{out}");
         let (code, text, _) = sdins(&["scenarios", name]);
         assert_eq!(code, 0);

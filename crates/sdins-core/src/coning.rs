@@ -21,7 +21,10 @@ pub struct Increment {
 impl Increment {
     /// Build from the two vectors.
     pub const fn new(dtheta_b_rad: Vec3, dv_b_mps: Vec3) -> Self {
-        Self { dtheta_b_rad, dv_b_mps }
+        Self {
+            dtheta_b_rad,
+            dv_b_mps,
+        }
     }
 }
 
@@ -46,8 +49,13 @@ pub enum ConingSet {
 }
 
 const TWO: [(usize, usize, f64); 1] = [(0, 1, 2.0 / 3.0)];
-const THREE_POLY: [(usize, usize, f64); 3] = [(0, 1, 57.0 / 80.0), (1, 2, 57.0 / 80.0), (0, 2, 33.0 / 80.0)];
-const THREE_OPT: [(usize, usize, f64); 3] = [(0, 1, 27.0 / 40.0), (1, 2, 27.0 / 40.0), (0, 2, 9.0 / 20.0)];
+const THREE_POLY: [(usize, usize, f64); 3] = [
+    (0, 1, 57.0 / 80.0),
+    (1, 2, 57.0 / 80.0),
+    (0, 2, 33.0 / 80.0),
+];
+const THREE_OPT: [(usize, usize, f64); 3] =
+    [(0, 1, 27.0 / 40.0), (1, 2, 27.0 / 40.0), (0, 2, 9.0 / 20.0)];
 const FOUR_POLY: [(usize, usize, f64); 6] = [
     (0, 1, 736.0 / 945.0),
     (2, 3, 736.0 / 945.0),
@@ -183,12 +191,18 @@ pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Co
             for &(i, j, k) in set.coefficients() {
                 if let (Some(a), Some(b)) = (samples.get(i), samples.get(j)) {
                     cone += k * a.dtheta_b_rad.cross(&b.dtheta_b_rad);
-                    scul += k * (a.dtheta_b_rad.cross(&b.dv_b_mps) + a.dv_b_mps.cross(&b.dtheta_b_rad));
+                    scul +=
+                        k * (a.dtheta_b_rad.cross(&b.dv_b_mps) + a.dv_b_mps.cross(&b.dtheta_b_rad));
                 }
             }
         }
     }
-    Compensated { dtheta_b_rad: dth, dv_b_mps: dv, dphi_b_rad: dth + cone, dv_scul_b_mps: scul }
+    Compensated {
+        dtheta_b_rad: dth,
+        dv_b_mps: dv,
+        dphi_b_rad: dth + cone,
+        dv_scul_b_mps: scul,
+    }
 }
 
 #[cfg(test)]
@@ -208,7 +222,8 @@ mod tests {
         let eq27 = (57.0 / 80.0) * ((t1 - t3).cross(&v2) + (v1 - v3).cross(&t2))
             + (33.0 / 80.0) * (t1.cross(&v3) + v1.cross(&t3));
         assert!((c.dv_scul_b_mps - eq27).norm() < 1e-16);
-        let eq4 = t1 + t2 + t3 + (33.0 / 80.0) * t1.cross(&t3) + (57.0 / 80.0) * t2.cross(&(t3 - t1));
+        let eq4 =
+            t1 + t2 + t3 + (33.0 / 80.0) * t1.cross(&t3) + (57.0 / 80.0) * t2.cross(&(t3 - t1));
         assert!((c.dphi_b_rad - eq4).norm() < 1e-17);
     }
 
@@ -220,9 +235,17 @@ mod tests {
         for set in ConingSet::ALL {
             let n = set.samples().max(1);
             let samples = [inc; 4];
-            let c = compensate(set, &samples[..n], &Increment::new(inc.dtheta_b_rad * n as f64, inc.dv_b_mps * n as f64));
+            let c = compensate(
+                set,
+                &samples[..n],
+                &Increment::new(inc.dtheta_b_rad * n as f64, inc.dv_b_mps * n as f64),
+            );
             assert!(c.dv_scul_b_mps.norm() < 1e-20, "{}", set.name());
-            assert!((c.dphi_b_rad - c.dtheta_b_rad).norm() < 1e-21, "{}", set.name());
+            assert!(
+                (c.dphi_b_rad - c.dtheta_b_rad).norm() < 1e-21,
+                "{}",
+                set.name()
+            );
         }
     }
 
@@ -249,7 +272,10 @@ mod tests {
         for set in ConingSet::ALL {
             assert_eq!(ConingSet::parse(set.name(), set.samples()), Some(set));
         }
-        assert_eq!(ConingSet::parse("polynomial", 3), Some(ConingSet::ThreePoly));
+        assert_eq!(
+            ConingSet::parse("polynomial", 3),
+            Some(ConingSet::ThreePoly)
+        );
         assert_eq!(ConingSet::parse("optimal", 3), Some(ConingSet::ThreeOpt));
         assert_eq!(ConingSet::parse("optimal", 4), Some(ConingSet::FourOpt));
         assert_eq!(ConingSet::parse("bogus", 3), None);

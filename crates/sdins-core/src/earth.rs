@@ -89,7 +89,12 @@ impl EarthModel {
         f: 1.0 / 298.257,
         e2: (1.0 / 298.257) * (2.0 - 1.0 / 298.257),
         omega_ie_rps: 7.292_115_146_7e-5,
-        gravity: Gravity::Psins { g0: 9.780_326_771_4, c2: 5.270_94e-3, c4: 2.327_18e-5, dh: 3.086e-6 },
+        gravity: Gravity::Psins {
+            g0: 9.780_326_771_4,
+            c2: 5.270_94e-3,
+            c4: 2.327_18e-5,
+            dh: 3.086e-6,
+        },
         transport: true,
     };
 
@@ -115,7 +120,10 @@ impl EarthModel {
         let w2 = 1.0 - self.e2 * s * s;
         let w = libm::sqrt(w2);
         let r_n_m = self.a_m / w;
-        Radii { r_m_m: r_n_m * (1.0 - self.e2) / w2, r_n_m }
+        Radii {
+            r_m_m: r_n_m * (1.0 - self.e2) / w2,
+            r_n_m,
+        }
     }
 
     /// Magnitude of normal gravity g(L, h) [m/s²] (positive down).
@@ -161,7 +169,11 @@ impl EarthModel {
         }
         let r = self.radii(lat_rad);
         let rn = r.r_n_m + h_m;
-        Vec3::new(v_n_mps.y / rn, -v_n_mps.x / (r.r_m_m + h_m), -v_n_mps.y * libm::tan(lat_rad) / rn)
+        Vec3::new(
+            v_n_mps.y / rn,
+            -v_n_mps.x / (r.r_m_m + h_m),
+            -v_n_mps.y * libm::tan(lat_rad) / rn,
+        )
     }
 
     /// ECEF position of a geodetic point:
@@ -170,7 +182,11 @@ impl EarthModel {
         let rn = self.radii(lat_rad).r_n_m;
         let (sl, cl) = (libm::sin(lat_rad), libm::cos(lat_rad));
         let (so, co) = (libm::sin(lon_rad), libm::cos(lon_rad));
-        Vec3::new((rn + h_m) * cl * co, (rn + h_m) * cl * so, (rn * (1.0 - self.e2) + h_m) * sl)
+        Vec3::new(
+            (rn + h_m) * cl * co,
+            (rn + h_m) * cl * so,
+            (rn * (1.0 - self.e2) + h_m) * sl,
+        )
     }
 
     /// Geodetic (lat, lon, h) of an ECEF position, by the fixed iteration of
@@ -180,7 +196,11 @@ impl EarthModel {
         let lon = libm::atan2(r_e.y, r_e.x);
         let p = libm::sqrt(r_e.x * r_e.x + r_e.y * r_e.y);
         if p < 1e-3 {
-            let lat = if r_e.z >= 0.0 { core::f64::consts::FRAC_PI_2 } else { -core::f64::consts::FRAC_PI_2 };
+            let lat = if r_e.z >= 0.0 {
+                core::f64::consts::FRAC_PI_2
+            } else {
+                -core::f64::consts::FRAC_PI_2
+            };
             let b = self.a_m * libm::sqrt(1.0 - self.e2);
             return (lat, lon, libm::fabs(r_e.z) - b);
         }
@@ -200,7 +220,17 @@ impl EarthModel {
     pub fn c_e_n(lat_rad: f64, lon_rad: f64) -> Mat3 {
         let (sl, cl) = (libm::sin(lat_rad), libm::cos(lat_rad));
         let (so, co) = (libm::sin(lon_rad), libm::cos(lon_rad));
-        Mat3::new(-sl * co, -sl * so, cl, -so, co, 0.0, -cl * co, -cl * so, -sl)
+        Mat3::new(
+            -sl * co,
+            -sl * so,
+            cl,
+            -so,
+            co,
+            0.0,
+            -cl * co,
+            -cl * so,
+            -sl,
+        )
     }
 }
 
@@ -294,11 +324,15 @@ mod tests {
     fn psins_and_flat_variants() {
         let p = EarthModel::PSINS;
         let s2 = (34.25 * D2R).sin().powi(2);
-        let g = 9.780_326_771_4 * (1.0 + 5.270_94e-3 * s2 + 2.327_18e-5 * s2 * s2) - 3.086e-6 * 380.0;
+        let g =
+            9.780_326_771_4 * (1.0 + 5.270_94e-3 * s2 + 2.327_18e-5 * s2 * s2) - 3.086e-6 * 380.0;
         assert_eq!(p.gravity(34.25 * D2R, 380.0), g);
         let f = EarthModel::flat(9.80665);
         assert_eq!(f.gravity(1.0, 1000.0), 9.80665);
         assert_eq!(f.omega_ie_n(0.5), Vec3::zeros());
-        assert_eq!(f.omega_en_n(0.5, 0.0, &Vec3::new(10.0, 5.0, 0.0)), Vec3::zeros());
+        assert_eq!(
+            f.omega_en_n(0.5, 0.0, &Vec3::new(10.0, 5.0, 0.0)),
+            Vec3::zeros()
+        );
     }
 }

@@ -32,7 +32,13 @@ pub struct NavError {
 impl NavError {
     /// Element-wise maximum of absolute values (`t_s` is the later time).
     pub fn max_abs(&self, o: &NavError) -> NavError {
-        let m3 = |a: [f64; 3], b: [f64; 3]| [a[0].abs().max(b[0].abs()), a[1].abs().max(b[1].abs()), a[2].abs().max(b[2].abs())];
+        let m3 = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[0].abs().max(b[0].abs()),
+                a[1].abs().max(b[1].abs()),
+                a[2].abs().max(b[2].abs()),
+            ]
+        };
         NavError {
             t_s: self.t_s.max(o.t_s),
             pos_err_ned_m: m3(self.pos_err_ned_m, o.pos_err_ned_m),
@@ -54,7 +60,11 @@ pub fn nav_error(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> Nav
     let dlat = nav.lat_rad - truth.lat_rad;
     let dlon = lon_diff(nav.lon_rad, truth.lon_rad);
     let dh = nav.h_m - truth.h_m;
-    let pos = Vec3::new(dlat * (r.r_m_m + truth.h_m), dlon * (r.r_n_m + truth.h_m) * truth.lat_rad.cos(), -dh);
+    let pos = Vec3::new(
+        dlat * (r.r_m_m + truth.h_m),
+        dlon * (r.r_n_m + truth.h_m) * truth.lat_rad.cos(),
+        -dh,
+    );
     let ea = euler_from_c_b_n(&nav.c_b_n);
     let et = euler_from_c_b_n(&truth.c_b_n);
     let w = sdins_core::nav::wrap_pi;
@@ -64,7 +74,11 @@ pub fn nav_error(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> Nav
         vel_err_ned_mps: arr(&(nav.v_n_mps - truth.v_n_mps)),
         att_err_rad: arr(&attitude_error(&nav.c_b_n, &truth.c_b_n)),
         height_err_m: dh,
-        euler_err_rad: [w(ea.roll_rad - et.roll_rad), w(ea.pitch_rad - et.pitch_rad), w(ea.yaw_rad - et.yaw_rad)],
+        euler_err_rad: [
+            w(ea.roll_rad - et.roll_rad),
+            w(ea.pitch_rad - et.pitch_rad),
+            w(ea.yaw_rad - et.yaw_rad),
+        ],
     }
 }
 
@@ -119,9 +133,16 @@ pub fn run(
     };
     let mut truth = TruthGenerator::new(&scn.trajectory, cfg);
     let init = truth.initial_state();
-    let n = opts.algos.first().map_or(scn.nav.samples, |a| a.samples).max(1);
-    let mut mechs: Vec<AnyMechanization> =
-        opts.algos.iter().map(|a| AnyMechanization::new(a, earth, cfg.dt_s, &init)).collect();
+    let n = opts
+        .algos
+        .first()
+        .map_or(scn.nav.samples, |a| a.samples)
+        .max(1);
+    let mut mechs: Vec<AnyMechanization> = opts
+        .algos
+        .iter()
+        .map(|a| AnyMechanization::new(a, earth, cfg.dt_s, &init))
+        .collect();
     let mut total_updates = truth.len_samples() / n as u64;
     if let Some(t) = opts.until_s {
         total_updates = total_updates.min((t / (cfg.dt_s * n as f64)).round() as u64);
@@ -171,7 +192,7 @@ pub fn run(
                 }
                 wall[i] += t0.elapsed().as_secs_f64();
                 let finished = done + stop as u64;
-                if finished % every == 0 || finished == total_updates {
+                if finished.is_multiple_of(every) || finished == total_updates {
                     let tr = &ends[stop - 1];
                     let st = m.state();
                     let e = nav_error(&earth, &st, tr);

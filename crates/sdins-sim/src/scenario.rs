@@ -51,14 +51,63 @@ pub enum ScenarioError {
 /// Every key the parser accepts, by table (the documentation test compares with
 /// `docs/scenarios.md`).
 pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
-    ("", &["name", "description", "start", "imu", "nav", "segment", "overlay"]),
-    ("start", &["lat_deg", "lon_deg", "h_m", "speed_mps", "climb_rate_mps", "roll_deg", "pitch_deg", "yaw_deg"]),
+    (
+        "",
+        &[
+            "name",
+            "description",
+            "start",
+            "imu",
+            "nav",
+            "segment",
+            "overlay",
+        ],
+    ),
+    (
+        "start",
+        &[
+            "lat_deg",
+            "lon_deg",
+            "h_m",
+            "speed_mps",
+            "climb_rate_mps",
+            "roll_deg",
+            "pitch_deg",
+            "yaw_deg",
+        ],
+    ),
     ("imu", &["rate_hz", "seed", "grade", "errors"]),
-    ("nav", &["samples", "algos", "coning", "earth", "vertical", "substeps"]),
-    ("segment", &["type", "duration_s", "accel_mps2", "rate_dps", "angle_deg", "profile", "amplitude_dps", "to_climb_rate_mps"]),
+    (
+        "nav",
+        &[
+            "samples", "algos", "coning", "earth", "vertical", "substeps",
+        ],
+    ),
+    (
+        "segment",
+        &[
+            "type",
+            "duration_s",
+            "accel_mps2",
+            "rate_dps",
+            "angle_deg",
+            "profile",
+            "amplitude_dps",
+            "to_climb_rate_mps",
+        ],
+    ),
     (
         "overlay",
-        &["type", "axis", "half_angle_deg", "freq_hz", "angle_amp_deg", "accel_amp_mps2", "start_s", "end_s"],
+        &[
+            "type",
+            "axis",
+            "half_angle_deg",
+            "freq_hz",
+            "angle_amp_deg",
+            "accel_amp_mps2",
+            "start_s",
+            "end_s",
+        ],
     ),
 ];
 
@@ -247,9 +296,16 @@ struct Ctx<'a> {
 
 impl Ctx<'_> {
     fn line_of(&self, pos: usize) -> usize {
-        self.text.get(..pos.min(self.text.len())).map_or(1, |s| s.bytes().filter(|&b| b == b'\n').count() + 1)
+        self.text
+            .get(..pos.min(self.text.len()))
+            .map_or(1, |s| s.bytes().filter(|&b| b == b'\n').count() + 1)
     }
-    fn err<T>(&self, span: std::ops::Range<usize>, key: &str, message: impl Into<String>) -> Result<T, ScenarioError> {
+    fn err<T>(
+        &self,
+        span: std::ops::Range<usize>,
+        key: &str,
+        message: impl Into<String>,
+    ) -> Result<T, ScenarioError> {
         Err(ScenarioError::Invalid {
             file: self.file.to_string(),
             line: self.line_of(span.start),
@@ -264,10 +320,21 @@ impl Ctx<'_> {
         }
         Ok(x)
     }
-    fn range(&self, v: &S<f64>, key: &str, lo: f64, hi: f64, what: &str) -> Result<f64, ScenarioError> {
+    fn range(
+        &self,
+        v: &S<f64>,
+        key: &str,
+        lo: f64,
+        hi: f64,
+        what: &str,
+    ) -> Result<f64, ScenarioError> {
         let x = self.finite(v, key)?;
         if !(lo..=hi).contains(&x) {
-            return self.err(v.span(), key, format!("{x} is out of range: expected {what}"));
+            return self.err(
+                v.span(),
+                key,
+                format!("{x} is out of range: expected {what}"),
+            );
         }
         Ok(x)
     }
@@ -303,23 +370,37 @@ fn is_subsequence(short: &str, long: &str) -> bool {
 /// edit distance within half the key's length, or a key whose letters appear in order in
 /// the unknown one (`heigth_m` → `h_m`).
 pub fn suggest_from<'a>(unknown: &str, candidates: &[&'a str]) -> Option<&'a str> {
-    let best = candidates.iter().copied().map(|k| (levenshtein(unknown, k), k)).min_by_key(|(d, _)| *d);
+    let best = candidates
+        .iter()
+        .copied()
+        .map(|k| (levenshtein(unknown, k), k))
+        .min_by_key(|(d, _)| *d);
     if let Some((d, k)) = best {
         if d <= 3.max(unknown.len() / 2) {
             return Some(k);
         }
     }
-    candidates.iter().copied().filter(|k| k.len() >= 3 && is_subsequence(k, unknown)).max_by_key(|k| k.len())
+    candidates
+        .iter()
+        .copied()
+        .filter(|k| k.len() >= 3 && is_subsequence(k, unknown))
+        .max_by_key(|k| k.len())
 }
 
 /// Closest accepted key (of any table) to an unknown one.
 pub fn suggest(unknown: &str) -> Option<&'static str> {
-    let all: Vec<&'static str> = ACCEPTED_KEYS.iter().flat_map(|(_, keys)| keys.iter().copied()).collect();
+    let all: Vec<&'static str> = ACCEPTED_KEYS
+        .iter()
+        .flat_map(|(_, keys)| keys.iter().copied())
+        .collect();
     suggest_from(unknown, &all)
 }
 
 fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> ScenarioError {
-    let line = e.span().map_or(1, |s| text.get(..s.start).map_or(1, |p| p.matches('\n').count() + 1));
+    let line = e.span().map_or(1, |s| {
+        text.get(..s.start)
+            .map_or(1, |p| p.matches('\n').count() + 1)
+    });
     let msg = e.message().trim().to_string();
     let mut key = String::from("(syntax)");
     let mut message = msg.clone();
@@ -329,8 +410,16 @@ fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> ScenarioError {
             key = name.to_string();
             // candidates: the keys the parser listed as expected here
             let expected: Vec<&str> = rest.split('`').skip(2).step_by(2).collect();
-            let hint = if expected.is_empty() { suggest(name) } else { suggest_from(name, &expected) };
-            message = format!("unknown key{}", hint.map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default());
+            let hint = if expected.is_empty() {
+                suggest(name)
+            } else {
+                suggest_from(name, &expected)
+            };
+            message = format!(
+                "unknown key{}",
+                hint.map(|s| format!(" (did you mean `{s}`?)"))
+                    .unwrap_or_default()
+            );
             if let Some(exp) = rest.find("expected") {
                 message.push_str(&format!("; {}", &rest[exp..]));
             }
@@ -341,7 +430,12 @@ fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> ScenarioError {
             message = "missing required key".to_string();
         }
     }
-    ScenarioError::Invalid { file: file.to_string(), line, key, message }
+    ScenarioError::Invalid {
+        file: file.to_string(),
+        line,
+        key,
+        message,
+    }
 }
 
 impl Scenario {
@@ -350,7 +444,13 @@ impl Scenario {
         let doc: FileDoc = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;
         let cx = Ctx { file, text };
         let st = doc.start.get_ref();
-        let lat = cx.range(&st.lat_deg, "start.lat_deg", -90.0, 90.0, "latitude in [-90, 90] deg")?;
+        let lat = cx.range(
+            &st.lat_deg,
+            "start.lat_deg",
+            -90.0,
+            90.0,
+            "latitude in [-90, 90] deg",
+        )?;
         if lat.abs() > 89.0 {
             // The local-level (NED) mechanization is singular at the poles: tan L and
             // 1/cos L in the transport rate and longitude rate. We accept up to ±89.99°.
@@ -358,9 +458,21 @@ impl Scenario {
                 return cx.err(st.lat_deg.span(), "start.lat_deg", format!("{lat} is too close to a pole: the local-level NED mechanization needs |lat| ≤ 89.99 deg"));
             }
         }
-        let lon = cx.range(&st.lon_deg, "start.lon_deg", -180.0, 360.0, "longitude in [-180, 360] deg")?;
+        let lon = cx.range(
+            &st.lon_deg,
+            "start.lon_deg",
+            -180.0,
+            360.0,
+            "longitude in [-180, 360] deg",
+        )?;
         let h = match &st.h_m {
-            Some(v) => cx.range(v, "start.h_m", -1000.0, 100_000.0, "height in [-1000, 100000] m")?,
+            Some(v) => cx.range(
+                v,
+                "start.h_m",
+                -1000.0,
+                100_000.0,
+                "height in [-1000, 100000] m",
+            )?,
             None => 0.0,
         };
         let speed = match &st.speed_mps {
@@ -368,12 +480,23 @@ impl Scenario {
             None => 0.0,
         };
         let climb = match &st.climb_rate_mps {
-            Some(v) => cx.range(v, "start.climb_rate_mps", -500.0, 500.0, "climb rate in [-500, 500] m/s")?,
+            Some(v) => cx.range(
+                v,
+                "start.climb_rate_mps",
+                -500.0,
+                500.0,
+                "climb rate in [-500, 500] m/s",
+            )?,
             None => 0.0,
         };
         let ang = |v: &Option<S<f64>>, key: &str, lim: f64| -> Result<f64, ScenarioError> {
             match v {
-                Some(v) => Ok(cx.range(v, key, -lim, lim, &format!("angle in [-{lim}, {lim}] deg"))? * D2R),
+                Some(v) => {
+                    Ok(
+                        cx.range(v, key, -lim, lim, &format!("angle in [-{lim}, {lim}] deg"))?
+                            * D2R,
+                    )
+                }
                 None => Ok(0.0),
             }
         };
@@ -382,12 +505,23 @@ impl Scenario {
             ang(&st.pitch_deg, "start.pitch_deg", 89.9)?,
             ang(&st.yaw_deg, "start.yaw_deg", 360.0)?,
         );
-        let start = Start { lat_rad: lat * D2R, lon_rad: lon * D2R, h_m: h, speed_mps: speed, climb_rate_mps: climb, euler };
+        let start = Start {
+            lat_rad: lat * D2R,
+            lon_rad: lon * D2R,
+            h_m: h,
+            speed_mps: speed,
+            climb_rate_mps: climb,
+            euler,
+        };
 
         let im = doc.imu.get_ref();
         let rate_hz = cx.positive(&im.rate_hz, "imu.rate_hz")?;
         if rate_hz > 100_000.0 {
-            return cx.err(im.rate_hz.span(), "imu.rate_hz", format!("{rate_hz} Hz is beyond 100 kHz"));
+            return cx.err(
+                im.rate_hz.span(),
+                "imu.rate_hz",
+                format!("{rate_hz} Hz is beyond 100 kHz"),
+            );
         }
         let imu = ImuConfig {
             rate_hz,
@@ -426,19 +560,37 @@ impl Scenario {
                 ("angle_deg", sd.angle_deg.as_ref().map(|v| v.span())),
                 ("profile", sd.profile.as_ref().map(|v| v.span())),
                 ("amplitude_dps", sd.amplitude_dps.as_ref().map(|v| v.span())),
-                ("to_climb_rate_mps", sd.to_climb_rate_mps.as_ref().map(|v| v.span())),
+                (
+                    "to_climb_rate_mps",
+                    sd.to_climb_rate_mps.as_ref().map(|v| v.span()),
+                ),
             ];
             for (k, span) in present {
                 if let Some(span) = span {
                     if !allowed.contains(&k) {
-                        return cx.err(span, &format!("segment.{k}"), format!("not a key of segment type `{kind}` (it takes: {})", if allowed.is_empty() { "duration_s only".to_string() } else { allowed.join(", ") }));
+                        return cx.err(
+                            span,
+                            &format!("segment.{k}"),
+                            format!(
+                                "not a key of segment type `{kind}` (it takes: {})",
+                                if allowed.is_empty() {
+                                    "duration_s only".to_string()
+                                } else {
+                                    allowed.join(", ")
+                                }
+                            ),
+                        );
                     }
                 }
             }
             let need = |v: &Option<S<f64>>, key: &str| -> Result<f64, ScenarioError> {
                 match v {
                     Some(v) => cx.finite(v, key),
-                    None => cx.err(s.span(), key, format!("missing required key for segment type `{kind}`")),
+                    None => cx.err(
+                        s.span(),
+                        key,
+                        format!("missing required key for segment type `{kind}`"),
+                    ),
                 }
             };
             let motion = match kind {
@@ -452,7 +604,11 @@ impl Scenario {
                 "accelerate" => {
                     let a = need(&sd.accel_mps2, "segment.accel_mps2")?;
                     if a.abs() > 1000.0 * 9.80665 {
-                        return cx.err(s.span(), "segment.accel_mps2", format!("{a} m/s² exceeds 1000 g"));
+                        return cx.err(
+                            s.span(),
+                            "segment.accel_mps2",
+                            format!("{a} m/s² exceeds 1000 g"),
+                        );
                     }
                     speed_now += a * dur;
                     if speed_now < -1e-9 {
@@ -461,31 +617,63 @@ impl Scenario {
                     Motion::Accelerate { accel_mps2: a }
                 }
                 "turn" => {
-                    let profile = sd.profile.as_ref().map_or("constant", |p| p.get_ref().as_str());
+                    let profile = sd
+                        .profile
+                        .as_ref()
+                        .map_or("constant", |p| p.get_ref().as_str());
                     match (profile, &sd.rate_dps, &sd.angle_deg) {
-                        ("constant", Some(r), None) => Motion::TurnRate { rate_rps: cx.finite(r, "segment.rate_dps")? * D2R },
-                        ("constant", None, Some(a)) => Motion::TurnRate { rate_rps: cx.finite(a, "segment.angle_deg")? * D2R / dur },
-                        ("smooth", None, Some(a)) => Motion::TurnSmooth { angle_rad: cx.finite(a, "segment.angle_deg")? * D2R },
-                        ("smooth", Some(r), None) => Motion::TurnSmooth { angle_rad: cx.finite(r, "segment.rate_dps")? * D2R * dur },
+                        ("constant", Some(r), None) => Motion::TurnRate {
+                            rate_rps: cx.finite(r, "segment.rate_dps")? * D2R,
+                        },
+                        ("constant", None, Some(a)) => Motion::TurnRate {
+                            rate_rps: cx.finite(a, "segment.angle_deg")? * D2R / dur,
+                        },
+                        ("smooth", None, Some(a)) => Motion::TurnSmooth {
+                            angle_rad: cx.finite(a, "segment.angle_deg")? * D2R,
+                        },
+                        ("smooth", Some(r), None) => Motion::TurnSmooth {
+                            angle_rad: cx.finite(r, "segment.rate_dps")? * D2R * dur,
+                        },
                         ("constant" | "smooth", Some(_), Some(_)) => {
-                            return cx.err(s.span(), "segment.rate_dps", "give either rate_dps or angle_deg, not both");
+                            return cx.err(
+                                s.span(),
+                                "segment.rate_dps",
+                                "give either rate_dps or angle_deg, not both",
+                            );
                         }
                         ("constant" | "smooth", None, None) => {
-                            return cx.err(s.span(), "segment.angle_deg", "a turn needs rate_dps or angle_deg");
+                            return cx.err(
+                                s.span(),
+                                "segment.angle_deg",
+                                "a turn needs rate_dps or angle_deg",
+                            );
                         }
                         (other, _, _) => {
                             let span = sd.profile.as_ref().map_or(s.span(), |p| p.span());
-                            return cx.err(span, "segment.profile", format!("unknown profile `{other}`: expected constant or smooth"));
+                            return cx.err(
+                                span,
+                                "segment.profile",
+                                format!("unknown profile `{other}`: expected constant or smooth"),
+                            );
                         }
                     }
                 }
-                "sturn" => Motion::STurn { amplitude_rps: need(&sd.amplitude_dps, "segment.amplitude_dps")? * D2R },
-                _ => Motion::Climb { to_climb_rate_mps: need(&sd.to_climb_rate_mps, "segment.to_climb_rate_mps")? },
+                "sturn" => Motion::STurn {
+                    amplitude_rps: need(&sd.amplitude_dps, "segment.amplitude_dps")? * D2R,
+                },
+                _ => Motion::Climb {
+                    to_climb_rate_mps: need(&sd.to_climb_rate_mps, "segment.to_climb_rate_mps")?,
+                },
             };
             motions.push((motion, (n.round()) * dt));
         }
         if motions.is_empty() {
-            return Err(ScenarioError::Invalid { file: file.into(), line: 1, key: "segment".into(), message: "a scenario needs at least one [[segment]]".into() });
+            return Err(ScenarioError::Invalid {
+                file: file.into(),
+                line: 1,
+                key: "segment".into(),
+                message: "a scenario needs at least one [[segment]]".into(),
+            });
         }
         let total: f64 = motions.iter().map(|m| m.1).sum();
 
@@ -496,7 +684,11 @@ impl Scenario {
             let need_pos = |v: &Option<S<f64>>, key: &str| -> Result<f64, ScenarioError> {
                 match v {
                     Some(v) => cx.positive(v, key),
-                    None => cx.err(o.span(), key, format!("missing required key for overlay type `{kind}`")),
+                    None => cx.err(
+                        o.span(),
+                        key,
+                        format!("missing required key for overlay type `{kind}`"),
+                    ),
                 }
             };
             let axis = |default: Axis| -> Result<Axis, ScenarioError> {
@@ -506,22 +698,41 @@ impl Scenario {
                         "x" => Ok(Axis::X),
                         "y" => Ok(Axis::Y),
                         "z" => Ok(Axis::Z),
-                        other => cx.err(a.span(), "overlay.axis", format!("unknown axis `{other}`: expected x, y or z")),
+                        other => cx.err(
+                            a.span(),
+                            "overlay.axis",
+                            format!("unknown axis `{other}`: expected x, y or z"),
+                        ),
                     },
                 }
             };
             let freq = need_pos(&od.freq_hz, "overlay.freq_hz")?;
             if freq > 0.5 * rate_hz {
-                return cx.err(o.span(), "overlay.freq_hz", format!("{freq} Hz is above the Nyquist frequency {} Hz of the IMU", 0.5 * rate_hz));
+                return cx.err(
+                    o.span(),
+                    "overlay.freq_hz",
+                    format!(
+                        "{freq} Hz is above the Nyquist frequency {} Hz of the IMU",
+                        0.5 * rate_hz
+                    ),
+                );
             }
             let omega = 2.0 * std::f64::consts::PI * freq;
             let k = match kind {
                 "coning" => {
                     let a = need_pos(&od.half_angle_deg, "overlay.half_angle_deg")?;
                     if a >= 90.0 {
-                        return cx.err(o.span(), "overlay.half_angle_deg", "half-angle must be below 90 deg");
+                        return cx.err(
+                            o.span(),
+                            "overlay.half_angle_deg",
+                            "half-angle must be below 90 deg",
+                        );
                     }
-                    OverlayKind::Coning { axis: axis(Axis::Z)?, half_angle_rad: a * D2R, omega_rps: omega }
+                    OverlayKind::Coning {
+                        axis: axis(Axis::Z)?,
+                        half_angle_rad: a * D2R,
+                        omega_rps: omega,
+                    }
                 }
                 "sculling" => OverlayKind::Sculling {
                     angle_amp_rad: need_pos(&od.angle_amp_deg, "overlay.angle_amp_deg")? * D2R,
@@ -538,14 +749,30 @@ impl Scenario {
                 }
             };
             let start_s = match &od.start_s {
-                Some(v) => cx.range(v, "overlay.start_s", 0.0, total, "a time within the scenario")?,
+                Some(v) => cx.range(
+                    v,
+                    "overlay.start_s",
+                    0.0,
+                    total,
+                    "a time within the scenario",
+                )?,
                 None => 0.0,
             };
             let end_s = match &od.end_s {
-                Some(v) => cx.range(v, "overlay.end_s", start_s, f64::INFINITY, "a time after start_s")?,
+                Some(v) => cx.range(
+                    v,
+                    "overlay.end_s",
+                    start_s,
+                    f64::INFINITY,
+                    "a time after start_s",
+                )?,
                 None => f64::INFINITY,
             };
-            overlays.push(Overlay { kind: k, start_s, end_s });
+            overlays.push(Overlay {
+                kind: k,
+                start_s,
+                end_s,
+            });
         }
 
         let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
@@ -555,7 +782,9 @@ impl Scenario {
         }
         Ok(Scenario {
             name: doc.name.unwrap_or_else(|| {
-                Path::new(file).file_stem().map_or_else(|| "scenario".into(), |s| s.to_string_lossy().into_owned())
+                Path::new(file)
+                    .file_stem()
+                    .map_or_else(|| "scenario".into(), |s| s.to_string_lossy().into_owned())
             }),
             description: doc.description.unwrap_or_default(),
             start,
@@ -568,7 +797,10 @@ impl Scenario {
     /// Read and validate a scenario file.
     pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read { file: file.clone(), reason: e.to_string() })?;
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read {
+            file: file.clone(),
+            reason: e.to_string(),
+        })?;
         Scenario::from_toml(&text, &file)
     }
 
@@ -583,7 +815,11 @@ impl Scenario {
         }
         Err(ScenarioError::Unknown {
             name: name_or_path.to_string(),
-            known: BUILTINS.iter().map(|b| b.name).collect::<Vec<_>>().join(", "),
+            known: BUILTINS
+                .iter()
+                .map(|b| b.name)
+                .collect::<Vec<_>>()
+                .join(", "),
         })
     }
 
@@ -596,7 +832,12 @@ impl Scenario {
 fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioError> {
     let mut cfg = NavConfig {
         samples: 3,
-        algos: vec!["savage".into(), "songlee".into(), "songlee-complete".into(), "dualquat".into()],
+        algos: vec![
+            "savage".into(),
+            "songlee".into(),
+            "songlee-complete".into(),
+            "dualquat".into(),
+        ],
         coning: None,
         earth: EarthChoice::Wgs84,
         vertical_hold: false,
@@ -606,7 +847,11 @@ fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioEr
     if let Some(s) = &n.samples {
         let v = *s.get_ref();
         if !(1..=4).contains(&v) {
-            return cx.err(s.span(), "nav.samples", format!("{v}: expected 1, 2, 3 or 4 samples per update"));
+            return cx.err(
+                s.span(),
+                "nav.samples",
+                format!("{v}: expected 1, 2, 3 or 4 samples per update"),
+            );
         }
         cfg.samples = v as usize;
     }
@@ -628,14 +873,26 @@ fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioEr
             "wgs84" => EarthChoice::Wgs84,
             "psins" => EarthChoice::Psins,
             "flat" => EarthChoice::Flat,
-            other => return cx.err(e.span(), "nav.earth", format!("unknown earth model `{other}`: expected wgs84, psins or flat")),
+            other => {
+                return cx.err(
+                    e.span(),
+                    "nav.earth",
+                    format!("unknown earth model `{other}`: expected wgs84, psins or flat"),
+                )
+            }
         };
     }
     if let Some(v) = &n.vertical {
         cfg.vertical_hold = match v.get_ref().as_str() {
             "free" => false,
             "hold" => true,
-            other => return cx.err(v.span(), "nav.vertical", format!("unknown vertical mode `{other}`: expected free or hold")),
+            other => {
+                return cx.err(
+                    v.span(),
+                    "nav.vertical",
+                    format!("unknown vertical mode `{other}`: expected free or hold"),
+                )
+            }
         };
     }
     Ok(cfg)
@@ -692,7 +949,12 @@ mod tests {
     #[test]
     fn unknown_key_names_line_and_suggests() {
         let e = err_of(&BASE.replace("lon_deg = 127.0", "lon_deg = 127.0\nlat_dg = 3.0"));
-        let ScenarioError::Invalid { line, key, message, .. } = &e else { panic!("{e}") };
+        let ScenarioError::Invalid {
+            line, key, message, ..
+        } = &e
+        else {
+            panic!("{e}")
+        };
         assert_eq!((*line, key.as_str()), (4, "lat_dg"));
         assert!(message.contains("did you mean `lat_deg`"), "{message}");
     }
@@ -700,25 +962,46 @@ mod tests {
     #[test]
     fn missing_key() {
         let e = err_of(&BASE.replace("rate_hz = 100.0\n", ""));
-        assert!(e.to_string().contains("rate_hz") && e.to_string().contains("missing"), "{e}");
+        assert!(
+            e.to_string().contains("rate_hz") && e.to_string().contains("missing"),
+            "{e}"
+        );
     }
 
     #[test]
     fn impossible_values_name_line_and_key() {
         for (from, to, line, key) in [
-            ("duration_s = 10.0", "duration_s = -1.0", 8, "segment.duration_s"),
+            (
+                "duration_s = 10.0",
+                "duration_s = -1.0",
+                8,
+                "segment.duration_s",
+            ),
             ("rate_hz = 100.0", "rate_hz = 0.0", 5, "imu.rate_hz"),
             ("lat_deg = 37.5", "lat_deg = 95.0", 2, "start.lat_deg"),
-            ("duration_s = 10.0", "duration_s = 10.001", 8, "segment.duration_s"),
+            (
+                "duration_s = 10.0",
+                "duration_s = 10.001",
+                8,
+                "segment.duration_s",
+            ),
             ("lat_deg = 37.5", "lat_deg = nan", 2, "start.lat_deg"),
         ] {
             let e = err_of(&BASE.replace(from, to));
-            let ScenarioError::Invalid { line: l, key: k, .. } = &e else { panic!("{e}") };
+            let ScenarioError::Invalid {
+                line: l, key: k, ..
+            } = &e
+            else {
+                panic!("{e}")
+            };
             assert_eq!((*l, k.as_str()), (line, key), "{e}");
         }
         let e = err_of(&format!("{BASE}[start2]\n"));
         assert!(e.to_string().contains("start2"), "{e}");
-        let e = err_of(&BASE.replace("[start]\nlat_deg = 37.5\n", "[start]\nlat_deg = 37.5\nh_m = -2000.0\n"));
+        let e = err_of(&BASE.replace(
+            "[start]\nlat_deg = 37.5\n",
+            "[start]\nlat_deg = 37.5\nh_m = -2000.0\n",
+        ));
         assert!(e.to_string().contains("start.h_m"), "{e}");
     }
 
@@ -727,6 +1010,9 @@ mod tests {
         let e = err_of(&BASE.replace("type = \"static\"", "type = \"staticc\""));
         assert!(e.to_string().contains("unknown segment type"), "{e}");
         let e = err_of(&BASE.replace("duration_s = 10.0", "duration_s = 10.0\nrate_dps = 3.0"));
-        assert!(e.to_string().contains("not a key of segment type `static`"), "{e}");
+        assert!(
+            e.to_string().contains("not a key of segment type `static`"),
+            "{e}"
+        );
     }
 }

@@ -231,14 +231,28 @@ impl Trajectory {
         overlays: Vec<Overlay>,
     ) -> Self {
         let mut segments = Vec::with_capacity(motions.len());
-        let (mut t, mut s, mut h, mut vd) = (0.0, start_speed_mps, start_euler.yaw_rad, start_v_d_mps);
+        let (mut t, mut s, mut h, mut vd) =
+            (0.0, start_speed_mps, start_euler.yaw_rad, start_v_d_mps);
         for &(motion, duration_s) in motions {
-            let seg = Segment { motion, t0_s: t, duration_s, speed0: s, heading0: h, v_d0: vd };
+            let seg = Segment {
+                motion,
+                t0_s: t,
+                duration_s,
+                speed0: s,
+                heading0: h,
+                v_d0: vd,
+            };
             (s, h, vd) = seg.end_state();
             t += duration_s;
             segments.push(seg);
         }
-        Self { roll0_rad: start_euler.roll_rad, pitch0_rad: start_euler.pitch_rad, segments, overlays, duration_s: t }
+        Self {
+            roll0_rad: start_euler.roll_rad,
+            pitch0_rad: start_euler.pitch_rad,
+            segments,
+            overlays,
+            duration_s: t,
+        }
     }
 
     /// The segments.
@@ -270,7 +284,10 @@ impl Trajectory {
     /// cruise segments): then the truth has the closed form of spec §7.0 (A0, A1).
     pub fn is_constant_parallel(&self) -> bool {
         self.overlays.is_empty()
-            && self.segments.iter().all(|s| matches!(s.motion, Motion::Static | Motion::Cruise))
+            && self
+                .segments
+                .iter()
+                .all(|s| matches!(s.motion, Motion::Static | Motion::Cruise))
             && self.segments.first().is_none_or(|s| {
                 let k = self.kinematics(0.0, 0.0);
                 s.v_d0 == 0.0 && k.v_n_mps.x.abs() < 1e-12 * (1.0 + k.v_n_mps.y.abs())
@@ -279,7 +296,11 @@ impl Trajectory {
 
     fn segment_at(&self, t_sel: f64) -> Option<&Segment> {
         // Segments are few; linear search from the end finds the last one starting ≤ t_sel.
-        self.segments.iter().rev().find(|s| s.t0_s <= t_sel).or(self.segments.first())
+        self.segments
+            .iter()
+            .rev()
+            .find(|s| s.t0_s <= t_sel)
+            .or(self.segments.first())
     }
 
     /// Exact kinematics at time `t`, with the analytic branch selected by `t_sel`
@@ -297,7 +318,14 @@ impl Trajectory {
         let t = t_base + off;
         let n = match self.segment_at(t_sel) {
             Some(seg) => seg.eval(t),
-            None => Nominal { speed: 0.0, speed_dot: 0.0, heading: 0.0, heading_dot: 0.0, v_d: 0.0, v_d_dot: 0.0 },
+            None => Nominal {
+                speed: 0.0,
+                speed_dot: 0.0,
+                heading: 0.0,
+                heading_dot: 0.0,
+                v_d: 0.0,
+                v_d_dot: 0.0,
+            },
         };
         let (sh, ch) = n.heading.sin_cos();
         let mut v = Vec3::new(n.speed * ch, n.speed * sh, n.v_d);
@@ -310,7 +338,11 @@ impl Trajectory {
         let (sr, cr) = self.roll0_rad.sin_cos();
         let (sp, cp) = self.pitch0_rad.sin_cos();
         // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (spec §1.2)
-        let w_nom = Vec3::new(-n.heading_dot * sp, n.heading_dot * cp * sr, n.heading_dot * cp * cr);
+        let w_nom = Vec3::new(
+            -n.heading_dot * sp,
+            n.heading_dot * cp * sr,
+            n.heading_dot * cp * cr,
+        );
 
         // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (spec §7.0)
         let mut c_c = Mat3::identity();
@@ -331,7 +363,11 @@ impl Trajectory {
                 (sa * cb + ca * sb, ca * cb - sa * sb)
             };
             let (c_k, w_k) = match ov.kind {
-                OverlayKind::Coning { axis, half_angle_rad, omega_rps } => {
+                OverlayKind::Coning {
+                    axis,
+                    half_angle_rad,
+                    omega_rps,
+                } => {
                     let (sa2, ca2) = (0.5 * half_angle_rad).sin_cos();
                     let (swt, cwt) = sincos(omega_rps);
                     let v0 = axis.place(sa2, 0.0, 0.0);
@@ -340,23 +376,39 @@ impl Trajectory {
                     let qt = Quat::from_parts(ca2, &vt);
                     let c = q0.conj().mul(&qt).to_dcm();
                     let (sa, ca) = half_angle_rad.sin_cos();
-                    let w = axis.place(-omega_rps * sa * swt, omega_rps * sa * cwt, -omega_rps * (1.0 - ca));
+                    let w = axis.place(
+                        -omega_rps * sa * swt,
+                        omega_rps * sa * cwt,
+                        -omega_rps * (1.0 - ca),
+                    );
                     (c, if active { w } else { Vec3::zeros() })
                 }
-                OverlayKind::Sculling { angle_amp_rad, accel_amp_mps2, omega_rps } => {
+                OverlayKind::Sculling {
+                    angle_amp_rad,
+                    accel_amp_mps2,
+                    omega_rps,
+                } => {
                     let (swt, cwt) = sincos(omega_rps);
                     let ang = angle_amp_rad * swt;
                     let (sa, ca) = ang.sin_cos();
                     let c = Mat3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca);
                     // linear part: body-y velocity (A0/Ω)(1 − cos Ωτ) in the nominal frame
                     let u = Vec3::new(0.0, accel_amp_mps2 / omega_rps * (1.0 - cwt), 0.0);
-                    let u_dot = if active { Vec3::new(0.0, accel_amp_mps2 * swt, 0.0) } else { Vec3::zeros() };
+                    let u_dot = if active {
+                        Vec3::new(0.0, accel_amp_mps2 * swt, 0.0)
+                    } else {
+                        Vec3::zeros()
+                    };
                     v += c_nom * u;
                     v_dot += c_nom * (w_nom.cross(&u) + u_dot);
                     let w = Vec3::new(angle_amp_rad * omega_rps * cwt, 0.0, 0.0);
                     (c, if active { w } else { Vec3::zeros() })
                 }
-                OverlayKind::Vibration { axis, accel_amp_mps2, omega_rps } => {
+                OverlayKind::Vibration {
+                    axis,
+                    accel_amp_mps2,
+                    omega_rps,
+                } => {
                     let (swt, cwt) = sincos(omega_rps);
                     let mut u = Vec3::zeros();
                     let mut u_dot = Vec3::zeros();
@@ -399,21 +451,38 @@ mod tests {
                 (Motion::Accelerate { accel_mps2: 2.0 }, 5.0),
                 (Motion::TurnSmooth { angle_rad: 1.0 }, 4.0),
                 (Motion::STurn { amplitude_rps: 0.1 }, 6.0),
-                (Motion::Climb { to_climb_rate_mps: 3.0 }, 2.0),
+                (
+                    Motion::Climb {
+                        to_climb_rate_mps: 3.0,
+                    },
+                    2.0,
+                ),
             ],
             vec![
                 Overlay {
-                    kind: OverlayKind::Coning { axis: Axis::X, half_angle_rad: 0.01, omega_rps: 6.0 },
+                    kind: OverlayKind::Coning {
+                        axis: Axis::X,
+                        half_angle_rad: 0.01,
+                        omega_rps: 6.0,
+                    },
                     start_s: 0.0,
                     end_s: 100.0,
                 },
                 Overlay {
-                    kind: OverlayKind::Sculling { angle_amp_rad: 0.002, accel_amp_mps2: 0.5, omega_rps: 9.0 },
+                    kind: OverlayKind::Sculling {
+                        angle_amp_rad: 0.002,
+                        accel_amp_mps2: 0.5,
+                        omega_rps: 9.0,
+                    },
                     start_s: 0.0,
                     end_s: 100.0,
                 },
                 Overlay {
-                    kind: OverlayKind::Vibration { axis: Axis::Z, accel_amp_mps2: 0.3, omega_rps: 20.0 },
+                    kind: OverlayKind::Vibration {
+                        axis: Axis::Z,
+                        accel_amp_mps2: 0.3,
+                        omega_rps: 20.0,
+                    },
                     start_s: 0.0,
                     end_s: 100.0,
                 },
@@ -429,12 +498,20 @@ mod tests {
         for &t in &[1.3, 6.7, 11.1, 16.2] {
             let k = tr.kinematics(t, t);
             let dv = num_deriv(|x| tr.kinematics(x, t).v_n_mps, t, 1e-3);
-            assert!((dv - k.v_dot_n_mps2).norm() < 1e-8, "t={t}: {}", (dv - k.v_dot_n_mps2).norm());
+            assert!(
+                (dv - k.v_dot_n_mps2).norm() < 1e-8,
+                "t={t}: {}",
+                (dv - k.v_dot_n_mps2).norm()
+            );
             let h = 1e-4;
             let cdot = (tr.kinematics(t + h, t).c_b_n - tr.kinematics(t - h, t).c_b_n) / (2.0 * h);
             let w_skew = k.c_b_n.transpose() * cdot;
             let w = sdins_core::math::vee_antisym(&w_skew);
-            assert!((w - k.omega_nb_b_rps).norm() < 1e-6, "t={t}: {}", (w - k.omega_nb_b_rps).norm());
+            assert!(
+                (w - k.omega_nb_b_rps).norm() < 1e-6,
+                "t={t}: {}",
+                (w - k.omega_nb_b_rps).norm()
+            );
         }
     }
 

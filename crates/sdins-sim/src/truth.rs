@@ -76,7 +76,16 @@ impl<'a> TruthGenerator<'a> {
     /// New generator over the whole trajectory (⌊duration/δt⌉ samples).
     pub fn new(traj: &'a Trajectory, cfg: TruthConfig) -> Self {
         let n_samples = (traj.duration_s / cfg.dt_s).round().max(0.0) as u64;
-        let mut g = Self { traj, cfg, k: 0, n_samples, dlat: 0.0, dlon: 0.0, h: cfg.h0_m, closed: None };
+        let mut g = Self {
+            traj,
+            cfg,
+            k: 0,
+            n_samples,
+            dlat: 0.0,
+            dlon: 0.0,
+            h: cfg.h0_m,
+            closed: None,
+        };
         if traj.is_constant_parallel() {
             g.closed = Some(g.closed_form());
         }
@@ -118,7 +127,10 @@ impl<'a> TruthGenerator<'a> {
         let dv = c_n_b * ((2.0 * w_ie + w_en).cross(&k.v_n_mps) - e.gravity_n(lat, h)) * dt;
         let r = e.radii(lat);
         let lon_rate_rps = k.v_n_mps.y / ((r.r_n_m + h) * lat.cos());
-        ClosedForm { inc: Increment::new(dtheta, dv), lon_rate_rps }
+        ClosedForm {
+            inc: Increment::new(dtheta, dv),
+            lon_rate_rps,
+        }
     }
 
     #[inline]
@@ -139,9 +151,14 @@ impl<'a> TruthGenerator<'a> {
         } else {
             // flat model: positions still advance over the ellipsoid at the start latitude
             let r0 = e.radii(self.cfg.lat0_rad);
-            (v.x / (r0.r_m_m + h), v.y / ((r0.r_n_m + h) * self.cfg.lat0_rad.cos()))
+            (
+                v.x / (r0.r_m_m + h),
+                v.y / ((r0.r_n_m + h) * self.cfg.lat0_rad.cos()),
+            )
         };
-        [lat_dot, lon_dot, -v.z, w_ib.x, w_ib.y, w_ib.z, f_b.x, f_b.y, f_b.z]
+        [
+            lat_dot, lon_dot, -v.z, w_ib.x, w_ib.y, w_ib.z, f_b.x, f_b.y, f_b.z,
+        ]
     }
 
     fn sample_rk4(&mut self, t0: f64) -> Increment {
@@ -194,7 +211,9 @@ impl Iterator for TruthGenerator<'_> {
             None => self.sample_rk4(t0),
         };
         // attitude and velocity at the sample end are analytic (branch of the last substep)
-        let kin = self.traj.kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
+        let kin = self
+            .traj
+            .kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
         Some(TruthSample {
             t_s: t1,
             inc,
@@ -219,7 +238,7 @@ impl Iterator for TruthGenerator<'_> {
 /// Rounded up to a power of two.
 pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
     let w_max = traj.max_frequency_rps();
-    let need = (dt_s * w_max / 2e-3).ceil().max(16.0).min(4096.0) as usize;
+    let need = (dt_s * w_max / 2e-3).ceil().clamp(16.0, 4096.0) as usize;
     need.next_power_of_two()
 }
 

@@ -10,7 +10,12 @@ pub fn spec(kind: AlgorithmKind, n: usize) -> AlgorithmSpec {
     AlgorithmSpec::new(kind, n)
 }
 
-pub fn with(mut s: AlgorithmSpec, coning: Option<ConingSet>, att: Option<AttitudeMode>, rot3: Option<bool>) -> AlgorithmSpec {
+pub fn with(
+    mut s: AlgorithmSpec,
+    coning: Option<ConingSet>,
+    att: Option<AttitudeMode>,
+    rot3: Option<bool>,
+) -> AlgorithmSpec {
     if let Some(c) = coning {
         s.coning = c;
     }
@@ -20,12 +25,22 @@ pub fn with(mut s: AlgorithmSpec, coning: Option<ConingSet>, att: Option<Attitud
 }
 
 /// Run and collect the errors at the given epochs (seconds).
-pub fn run_at(scn: &Scenario, algos: Vec<AlgorithmSpec>, epochs: &[f64], hold: bool) -> (Vec<RunSummary>, Vec<Vec<NavError>>) {
+pub fn run_at(
+    scn: &Scenario,
+    algos: Vec<AlgorithmSpec>,
+    epochs: &[f64],
+    hold: bool,
+) -> (Vec<RunSummary>, Vec<Vec<NavError>>) {
     let n = algos[0].samples;
     let dt_u = scn.imu.dt_s() * n as f64;
     let mut got = vec![Vec::new(); algos.len()];
     let until = epochs.iter().copied().fold(0.0, f64::max);
-    let opts = RunOptions { algos, vertical_hold: hold, every: 1, until_s: Some(until) };
+    let opts = RunOptions {
+        algos,
+        vertical_hold: hold,
+        every: 1,
+        until_s: Some(until),
+    };
     let want: Vec<u64> = epochs.iter().map(|t| (t / dt_u).round() as u64).collect();
     let summ = run(
         scn,
@@ -44,7 +59,11 @@ pub fn run_at(scn: &Scenario, algos: Vec<AlgorithmSpec>, epochs: &[f64], hold: b
 /// Signed comparison within a relative tolerance.
 pub fn check_rel(what: &str, got: f64, want: f64, rel: f64) {
     let ok = (got - want).abs() <= rel * want.abs();
-    assert!(ok, "{what}: got {got:.6e}, want {want:.6e} ±{:.0}%", rel * 100.0);
+    assert!(
+        ok,
+        "{what}: got {got:.6e}, want {want:.6e} ±{:.0}%",
+        rel * 100.0
+    );
 }
 
 pub fn print(name: &str, e: &NavError) {

@@ -42,17 +42,41 @@ fn turn_90dps_spec_7_3() {
     let v = got[0][1].vel_err_ned_mps;
     check_rel("SL vN(30)", v[0], -3.325e-3, 0.05);
     check_rel("SL vE(30)", v[1], -3.333e-3, 0.05);
-    check3("SL pos(30)", [got[0][1].pos_err_ned_m[0], got[0][1].pos_err_ned_m[1], 0.0], [-7.68e-2, -7.63e-2, 0.0], [0.05, 0.05, 0.0]);
+    check3(
+        "SL pos(30)",
+        [got[0][1].pos_err_ned_m[0], got[0][1].pos_err_ned_m[1], 0.0],
+        [-7.68e-2, -7.63e-2, 0.0],
+        [0.05, 0.05, 0.0],
+    );
     // (5)-method attitude 2.99e-7 ± 10 %; Savage Part 1 attitude 2.57e-7 ± 10 %
-    check_rel("(5)-method ‖ε(8)‖", norm(got[1][0].att_err_rad), 2.99e-7, 0.10);
-    check_rel("Savage-1 ‖ε(8)‖", norm(got[2][0].att_err_rad), 2.57e-7, 0.10);
+    check_rel(
+        "(5)-method ‖ε(8)‖",
+        norm(got[1][0].att_err_rad),
+        2.99e-7,
+        0.10,
+    );
+    check_rel(
+        "Savage-1 ‖ε(8)‖",
+        norm(got[2][0].att_err_rad),
+        2.57e-7,
+        0.10,
+    );
     // SL + rot3: |vel| ≤ 1e-4 m/s
-    assert!(norm(got[3][1].vel_err_ned_mps) <= 1e-4, "{:?}", got[3][1].vel_err_ned_mps);
+    assert!(
+        norm(got[3][1].vel_err_ned_mps) <= 1e-4,
+        "{:?}",
+        got[3][1].vel_err_ned_mps
+    );
     // DQ: |vel| ≤ 1e-7, ‖ε‖ ≤ 1e-10
     assert!(norm(got[4][1].vel_err_ned_mps) <= 1e-7);
     assert!(norm(got[4][0].att_err_rad) <= 1e-10);
     // three_opt identical to three_poly to 4 significant digits (constant-rate legs dominate)
-    check_rel("three_opt vN(30)", got[5][1].vel_err_ned_mps[0], got[0][1].vel_err_ned_mps[0], 1e-4);
+    check_rel(
+        "three_opt vN(30)",
+        got[5][1].vel_err_ned_mps[0],
+        got[0][1].vel_err_ned_mps[0],
+        1e-4,
+    );
 }
 
 #[test]
@@ -62,22 +86,42 @@ fn dual_quaternion_paper_case_spec_7_5() {
     let conventional = with(sl, None, None, None);
     let mut conventional_theta = conventional;
     conventional_theta.rot_vector = Some(RotVector::Theta);
-    let (_s, got) = run_at(&scn, vec![conventional_theta, spec(K::DualQuat, 2), spec(K::Savage, 2), conventional], &[420.0], false);
+    let (_s, got) = run_at(
+        &scn,
+        vec![
+            conventional_theta,
+            spec(K::DualQuat, 2),
+            spec(K::Savage, 2),
+            conventional,
+        ],
+        &[420.0],
+        false,
+    );
     let [c, dq, sav, conv_phi] = [&got[0][0], &got[1][0], &got[2][0], &got[3][0]];
     // Conventional row (spec §7.5 was computed with ½Δθ×Δv rotation compensation): ±10 %
     let row = |e: &NavError| -> Vec<f64> {
         vec![
-            e.pos_err_ned_m[0], e.pos_err_ned_m[1], e.height_err_m,
-            e.vel_err_ned_mps[0], e.vel_err_ned_mps[1], e.vel_err_ned_mps[2],
-            e.euler_err_rad[0], e.euler_err_rad[1], e.euler_err_rad[2],
+            e.pos_err_ned_m[0],
+            e.pos_err_ned_m[1],
+            e.height_err_m,
+            e.vel_err_ned_mps[0],
+            e.vel_err_ned_mps[1],
+            e.vel_err_ned_mps[2],
+            e.euler_err_rad[0],
+            e.euler_err_rad[1],
+            e.euler_err_rad[2],
         ]
     };
-    let want = [5.33e-3, -1.68e-2, 8.96e-2, 4.23e-5, -1.07e-4, -4.44e-4, -3.71e-8, -1.94e-8, -2.25e-9];
+    let want = [
+        5.33e-3, -1.68e-2, 8.96e-2, 4.23e-5, -1.07e-4, -4.44e-4, -3.71e-8, -1.94e-8, -2.25e-9,
+    ];
     for (i, (g, w)) in row(c).iter().zip(want).enumerate() {
         check_rel(&format!("conventional[{i}]"), *g, w, 0.10);
     }
     // SAV row ±10 %
-    let want_sav = [6.16e-2, 4.98e-1, 7.94e-2, 3.27e-4, 2.38e-3, -4.95e-4, -1.18e-7, -1.05e-7, 5.98e-8];
+    let want_sav = [
+        6.16e-2, 4.98e-1, 7.94e-2, 3.27e-4, 2.38e-3, -4.95e-4, -1.18e-7, -1.05e-7, 5.98e-8,
+    ];
     for (i, (g, w)) in row(sav).iter().zip(want_sav).enumerate() {
         check_rel(&format!("savage[{i}]"), *g, w, 0.10);
     }
@@ -87,8 +131,14 @@ fn dual_quaternion_paper_case_spec_7_5() {
     assert!(dq.pos_err_ned_m[0].hypot(dq.pos_err_ned_m[1]) <= 0.05);
     check_rel("DQ roll", dq.euler_err_rad[0], -3.76e-8, 0.10);
     // S2's finding: DQ better than the conventional 2-sample algorithm in height and v_D
-    assert!(dq.height_err_m.abs() < c.height_err_m.abs() && dq.vel_err_ned_mps[2].abs() < c.vel_err_ned_mps[2].abs());
-    assert!(dq.height_err_m.abs() < sav.height_err_m.abs() && dq.vel_err_ned_mps[2].abs() < sav.vel_err_ned_mps[2].abs());
+    assert!(
+        dq.height_err_m.abs() < c.height_err_m.abs()
+            && dq.vel_err_ned_mps[2].abs() < c.vel_err_ned_mps[2].abs()
+    );
+    assert!(
+        dq.height_err_m.abs() < sav.height_err_m.abs()
+            && dq.vel_err_ned_mps[2].abs() < sav.vel_err_ned_mps[2].abs()
+    );
     // The S1 (30) form ½Δφ×Δv is closer to the exact screw (DQ) horizontally than ½Δθ×Δv.
     let h = |e: &NavError| e.pos_err_ned_m[0].hypot(e.pos_err_ned_m[1]);
     assert!((h(conv_phi) - h(dq)).abs() < (h(c) - h(dq)).abs());
@@ -98,48 +148,160 @@ fn dual_quaternion_paper_case_spec_7_5() {
 #[ignore = "90-minute scenario: run in release with --ignored"]
 fn mach1_east_table1_spec_7_2() {
     let scn = Scenario::load("mach1-east").unwrap();
-    let algos = vec![spec(K::Savage, 3), spec(K::SongLee, 3), spec(K::SongLeeComplete, 3), spec(K::DualQuat, 3)];
+    let algos = vec![
+        spec(K::Savage, 3),
+        spec(K::SongLee, 3),
+        spec(K::SongLeeComplete, 3),
+        spec(K::DualQuat, 3),
+    ];
     let (_s, got) = run_at(&scn, algos, &[1800.0, 3600.0, 5400.0], false);
     let p = 0.05;
     let q = 0.20;
     // SAV
     let s = &got[0];
-    check3("SAV pos 1800", s[0].pos_err_ned_m, [-0.3092, 3.318, -0.9397], [p; 3]);
-    check3("SAV vel 1800", s[0].vel_err_ned_mps, [-3.07e-4, 1.948e-3, -1.920e-3], [p; 3]);
-    check3("SAV att 1800", s[0].att_err_rad, [-5.20e-7, -4.9e-8, 3.99e-7], [p; 3]);
-    check3("SAV pos 3600", s[1].pos_err_ned_m, [0.0799, 0.596, -24.41], [q, q, p]);
-    check3("SAV vel 3600", s[1].vel_err_ned_mps, [9.39e-4, -4.729e-3, -4.255e-2], [p; 3]);
-    check3("SAV att 3600", s[1].att_err_rad, [-9.3e-8, 1.3e-8, 7.2e-8], [q, p, q]);
-    check3("SAV pos 5400", s[2].pos_err_ned_m, [3.065, -47.58, -566.7], [p; 3]);
-    check3("SAV vel 5400", s[2].vel_err_ned_mps, [3.476e-3, -5.288e-2, -0.9916], [p; 3]);
-    check3("SAV att 5400", s[2].att_err_rad, [7.451e-6, 4.82e-7, -5.718e-6], [p; 3]);
+    check3(
+        "SAV pos 1800",
+        s[0].pos_err_ned_m,
+        [-0.3092, 3.318, -0.9397],
+        [p; 3],
+    );
+    check3(
+        "SAV vel 1800",
+        s[0].vel_err_ned_mps,
+        [-3.07e-4, 1.948e-3, -1.920e-3],
+        [p; 3],
+    );
+    check3(
+        "SAV att 1800",
+        s[0].att_err_rad,
+        [-5.20e-7, -4.9e-8, 3.99e-7],
+        [p; 3],
+    );
+    check3(
+        "SAV pos 3600",
+        s[1].pos_err_ned_m,
+        [0.0799, 0.596, -24.41],
+        [q, q, p],
+    );
+    check3(
+        "SAV vel 3600",
+        s[1].vel_err_ned_mps,
+        [9.39e-4, -4.729e-3, -4.255e-2],
+        [p; 3],
+    );
+    check3(
+        "SAV att 3600",
+        s[1].att_err_rad,
+        [-9.3e-8, 1.3e-8, 7.2e-8],
+        [q, p, q],
+    );
+    check3(
+        "SAV pos 5400",
+        s[2].pos_err_ned_m,
+        [3.065, -47.58, -566.7],
+        [p; 3],
+    );
+    check3(
+        "SAV vel 5400",
+        s[2].vel_err_ned_mps,
+        [3.476e-3, -5.288e-2, -0.9916],
+        [p; 3],
+    );
+    check3(
+        "SAV att 5400",
+        s[2].att_err_rad,
+        [7.451e-6, 4.82e-7, -5.718e-6],
+        [p; 3],
+    );
     // SL
     let s = &got[1];
-    check3("SL pos 1800", s[0].pos_err_ned_m, [-4.43e-3, 4.749e-2, -1.345e-2], [p; 3]);
-    check3("SL vel 1800", s[0].vel_err_ned_mps, [-4.40e-6, 2.787e-5, -2.747e-5], [p; 3]);
-    check3("SL att 1800", s[0].att_err_rad, [-7.44e-9, -7.0e-10, 5.71e-9], [p; 3]);
-    check3("SL pos 3600", s[1].pos_err_ned_m, [1.1e-3, 8.5e-3, -0.3492], [q, q, p]);
-    check3("SL vel 3600", s[1].vel_err_ned_mps, [1.34e-5, -6.77e-5, -6.088e-4], [p; 3]);
-    check3("SL att 3600", s[1].att_err_rad, [-1.33e-9, 1.8e-10, 1.03e-9], [q, p, q]);
-    check3("SL pos 5400", s[2].pos_err_ned_m, [4.381e-2, -0.6809, -8.109], [p; 3]);
-    check3("SL vel 5400", s[2].vel_err_ned_mps, [4.97e-5, -7.566e-4, -1.419e-2], [p; 3]);
-    check3("SL att 5400", s[2].att_err_rad, [1.066e-7, 6.90e-9, -8.180e-8], [p; 3]);
+    check3(
+        "SL pos 1800",
+        s[0].pos_err_ned_m,
+        [-4.43e-3, 4.749e-2, -1.345e-2],
+        [p; 3],
+    );
+    check3(
+        "SL vel 1800",
+        s[0].vel_err_ned_mps,
+        [-4.40e-6, 2.787e-5, -2.747e-5],
+        [p; 3],
+    );
+    check3(
+        "SL att 1800",
+        s[0].att_err_rad,
+        [-7.44e-9, -7.0e-10, 5.71e-9],
+        [p; 3],
+    );
+    check3(
+        "SL pos 3600",
+        s[1].pos_err_ned_m,
+        [1.1e-3, 8.5e-3, -0.3492],
+        [q, q, p],
+    );
+    check3(
+        "SL vel 3600",
+        s[1].vel_err_ned_mps,
+        [1.34e-5, -6.77e-5, -6.088e-4],
+        [p; 3],
+    );
+    check3(
+        "SL att 3600",
+        s[1].att_err_rad,
+        [-1.33e-9, 1.8e-10, 1.03e-9],
+        [q, p, q],
+    );
+    check3(
+        "SL pos 5400",
+        s[2].pos_err_ned_m,
+        [4.381e-2, -0.6809, -8.109],
+        [p; 3],
+    );
+    check3(
+        "SL vel 5400",
+        s[2].vel_err_ned_mps,
+        [4.97e-5, -7.566e-4, -1.419e-2],
+        [p; 3],
+    );
+    check3(
+        "SL att 5400",
+        s[2].att_err_rad,
+        [1.066e-7, 6.90e-9, -8.180e-8],
+        [p; 3],
+    );
     // S1's claim: SL beats SAV by ≥ 50× in every component at 5400 s
-    for (a, b) in [(got[0][2].pos_err_ned_m, got[1][2].pos_err_ned_m), (got[0][2].vel_err_ned_mps, got[1][2].vel_err_ned_mps), (got[0][2].att_err_rad, got[1][2].att_err_rad)] {
+    for (a, b) in [
+        (got[0][2].pos_err_ned_m, got[1][2].pos_err_ned_m),
+        (got[0][2].vel_err_ned_mps, got[1][2].vel_err_ned_mps),
+        (got[0][2].att_err_rad, got[1][2].att_err_rad),
+    ] {
         for i in 0..3 {
             assert!(a[i].abs() >= 50.0 * b[i].abs(), "ratio {}", a[i] / b[i]);
         }
     }
     // SLC bars (and the stretch: horizontal ≤ 1e-3 m, D ≤ 2e-2 m)
     let c = &got[2][2];
-    assert!(c.pos_err_ned_m[0].hypot(c.pos_err_ned_m[1]) <= 1e-3, "{:?}", c.pos_err_ned_m);
+    assert!(
+        c.pos_err_ned_m[0].hypot(c.pos_err_ned_m[1]) <= 1e-3,
+        "{:?}",
+        c.pos_err_ned_m
+    );
     assert!(c.pos_err_ned_m[2].abs() <= 2e-2);
-    assert!(c.vel_err_ned_mps[0].hypot(c.vel_err_ned_mps[1]) <= 1e-5 && c.vel_err_ned_mps[2].abs() <= 3e-4);
+    assert!(
+        c.vel_err_ned_mps[0].hypot(c.vel_err_ned_mps[1]) <= 1e-5
+            && c.vel_err_ned_mps[2].abs() <= 3e-4
+    );
     assert!(norm(c.att_err_rad) <= 2e-9);
     // DQ bars
     let d = &got[3];
-    assert!(d[1].pos_err_ned_m[0].hypot(d[1].pos_err_ned_m[1]) <= 0.02 && d[1].pos_err_ned_m[2].abs() <= 0.2);
-    assert!(d[2].pos_err_ned_m[0].hypot(d[2].pos_err_ned_m[1]) <= 0.5 && d[2].pos_err_ned_m[2].abs() <= 5.0);
+    assert!(
+        d[1].pos_err_ned_m[0].hypot(d[1].pos_err_ned_m[1]) <= 0.02
+            && d[1].pos_err_ned_m[2].abs() <= 0.2
+    );
+    assert!(
+        d[2].pos_err_ned_m[0].hypot(d[2].pos_err_ned_m[1]) <= 0.5
+            && d[2].pos_err_ned_m[2].abs() <= 5.0
+    );
     assert!(norm(d[2].att_err_rad) <= 5e-8);
 }
 
@@ -147,7 +309,12 @@ fn mach1_east_table1_spec_7_2() {
 #[ignore = "90-minute scenario: run in release with --ignored"]
 fn stationary_90min_spec_7_1() {
     let scn = Scenario::load("stationary").unwrap();
-    let algos = vec![spec(K::Savage, 3), spec(K::SongLee, 3), spec(K::SongLeeComplete, 3), spec(K::DualQuat, 3)];
+    let algos = vec![
+        spec(K::Savage, 3),
+        spec(K::SongLee, 3),
+        spec(K::SongLeeComplete, 3),
+        spec(K::DualQuat, 3),
+    ];
     let (_s, got) = run_at(&scn, algos, &[5400.0], false);
     let sav = &got[0][0];
     let refs = [
@@ -163,7 +330,12 @@ fn stationary_90min_spec_7_1() {
         }
     }
     for e in [&got[1][0], &got[2][0]] {
-        assert!(norm(e.pos_err_ned_m) <= 1e-2 && norm(e.vel_err_ned_mps) <= 1e-5 && norm(e.att_err_rad) <= 1e-10, "{e:?}");
+        assert!(
+            norm(e.pos_err_ned_m) <= 1e-2
+                && norm(e.vel_err_ned_mps) <= 1e-5
+                && norm(e.att_err_rad) <= 1e-10,
+            "{e:?}"
+        );
     }
     let d = &got[3][0];
     assert!(d.pos_err_ned_m[0].hypot(d.pos_err_ned_m[1]) <= 0.2 && d.pos_err_ned_m[2].abs() <= 3.0);

@@ -29,7 +29,10 @@ fn stationary_increments_closed_form() {
     let dt = c.dt_s;
     let want_th = c_n_b * e.omega_ie_n(c.lat0_rad) * dt;
     let want_dv = -(c_n_b * e.gravity_n(c.lat0_rad, 0.0)) * dt;
-    for gen in [TruthGenerator::new(&scn.trajectory, c), TruthGenerator::new(&scn.trajectory, c).without_closed_form()] {
+    for gen in [
+        TruthGenerator::new(&scn.trajectory, c),
+        TruthGenerator::new(&scn.trajectory, c).without_closed_form(),
+    ] {
         for s in gen.take(50) {
             assert!((s.inc.dtheta_b_rad - want_th).norm() <= 1e-15 * want_th.norm());
             assert!((s.inc.dv_b_mps - want_dv).norm() <= 1e-15 * want_dv.norm());
@@ -49,7 +52,11 @@ fn mach1_rk4_reproduces_closed_form() {
     for (x, y) in a.zip(b).take(5000) {
         dth = dth.max((x.inc.dtheta_b_rad - y.inc.dtheta_b_rad).norm());
         dv = dv.max((x.inc.dv_b_mps - y.inc.dv_b_mps).norm());
-        dpos = dpos.max((x.lat_rad - y.lat_rad).abs().max((x.lon_rad - y.lon_rad).abs()));
+        dpos = dpos.max(
+            (x.lat_rad - y.lat_rad)
+                .abs()
+                .max((x.lon_rad - y.lon_rad).abs()),
+        );
     }
     eprintln!("A1 closed vs RK4: dθ {dth:e} rad, dv {dv:e} m/s, pos {dpos:e} rad");
     assert!(dth <= 1e-21, "{dth:e}");
@@ -76,9 +83,16 @@ fn refinement(name: &str) -> (f64, f64, f64) {
         }
         dth = dth.max(d);
         dv = dv.max((x.inc.dv_b_mps - y.inc.dv_b_mps).norm());
-        dpos = dpos.max((x.lat_rad - y.lat_rad).abs().max((x.lon_rad - y.lon_rad).abs()));
+        dpos = dpos.max(
+            (x.lat_rad - y.lat_rad)
+                .abs()
+                .max((x.lon_rad - y.lon_rad).abs()),
+        );
     }
-    eprintln!("{name}: {base} vs {} substeps: dθ {dth:e} rad, dv {dv:e} m/s, pos {dpos:e} rad", 2 * base);
+    eprintln!(
+        "{name}: {base} vs {} substeps: dθ {dth:e} rad, dv {dv:e} m/s, pos {dpos:e} rad",
+        2 * base
+    );
     (dth, dv, dpos)
 }
 
@@ -104,9 +118,24 @@ fn classical_coning_increments_closed_form() {
         0.0,
         Euler::default(),
         &[(Motion::Static, 2.0)],
-        vec![Overlay { kind: OverlayKind::Coning { axis: Axis::Z, half_angle_rad: alpha, omega_rps: omega }, start_s: 0.0, end_s: f64::INFINITY }],
+        vec![Overlay {
+            kind: OverlayKind::Coning {
+                axis: Axis::Z,
+                half_angle_rad: alpha,
+                omega_rps: omega,
+            },
+            start_s: 0.0,
+            end_s: f64::INFINITY,
+        }],
     );
-    let c = TruthConfig { earth: EarthModel::flat(9.80665), dt_s: 0.002, lat0_rad: 0.6, lon0_rad: 2.0, h0_m: 0.0, substeps: 16 };
+    let c = TruthConfig {
+        earth: EarthModel::flat(9.80665),
+        dt_s: 0.002,
+        lat0_rad: 0.6,
+        lon0_rad: 2.0,
+        h0_m: 0.0,
+        substeps: 16,
+    };
     let mut t1 = 0.0;
     for s in TruthGenerator::new(&tr, c) {
         let t2 = s.t_s;
@@ -121,7 +150,11 @@ fn classical_coning_increments_closed_form() {
         );
         // relative form C_c = C(q(0))ᵀ C(q(t)) has the same body rates, so Δθ is identical
         let tol = 1e-14 * want.norm();
-        assert!((s.inc.dtheta_b_rad - want).norm() <= tol, "t {t2}: {:e}", (s.inc.dtheta_b_rad - want).norm());
+        assert!(
+            (s.inc.dtheta_b_rad - want).norm() <= tol,
+            "t {t2}: {:e}",
+            (s.inc.dtheta_b_rad - want).norm()
+        );
         t1 = t2;
     }
 }
@@ -131,23 +164,78 @@ fn psins_trj10ms_stationary_rows() {
     // External: PSINS trj10ms starts at rest at 34.25N, 380 m. With the PSINS constant set
     // and RFU/ENU converted to FRD/NED at the edge, our stationary increments equal
     // PSINS's first rows to 1e-11 of each vector's norm.
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/csv/psins/trj10ms_imu.csv");
-    let avp0 = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/csv/psins/trj10ms_avp0.csv");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/csv/psins/trj10ms_imu.csv"
+    );
+    let avp0 = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/csv/psins/trj10ms_avp0.csv"
+    );
     let (Ok(text), Ok(a0)) = (std::fs::read_to_string(path), std::fs::read_to_string(avp0)) else {
         eprintln!("skipped: ../shared/data not present ({path})");
         return;
     };
-    let v0: Vec<f64> = a0.lines().nth(1).unwrap().split(',').map(|x| x.trim().parse().unwrap()).collect();
+    let v0: Vec<f64> = a0
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|x| x.trim().parse().unwrap())
+        .collect();
     let (lat, lon, h, ts) = (v0[6], v0[7], v0[8], v0[9]);
-    let tr = Trajectory::new(0.0, 0.0, Euler::default(), &[(Motion::Static, 10.0 * ts)], vec![]);
-    let c = TruthConfig { earth: EarthModel::PSINS, dt_s: ts, lat0_rad: lat, lon0_rad: lon, h0_m: h, substeps: 16 };
+    let tr = Trajectory::new(
+        0.0,
+        0.0,
+        Euler::default(),
+        &[(Motion::Static, 10.0 * ts)],
+        vec![],
+    );
+    let c = TruthConfig {
+        earth: EarthModel::PSINS,
+        dt_s: ts,
+        lat0_rad: lat,
+        lon0_rad: lon,
+        h0_m: h,
+        substeps: 16,
+    };
     let ours: Vec<_> = TruthGenerator::new(&tr, c).take(3).collect();
     for (row, s) in text.lines().skip(1).take(3).zip(&ours) {
         let r: Vec<f64> = row.split(',').map(|x| x.trim().parse().unwrap()).collect();
         // RFU → FRD: x_frd = y_rfu, y_frd = x_rfu, z_frd = −z_rfu
         let th = Vec3::new(r[2], r[1], -r[3]);
         let dv = Vec3::new(r[5], r[4], -r[6]);
-        assert!((s.inc.dtheta_b_rad - th).norm() <= 1e-11 * th.norm(), "{:?} vs {:?}", s.inc.dtheta_b_rad, th);
-        assert!((s.inc.dv_b_mps - dv).norm() <= 1e-11 * dv.norm(), "{:?} vs {:?}", s.inc.dv_b_mps, dv);
+        assert!(
+            (s.inc.dtheta_b_rad - th).norm() <= 1e-11 * th.norm(),
+            "{:?} vs {:?}",
+            s.inc.dtheta_b_rad,
+            th
+        );
+        assert!(
+            (s.inc.dv_b_mps - dv).norm() <= 1e-11 * dv.norm(),
+            "{:?} vs {:?}",
+            s.inc.dv_b_mps,
+            dv
+        );
     }
+}
+
+#[test]
+fn scenario_reference_lists_every_accepted_key() {
+    // docs/scenarios.md must document exactly the keys the parser accepts.
+    let doc = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../docs/scenarios.md"
+    ))
+    .unwrap();
+    let documented: std::collections::BTreeSet<String> = doc
+        .lines()
+        .filter(|l| l.starts_with("| `"))
+        .filter_map(|l| l.split('`').nth(1).map(str::to_string))
+        .collect();
+    let accepted: std::collections::BTreeSet<String> = sdins_sim::scenario::ACCEPTED_KEYS
+        .iter()
+        .flat_map(|(_, keys)| keys.iter().map(|k| k.to_string()))
+        .collect();
+    assert_eq!(documented, accepted);
 }

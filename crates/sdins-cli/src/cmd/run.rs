@@ -12,7 +12,9 @@ use std::path::PathBuf;
 
 /// Arguments of `sdins run`.
 #[derive(clap::Args, Debug, Clone)]
-#[command(after_help = "Examples:\n  sdins run mach1-east --algo savage,songlee\n  sdins run my.toml --algo dualquat --samples 2 --json")]
+#[command(
+    after_help = "Examples:\n  sdins run mach1-east --algo savage,songlee\n  sdins run my.toml --algo dualquat --samples 2 --json"
+)]
 pub struct Args {
     /// built-in scenario name or scenario file
     pub scenario: String,
@@ -55,10 +57,16 @@ pub struct Args {
 pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, CliError> {
     let n = args.samples.unwrap_or(scn.nav.samples);
     if !(1..=4).contains(&n) {
-        return Err(CliError::bad(format!("--samples {n}: expected 1, 2, 3 or 4")));
+        return Err(CliError::bad(format!(
+            "--samples {n}: expected 1, 2, 3 or 4"
+        )));
     }
     let names: Vec<String> = match &args.algo {
-        Some(s) => s.split(',').map(|x| x.trim().to_string()).filter(|x| !x.is_empty()).collect(),
+        Some(s) => s
+            .split(',')
+            .map(|x| x.trim().to_string())
+            .filter(|x| !x.is_empty())
+            .collect(),
         None => scn.nav.algos.clone(),
     };
     let coning_name = args.coning.clone().or_else(|| scn.nav.coning.clone());
@@ -71,7 +79,10 @@ pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, Cli
                 ))
             })?;
             if !set.accepts(n) {
-                return Err(CliError::bad(format!("--coning {c}: the set is for {} samples, but --samples is {n}", set.samples())));
+                return Err(CliError::bad(format!(
+                    "--coning {c}: the set is for {} samples, but --samples is {n}",
+                    set.samples()
+                )));
             }
             set
         }
@@ -81,13 +92,21 @@ pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, Cli
         Some("transport") => Some(AttitudeMode::Transport),
         Some("five") => Some(AttitudeMode::Five),
         Some("savage") => Some(AttitudeMode::Savage),
-        Some(o) => return Err(CliError::bad(format!("--attitude {o}: expected transport, five or savage"))),
+        Some(o) => {
+            return Err(CliError::bad(format!(
+                "--attitude {o}: expected transport, five or savage"
+            )))
+        }
     };
     let rot_vector = match args.rotvec.as_deref() {
         None => None,
         Some("theta") => Some(RotVector::Theta),
         Some("phi") => Some(RotVector::Phi),
-        Some(o) => return Err(CliError::bad(format!("--rotvec {o}: expected theta or phi"))),
+        Some(o) => {
+            return Err(CliError::bad(format!(
+                "--rotvec {o}: expected theta or phi"
+            )))
+        }
     };
     names
         .iter()
@@ -120,22 +139,38 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
         None => scn.nav.vertical_hold,
         Some("free") => false,
         Some("hold") => true,
-        Some(o) => return Err(CliError::bad(format!("--vertical {o}: expected free or hold"))),
+        Some(o) => {
+            return Err(CliError::bad(format!(
+                "--vertical {o}: expected free or hold"
+            )))
+        }
     };
     if !(args.every_s.is_finite() && args.every_s > 0.0) {
-        return Err(CliError::bad(format!("--every-s {}: expected a positive number of seconds", args.every_s)));
+        return Err(CliError::bad(format!(
+            "--every-s {}: expected a positive number of seconds",
+            args.every_s
+        )));
     }
     let n = algos[0].samples;
     let dt_u = scn.imu.dt_s() * n as f64;
     let every = ((args.every_s / dt_u).round() as u64).max(1);
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("sdins-out/run-{}", scn.name)));
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/run-{}", scn.name)));
     let mut nav_files = Vec::new();
     let mut err_files = Vec::new();
     for a in &algos {
         let mut nf = AtomicFile::create(&out.join(format!("nav_{}.csv", a.kind.name())))?;
         let mut ef = AtomicFile::create(&out.join(format!("err_{}.csv", a.kind.name())))?;
-        writeln!(nf.writer(), "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg")
-            .map_err(|source| CliError::Io { path: out.clone(), source })?;
+        writeln!(
+            nf.writer(),
+            "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg"
+        )
+        .map_err(|source| CliError::Io {
+            path: out.clone(),
+            source,
+        })?;
         writeln!(
             ef.writer(),
             "# attitude error eps: C_alg C_true^T = I + [eps x] (NED, rad); position error dN = dLat(R_M+h), dE = dLon(R_N+h)cosL, dD = -(h_alg - h_true)\nt_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,vel_err_n_mps,vel_err_e_mps,vel_err_d_mps,att_err_n_rad,att_err_e_rad,att_err_d_rad,height_err_m,roll_err_rad,pitch_err_rad,yaw_err_rad"
@@ -148,7 +183,12 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
     let mut bar = Progress::new(total, "navigate", args.quiet);
     let mut io_error = None;
     let d = 180.0 / std::f64::consts::PI;
-    let opts = RunOptions { algos: algos.clone(), vertical_hold: hold, every, until_s: None };
+    let opts = RunOptions {
+        algos: algos.clone(),
+        vertical_hold: hold,
+        every,
+        until_s: None,
+    };
     let summaries = run_pipeline(
         &scn,
         &opts,
@@ -157,14 +197,40 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
             let r1 = writeln!(
                 nav_files[i].writer(),
                 "{},{},{},{},{},{},{},{},{},{}",
-                e.t_s, st.lat_rad * d, st.lon_rad * d, st.h_m, st.v_n_mps.x, st.v_n_mps.y, st.v_n_mps.z,
-                eu.roll_rad * d, eu.pitch_rad * d, eu.yaw_rad * d
+                e.t_s,
+                st.lat_rad * d,
+                st.lon_rad * d,
+                st.h_m,
+                st.v_n_mps.x,
+                st.v_n_mps.y,
+                st.v_n_mps.z,
+                eu.roll_rad * d,
+                eu.pitch_rad * d,
+                eu.yaw_rad * d
             );
-            let (p, v, a, u) = (e.pos_err_ned_m, e.vel_err_ned_mps, e.att_err_rad, e.euler_err_rad);
+            let (p, v, a, u) = (
+                e.pos_err_ned_m,
+                e.vel_err_ned_mps,
+                e.att_err_rad,
+                e.euler_err_rad,
+            );
             let r2 = writeln!(
                 err_files[i].writer(),
                 "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-                e.t_s, p[0], p[1], p[2], v[0], v[1], v[2], a[0], a[1], a[2], e.height_err_m, u[0], u[1], u[2]
+                e.t_s,
+                p[0],
+                p[1],
+                p[2],
+                v[0],
+                v[1],
+                v[2],
+                a[0],
+                a[1],
+                a[2],
+                e.height_err_m,
+                u[0],
+                u[1],
+                u[2]
             );
             if let Err(err) = r1.and(r2) {
                 io_error.get_or_insert(err);
@@ -187,10 +253,27 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
 
 /// Print a summary table of final errors.
 pub fn print_table(scn: &Scenario, sums: &[RunSummary]) {
-    println!("scenario {} ({} s, {} Hz IMU, {} samples/update)", scn.name, scn.duration_s(), scn.imu.rate_hz, sums.first().map_or(0, |s| s.samples));
+    println!(
+        "scenario {} ({} s, {} Hz IMU, {} samples/update)",
+        scn.name,
+        scn.duration_s(),
+        scn.imu.rate_hz,
+        sums.first().map_or(0, |s| s.samples)
+    );
     println!(
         "{:<17} {:>11} {:>11} {:>11} | {:>10} {:>10} {:>10} | {:>10} {:>10} {:>10} | {:>8} {:>9}",
-        "algo", "pos N m", "pos E m", "pos D m", "vel N m/s", "vel E m/s", "vel D m/s", "att N rad", "att E rad", "att D rad", "wall s", "Mupd/s"
+        "algo",
+        "pos N m",
+        "pos E m",
+        "pos D m",
+        "vel N m/s",
+        "vel E m/s",
+        "vel D m/s",
+        "att N rad",
+        "att E rad",
+        "att D rad",
+        "wall s",
+        "Mupd/s"
     );
     for s in sums {
         let e = &s.final_err;
@@ -208,10 +291,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (scn, sums, out) = execute(&args)?;
     if args.json {
         let v = serde_json::json!({ "scenario": scn.name, "results": sums });
-        println!("{}", serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?
+        );
     } else {
         print_table(&scn, &sums);
-        println!("errors at t = {} s; files in {}", sums.first().map_or(0.0, |s| s.final_err.t_s), out.display());
+        println!(
+            "errors at t = {} s; files in {}",
+            sums.first().map_or(0.0, |s| s.final_err.t_s),
+            out.display()
+        );
     }
     Ok(())
 }

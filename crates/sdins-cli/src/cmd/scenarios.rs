@@ -28,7 +28,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             }
             None => Err(CliError::bad(format!(
                 "unknown scenario `{n}` (built-ins: {})",
-                BUILTINS.iter().map(|b| b.name).collect::<Vec<_>>().join(", ")
+                BUILTINS
+                    .iter()
+                    .map(|b| b.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ))),
         },
     }

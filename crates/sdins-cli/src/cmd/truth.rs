@@ -32,7 +32,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.every == 0 {
         return Err(CliError::bad("--every: must be at least 1"));
     }
-    let out = args.out.unwrap_or_else(|| PathBuf::from(format!("sdins-out/truth-{}", scn.name)));
+    let out = args
+        .out
+        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/truth-{}", scn.name)));
     let cfg = TruthConfig {
         earth: scn.nav.earth.model(),
         dt_s: scn.imu.dt_s(),
@@ -47,7 +49,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut imu = AtomicFile::create(&out.join("imu.csv"))?;
     writeln!(truth.writer(), "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg,q_w,q_x,q_y,q_z")
         .map_err(|e| io_err(&out, "truth.csv", e))?;
-    writeln!(imu.writer(), "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps").map_err(|e| io_err(&out, "imu.csv", e))?;
+    writeln!(
+        imu.writer(),
+        "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps"
+    )
+    .map_err(|e| io_err(&out, "imu.csv", e))?;
     let init = gen.initial_state();
     let e0 = euler_from_c_b_n(&init.c_b_n);
     let q0 = Quat::from_dcm(&init.c_b_n);
@@ -65,10 +71,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
         writeln!(
             imu.writer(),
             "{},{:e},{:e},{:e},{:e},{:e},{:e}",
-            s.t_s, i.dtheta_b_rad.x, i.dtheta_b_rad.y, i.dtheta_b_rad.z, i.dv_b_mps.x, i.dv_b_mps.y, i.dv_b_mps.z
+            s.t_s,
+            i.dtheta_b_rad.x,
+            i.dtheta_b_rad.y,
+            i.dtheta_b_rad.z,
+            i.dv_b_mps.x,
+            i.dv_b_mps.y,
+            i.dv_b_mps.z
         )
         .map_err(|e| io_err(&out, "imu.csv", e))?;
-        if (k as u64 + 1) % args.every == 0 {
+        if (k as u64 + 1).is_multiple_of(args.every) {
             let e = euler_from_c_b_n(&s.c_b_n);
             let q = Quat::from_dcm(&s.c_b_n);
             writeln!(
@@ -101,5 +113,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
 }
 
 fn io_err(dir: &std::path::Path, name: &str, source: std::io::Error) -> CliError {
-    CliError::Io { path: dir.join(name), source }
+    CliError::Io {
+        path: dir.join(name),
+        source,
+    }
 }

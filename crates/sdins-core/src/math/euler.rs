@@ -17,7 +17,11 @@ pub struct Euler {
 impl Euler {
     /// Build from roll, pitch, yaw in radians.
     pub const fn new(roll_rad: f64, pitch_rad: f64, yaw_rad: f64) -> Self {
-        Self { roll_rad, pitch_rad, yaw_rad }
+        Self {
+            roll_rad,
+            pitch_rad,
+            yaw_rad,
+        }
     }
 }
 

@@ -26,7 +26,12 @@ impl Default for Quat {
 
 impl Quat {
     /// The identity rotation.
-    pub const IDENTITY: Quat = Quat { w: 1.0, x: 0.0, y: 0.0, z: 0.0 };
+    pub const IDENTITY: Quat = Quat {
+        w: 1.0,
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+    };
 
     /// Build from components, scalar first.
     #[inline]
@@ -37,7 +42,12 @@ impl Quat {
     /// Build from a scalar and a vector part.
     #[inline]
     pub fn from_parts(w: f64, v: &Vec3) -> Self {
-        Self { w, x: v.x, y: v.y, z: v.z }
+        Self {
+            w,
+            x: v.x,
+            y: v.y,
+            z: v.z,
+        }
     }
 
     /// Vector part.
@@ -49,7 +59,12 @@ impl Quat {
     /// Conjugate `q*`.
     #[inline]
     pub fn conj(&self) -> Self {
-        Self { w: self.w, x: -self.x, y: -self.y, z: -self.z }
+        Self {
+            w: self.w,
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
     }
 
     /// Euclidean norm.
@@ -71,13 +86,23 @@ impl Quat {
     /// Multiply every component by `s`.
     #[inline]
     pub fn scale(&self, s: f64) -> Self {
-        Self { w: self.w * s, x: self.x * s, y: self.y * s, z: self.z * s }
+        Self {
+            w: self.w * s,
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
     }
 
     /// Component-wise sum.
     #[inline]
     pub fn add(&self, o: &Self) -> Self {
-        Self { w: self.w + o.w, x: self.x + o.x, y: self.y + o.y, z: self.z + o.z }
+        Self {
+            w: self.w + o.w,
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
     }
 
     /// Hamilton product `self ⊗ o`:
@@ -170,7 +195,10 @@ impl Quat {
         let a2 = phi.norm_squared();
         let a = libm::sqrt(a2);
         let (c, s_over) = if a < 1e-6 {
-            (1.0 - a2 / 8.0 + a2 * a2 / 384.0, 0.5 - a2 / 48.0 + a2 * a2 / 3840.0)
+            (
+                1.0 - a2 / 8.0 + a2 * a2 / 384.0,
+                0.5 - a2 / 48.0 + a2 * a2 / 3840.0,
+            )
         } else {
             (libm::cos(0.5 * a), libm::sin(0.5 * a) / a)
         };
@@ -180,7 +208,11 @@ impl Quat {
     /// Rotation vector of the quaternion (shortest rotation, |φ| ≤ π), inverse of
     /// [`Quat::from_rotvec`].
     pub fn to_rotvec(&self) -> Vec3 {
-        let q = if self.w < 0.0 { self.scale(-1.0) } else { *self };
+        let q = if self.w < 0.0 {
+            self.scale(-1.0)
+        } else {
+            *self
+        };
         let v = q.vec();
         let s = v.norm();
         if s < 1e-8 {
@@ -204,7 +236,11 @@ mod tests {
     fn product_matches_dcm_composition() {
         let a = Quat::from_rotvec(&Vec3::new(0.3, -0.5, 0.9));
         let b = Quat::from_rotvec(&Vec3::new(-1.1, 0.2, 0.4));
-        assert!(close(&a.mul(&b).to_dcm(), &(a.to_dcm() * b.to_dcm()), 1e-15));
+        assert!(close(
+            &a.mul(&b).to_dcm(),
+            &(a.to_dcm() * b.to_dcm()),
+            1e-15
+        ));
     }
 
     #[test]

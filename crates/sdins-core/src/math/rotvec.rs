@@ -7,7 +7,10 @@ use super::{skew, Mat3, Quat, Vec3};
 pub fn dcm_from_rotvec(phi: &Vec3) -> Mat3 {
     let a2 = phi.norm_squared();
     let (s1, s2) = if a2 < 1e-8 {
-        (1.0 - a2 / 6.0 + a2 * a2 / 120.0, 0.5 - a2 / 24.0 + a2 * a2 / 720.0)
+        (
+            1.0 - a2 / 6.0 + a2 * a2 / 120.0,
+            0.5 - a2 / 24.0 + a2 * a2 / 720.0,
+        )
     } else {
         let a = libm::sqrt(a2);
         (libm::sin(a) / a, (1.0 - libm::cos(a)) / a2)

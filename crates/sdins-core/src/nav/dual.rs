@@ -14,12 +14,18 @@ pub struct DualQuat {
 
 impl DualQuat {
     /// Identity.
-    pub const IDENTITY: DualQuat = DualQuat { r: Quat::IDENTITY, d: Quat::new(0.0, 0.0, 0.0, 0.0) };
+    pub const IDENTITY: DualQuat = DualQuat {
+        r: Quat::IDENTITY,
+        d: Quat::new(0.0, 0.0, 0.0, 0.0),
+    };
 
     /// Product `(r₁ + εd₁)(r₂ + εd₂) = r₁r₂ + ε(r₁d₂ + d₁r₂)`.
     #[inline]
     pub fn mul(&self, o: &DualQuat) -> DualQuat {
-        DualQuat { r: self.r.mul(&o.r), d: self.r.mul(&o.d).add(&self.d.mul(&o.r)) }
+        DualQuat {
+            r: self.r.mul(&o.r),
+            d: self.r.mul(&o.d).add(&self.d.mul(&o.r)),
+        }
     }
 
     /// Translation in old-frame coordinates, `t^O = 2 d ⊗ r*` (vector part).
@@ -42,7 +48,10 @@ impl DualQuat {
         let r = self.r.scale(1.0 / n);
         let d = self.d.scale(1.0 / n);
         let dot = r.w * d.w + r.x * d.x + r.y * d.y + r.z * d.z;
-        DualQuat { r, d: d.add(&r.scale(-dot)) }
+        DualQuat {
+            r,
+            d: d.add(&r.scale(-dot)),
+        }
     }
 
     /// Screw exponential of the dual vector `σ̂ = σ + εσ'` (constant twist integrated over
@@ -76,12 +85,21 @@ mod tests {
 
     fn rate(q: &DualQuat, w: &Vec3, wd: &Vec3) -> DualQuat {
         // dq̂/dt = ½ q̂ ⊗ ω̂
-        let tw = DualQuat { r: Quat::from_parts(0.0, w), d: Quat::from_parts(0.0, wd) };
+        let tw = DualQuat {
+            r: Quat::from_parts(0.0, w),
+            d: Quat::from_parts(0.0, wd),
+        };
         let p = q.mul(&tw);
-        DualQuat { r: p.r.scale(0.5), d: p.d.scale(0.5) }
+        DualQuat {
+            r: p.r.scale(0.5),
+            d: p.d.scale(0.5),
+        }
     }
     fn axpy(q: &DualQuat, k: &DualQuat, a: f64) -> DualQuat {
-        DualQuat { r: q.r.add(&k.r.scale(a)), d: q.d.add(&k.d.scale(a)) }
+        DualQuat {
+            r: q.r.add(&k.r.scale(a)),
+            d: q.d.add(&k.d.scale(a)),
+        }
     }
 
     #[test]
@@ -103,8 +121,14 @@ mod tests {
         }
         let e = DualQuat::exp(&(w * t), &(wd * t));
         let diff = [
-            e.r.w - q.r.w, e.r.x - q.r.x, e.r.y - q.r.y, e.r.z - q.r.z,
-            e.d.w - q.d.w, e.d.x - q.d.x, e.d.y - q.d.y, e.d.z - q.d.z,
+            e.r.w - q.r.w,
+            e.r.x - q.r.x,
+            e.r.y - q.r.y,
+            e.r.z - q.r.z,
+            e.d.w - q.d.w,
+            e.d.x - q.d.x,
+            e.d.y - q.d.y,
+            e.d.z - q.d.z,
         ];
         let m = diff.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
         assert!(m < 1e-13, "{m}");
@@ -125,7 +149,10 @@ mod tests {
     fn translation_extraction() {
         let r = Quat::from_rotvec(&Vec3::new(0.2, 0.4, -0.1));
         let t_old = Vec3::new(3.0, -1.0, 2.0);
-        let q = DualQuat { r, d: Quat::from_parts(0.0, &t_old).mul(&r).scale(0.5) };
+        let q = DualQuat {
+            r,
+            d: Quat::from_parts(0.0, &t_old).mul(&r).scale(0.5),
+        };
         assert!((q.translation_old() - t_old).norm() < 1e-15);
         assert!((q.translation_new() - r.conj().rotate(&t_old)).norm() < 1e-14);
     }

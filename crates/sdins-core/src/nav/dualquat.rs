@@ -36,15 +36,30 @@ pub struct DualQuatNav {
 
 impl DualQuatNav {
     /// Initialise (spec §6.3 "Initialisation").
-    pub fn new(earth: EarthModel, dt_s: f64, samples: usize, coning: ConingSet, init: &InitialState) -> Self {
+    pub fn new(
+        earth: EarthModel,
+        dt_s: f64,
+        samples: usize,
+        coning: ConingSet,
+        init: &InitialState,
+    ) -> Self {
         let omega_ie_e = Vec3::new(0.0, 0.0, earth.omega_ie_rps);
         let r0 = earth.ecef_from_geodetic(init.lat_rad, init.lon_rad, init.h_m);
         let c_n_e0 = EarthModel::c_e_n(init.lat_rad, init.lon_rad).transpose();
         let v_e0 = c_n_e0 * init.v_n_mps;
         let v_i0 = v_e0 + omega_ie_e.cross(&r0);
-        let q_t = DualQuat { r: Quat::from_dcm(&(c_n_e0 * init.c_b_n)), d: Quat::new(0.0, 0.0, 0.0, 0.0) };
-        let q_g = DualQuat { r: Quat::IDENTITY, d: Quat::from_parts(0.0, &v_i0).scale(0.5) };
-        let q_u = DualQuat { r: Quat::IDENTITY, d: Quat::from_parts(0.0, &r0).scale(0.5) };
+        let q_t = DualQuat {
+            r: Quat::from_dcm(&(c_n_e0 * init.c_b_n)),
+            d: Quat::new(0.0, 0.0, 0.0, 0.0),
+        };
+        let q_g = DualQuat {
+            r: Quat::IDENTITY,
+            d: Quat::from_parts(0.0, &v_i0).scale(0.5),
+        };
+        let q_u = DualQuat {
+            r: Quat::IDENTITY,
+            d: Quat::from_parts(0.0, &r0).scale(0.5),
+        };
         let mut s = Self {
             earth,
             coning,
@@ -78,7 +93,9 @@ impl DualQuatNav {
     }
 
     fn attitude(&self) -> Mat3 {
-        EarthModel::c_e_n(self.lat_rad, self.lon_rad) * self.q_g.r.to_dcm().transpose() * self.q_t.r.to_dcm()
+        EarthModel::c_e_n(self.lat_rad, self.lon_rad)
+            * self.q_g.r.to_dcm().transpose()
+            * self.q_t.r.to_dcm()
     }
 }
 
@@ -126,14 +143,18 @@ impl Mechanization for DualQuatNav {
         let r_mid = self.r_e + 0.5 * dt * self.v_e;
         let g_mid = self.gravitation_e(&r_mid, self.lat_rad);
         let sig_w = self.omega_ie_e * dt;
-        self.q_g = self.q_g.mul(&DualQuat::exp(&sig_w, &(g_mid * dt))).normalized();
+        self.q_g = self
+            .q_g
+            .mul(&DualQuat::exp(&sig_w, &(g_mid * dt)))
+            .normalized();
 
         // 3. inertial velocity resolved in E, and the U frame
         let v_t_i = self.q_t.translation_old();
         let v_g_i = self.q_g.translation_old();
         let c_i_e = self.q_g.r.to_dcm().transpose();
         let u_k = c_i_e * (v_t_i + v_g_i);
-        let sig_u_d = 0.5 * (self.u_prev + u_k) * dt + (dt * dt / 12.0) * self.omega_ie_e.cross(&(u_k - self.u_prev));
+        let sig_u_d = 0.5 * (self.u_prev + u_k) * dt
+            + (dt * dt / 12.0) * self.omega_ie_e.cross(&(u_k - self.u_prev));
         self.q_u = self.q_u.mul(&DualQuat::exp(&sig_w, &sig_u_d)).normalized();
 
         // 4. outputs
@@ -166,7 +187,9 @@ impl Mechanization for DualQuatNav {
         // inertial velocity carries the held v_D; attitudes are untouched.
         self.h_m = h_m;
         self.v_n_mps.z = v_d_mps;
-        let r_e = self.earth.ecef_from_geodetic(self.lat_rad, self.lon_rad, h_m);
+        let r_e = self
+            .earth
+            .ecef_from_geodetic(self.lat_rad, self.lon_rad, h_m);
         let c_n_e = EarthModel::c_e_n(self.lat_rad, self.lon_rad).transpose();
         let v_e = c_n_e * self.v_n_mps;
         let c_e_i = self.q_g.r.to_dcm();

@@ -152,7 +152,8 @@ impl Mechanization for LocalLevel {
             dv_rot += dphi_rot.cross(&dphi_rot.cross(&comp.dv_b_mps)) / 6.0;
         }
         let c_dv = c * comp.dv_b_mps;
-        let mut v_new = v + c * (comp.dv_b_mps + dv_rot + comp.dv_scul_b_mps) + dt * (g_n - w_cor.cross(&v));
+        let mut v_new =
+            v + c * (comp.dv_b_mps + dv_rot + comp.dv_scul_b_mps) + dt * (g_n - w_cor.cross(&v));
         match self.cfg.velocity {
             VelocityMode::Savage => {}
             VelocityMode::SongLee | VelocityMode::SongLeeComplete => {
@@ -178,17 +179,25 @@ impl Mechanization for LocalLevel {
         };
         let lat_bar = self.lat0_rad + 0.5 * (self.dlat_rad + dlat_new);
         let lat_for_lon = if e.transport { lat_bar } else { self.lat0_rad };
-        let dlon_new =
-            self.dlon_rad + ve_bar * dt / ((e.radii(lat_for_lon).r_n_m + h_bar) * libm::cos(lat_for_lon));
+        let dlon_new = self.dlon_rad
+            + ve_bar * dt / ((e.radii(lat_for_lon).r_n_m + h_bar) * libm::cos(lat_for_lon));
 
         // 5. attitude
         match self.cfg.attitude {
             AttitudeMode::Transport => {
-                self.q = self.q.mul(&Quat::from_rotvec(&comp.dphi_b_rad)).normalized();
+                self.q = self
+                    .q
+                    .mul(&Quat::from_rotvec(&comp.dphi_b_rad))
+                    .normalized();
                 self.updates += 1;
                 let t = self.updates as f64 * dt;
                 let tm = if e.transport {
-                    transport_matrix(self.lat0_rad + dlat_new, self.s_lat0, self.c_lat0, dlon_new + e.omega_ie_rps * t)
+                    transport_matrix(
+                        self.lat0_rad + dlat_new,
+                        self.s_lat0,
+                        self.c_lat0,
+                        dlon_new + e.omega_ie_rps * t,
+                    )
                 } else {
                     transport_matrix(self.lat0_rad, self.s_lat0, self.c_lat0, e.omega_ie_rps * t)
                 };
@@ -196,7 +205,10 @@ impl Mechanization for LocalLevel {
             }
             AttitudeMode::Savage => {
                 let zeta = w_in * dt;
-                self.q = Quat::from_rotvec(&(-zeta)).mul(&self.q).mul(&Quat::from_rotvec(&comp.dphi_b_rad)).normalized();
+                self.q = Quat::from_rotvec(&(-zeta))
+                    .mul(&self.q)
+                    .mul(&Quat::from_rotvec(&comp.dphi_b_rad))
+                    .normalized();
                 self.updates += 1;
                 self.c_b_n = self.q.to_dcm();
             }
@@ -206,9 +218,15 @@ impl Mechanization for LocalLevel {
                 for (r, s) in rel.iter_mut().zip(samples.iter()) {
                     *r = Increment::new(s.dtheta_b_rad - w_in_b, s.dv_b_mps);
                 }
-                let prev_rel = Increment::new(self.prev.dtheta_b_rad - w_in_b * n as f64, self.prev.dv_b_mps);
+                let prev_rel = Increment::new(
+                    self.prev.dtheta_b_rad - w_in_b * n as f64,
+                    self.prev.dv_b_mps,
+                );
                 let comp_rel = compensate(self.cfg.coning, &rel[..n.min(4)], &prev_rel);
-                self.q = self.q.mul(&Quat::from_rotvec(&comp_rel.dphi_b_rad)).normalized();
+                self.q = self
+                    .q
+                    .mul(&Quat::from_rotvec(&comp_rel.dphi_b_rad))
+                    .normalized();
                 self.updates += 1;
                 self.c_b_n = self.q.to_dcm();
             }

@@ -120,8 +120,12 @@ pub enum AlgorithmKind {
 
 impl AlgorithmKind {
     /// Every algorithm, in CLI order.
-    pub const ALL: [AlgorithmKind; 4] =
-        [AlgorithmKind::Savage, AlgorithmKind::SongLee, AlgorithmKind::SongLeeComplete, AlgorithmKind::DualQuat];
+    pub const ALL: [AlgorithmKind; 4] = [
+        AlgorithmKind::Savage,
+        AlgorithmKind::SongLee,
+        AlgorithmKind::SongLeeComplete,
+        AlgorithmKind::DualQuat,
+    ];
 
     /// CLI name.
     pub const fn name(self) -> &'static str {
@@ -143,7 +147,14 @@ impl AlgorithmSpec {
     /// Default options for an algorithm with N samples per update: the polynomial
     /// coefficient set of N (S1's `three_poly` for N = 3).
     pub const fn new(kind: AlgorithmKind, samples: usize) -> Self {
-        Self { kind, samples, coning: ConingSet::default_for(samples), attitude: None, rot3: None, rot_vector: None }
+        Self {
+            kind,
+            samples,
+            coning: ConingSet::default_for(samples),
+            attitude: None,
+            rot3: None,
+            rot_vector: None,
+        }
     }
 
     /// Look up by CLI name.
@@ -167,14 +178,33 @@ impl AnyMechanization {
     /// earth model and initial state.
     pub fn new(spec: &AlgorithmSpec, earth: EarthModel, dt_s: f64, init: &InitialState) -> Self {
         match spec.kind {
-            AlgorithmKind::DualQuat => {
-                AnyMechanization::DualQuat(DualQuatNav::new(earth, dt_s, spec.samples, spec.coning, init))
-            }
+            AlgorithmKind::DualQuat => AnyMechanization::DualQuat(DualQuatNav::new(
+                earth,
+                dt_s,
+                spec.samples,
+                spec.coning,
+                init,
+            )),
             kind => {
                 let (velocity, attitude, rot3, rotv) = match kind {
-                    AlgorithmKind::Savage => (VelocityMode::Savage, AttitudeMode::Savage, false, RotVector::Theta),
-                    AlgorithmKind::SongLee => (VelocityMode::SongLee, AttitudeMode::Transport, false, RotVector::Phi),
-                    _ => (VelocityMode::SongLeeComplete, AttitudeMode::Transport, true, RotVector::Phi),
+                    AlgorithmKind::Savage => (
+                        VelocityMode::Savage,
+                        AttitudeMode::Savage,
+                        false,
+                        RotVector::Theta,
+                    ),
+                    AlgorithmKind::SongLee => (
+                        VelocityMode::SongLee,
+                        AttitudeMode::Transport,
+                        false,
+                        RotVector::Phi,
+                    ),
+                    _ => (
+                        VelocityMode::SongLeeComplete,
+                        AttitudeMode::Transport,
+                        true,
+                        RotVector::Phi,
+                    ),
                 };
                 let cfg = LocalLevelConfig {
                     velocity,

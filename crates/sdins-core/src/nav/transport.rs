@@ -60,7 +60,12 @@ mod tests {
         let ldot = v.x / (r.r_m_m + h);
         let lodot = v.y / ((r.r_n_m + h) * lat.cos());
         let tt = |dt: f64| {
-            transport_matrix(lat + ldot * dt, l0.sin(), l0.cos(), lon + lodot * dt - lon0 + e.omega_ie_rps * (t + dt))
+            transport_matrix(
+                lat + ldot * dt,
+                l0.sin(),
+                l0.cos(),
+                lon + lodot * dt - lon0 + e.omega_ie_rps * (t + dt),
+            )
         };
         // fourth-order central difference; with d = 2 s the truncation error (d⁴/30)|ω|⁵ ≈ 2e-19
         // and the roundoff 18ε/(12d) ≈ 8e-17 stay below 1e-12 of |ω_in| ≈ 1.3e-4 rad/s.
@@ -69,6 +74,10 @@ mod tests {
         let lhs = tdot * tt(0.0).transpose();
         let w_in = e.omega_ie_n(lat) + e.omega_en_n(lat, h, &v);
         let rhs = -skew(&w_in);
-        assert!((lhs - rhs).abs().max() < 1e-12 * w_in.norm(), "{}", (lhs - rhs).abs().max());
+        assert!(
+            (lhs - rhs).abs().max() < 1e-12 * w_in.norm(),
+            "{}",
+            (lhs - rhs).abs().max()
+        );
     }
 }
