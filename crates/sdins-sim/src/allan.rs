@@ -23,6 +23,9 @@
 //!   `log N = mean(log σ_i + ½ log τ_i)`, over the first run of consecutive points
 //!   whose local log-log slope lies within ±0.15 of −1/2 spanning at least half a
 //!   decade ([`MIN_RUN`] points);
+//! * quantization noise, slope −1: `σ(τ) = √3·Q/τ`, fixed-slope least squares over
+//!   the first run of points with local slope within ±0.15 of −1 (at least
+//!   [`MIN_RUN`] points);
 //! * rate random walk, slope +1/2: `σ(τ) = K √(τ/3)`, so `K = σ(τ)·√(3/τ)`,
 //!   fixed-slope least squares over the last run of points with local slope within
 //!   ±0.15 of +1/2, at least [`MIN_RUN`] points and beyond the white region (none
@@ -81,6 +84,8 @@ pub struct AllanFit {
     pub bias_instability_tau_s: Option<f64>,
     /// τ range [s] of the flat region averaged for `bias_instability`.
     pub bias_instability_range_s: Option<(f64, f64)>,
+    /// Quantization noise Q (rad or m/s): the −1 line `σ = √3·Q/τ`.
+    pub quantization: Option<f64>,
     /// Rate random walk K = σ(τ)·√(3/τ).
     pub rate_random_walk: Option<f64>,
     /// τ range [s] of the points used for `rate_random_walk`.
@@ -206,6 +211,10 @@ pub fn fit(c: &AllanCurve) -> AllanFit {
         f.white = Some(fixed_slope_level(c, (a, b), -0.5));
         f.white_tau_s = Some((c.tau_s[a], c.tau_s[b]));
     }
+    if let Some(&(a, b)) = runs(&slopes, -1.0, MIN_RUN).first() {
+        // σ = √3 Q / τ → level at τ = 1 of the −1 line is √3 Q
+        f.quantization = Some(fixed_slope_level(c, (a, b), -1.0) / 3f64.sqrt());
+    }
     if let Some(&(a, b)) = runs(&slopes, 0.5, MIN_RUN).last() {
         let w_end = f.white_tau_s.map_or(0.0, |w| w.1);
         if c.tau_s[a] > w_end {
@@ -280,6 +289,33 @@ mod tests {
             a.push(o.dv_b_mps[0] / dt);
         }
         (g, a)
+    }
+
+    #[test]
+    fn quantization_fit_recovers_the_quantum() {
+        // independent uniform angle errors e_j ∈ [−Q/2, Q/2) on the integrated output
+        // (θ̃_j = θ_j + e_j, the carried-remainder quantizer's error): the second
+        // difference has variance 6·Q²/12, so σ²(τ) = Q²/(4τ²), σ = Q/(2τ), and the
+        // −1-slope estimate σ·τ/√3 is Q/√12 (IEEE Std 952's σ = √3·Q/τ defines Q on
+        // another scale); checked within 10 %.
+        let (dt, q) = (0.01, 1e-6);
+        let mut state = 12345u64;
+        let mut e_prev = 0.0;
+        let rate: Vec<f64> = (0..200_000)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let e = ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * q;
+                let r = (e - e_prev) / dt;
+                e_prev = e;
+                r
+            })
+            .collect();
+        let f = fit(&allan_deviation(&rate, dt));
+        let qhat = f.quantization.unwrap();
+        assert!((qhat / (q / 12f64.sqrt()) - 1.0).abs() < 0.10, "{qhat}");
+        assert!(f.white.is_none());
     }
 
     #[test]
@@ -358,5 +394,101 @@ mod tests {
         let fa = fit(&allan_deviation(&a, dt));
         let b = fa.bias_instability.unwrap() / UG;
         assert!((b / 100.0 - 1.0).abs() < 0.10, "accel B {b} {:?}", fa);
+    }
+
+    /// `../shared/data/csv/navego/<name>` from the workspace root, or `None` (skip).
+    fn navego(name: &str) -> Option<std::path::PathBuf> {
+        let p = std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/data/csv/navego"
+        ))
+        .join(name);
+        if p.exists() {
+            Some(p)
+        } else {
+            println!(
+                "skipped: {} not found (shared data folder absent)",
+                p.display()
+            );
+            None
+        }
+    }
+
+    /// First value of `key = [v, v, v]` in a NaveGo params file.
+    fn param(path: &std::path::Path, key: &str) -> f64 {
+        let text = std::fs::read_to_string(path).unwrap();
+        let line = text
+            .lines()
+            .find(|l| l.split('=').next().map(str::trim) == Some(key))
+            .unwrap();
+        let v = line
+            .split('=')
+            .nth(1)
+            .unwrap()
+            .trim()
+            .trim_start_matches('[');
+        v.split(',').next().unwrap().trim().parse().unwrap()
+    }
+
+    #[test]
+    fn navego_imu1_minus_imu2_recovers_combined_arw_vrw() {
+        use crate::imu_file::{read_imu_file, ImuFormat};
+        let (Some(f1), Some(f2), Some(p1), Some(p2)) = (
+            navego("imu1.csv"),
+            navego("imu2.csv"),
+            navego("imu1_params.txt"),
+            navego("imu2_params.txt"),
+        ) else {
+            return;
+        };
+        // NaveGo params: arw in rad/√s, vrw in m/s/√s (white-noise sample σ g_std =
+        // arw/√dt: 5.8177641733144e-4/√0.005 = 8.22756e-3 = g_std of imu1_params.txt).
+        // imu1 (ADIS16405): arw 5.8177641733144e-4 rad/√s = 2 °/√h,
+        //                   vrw 3.33333333333333e-3 m/s/√s = 0.2 m/s/√h;
+        // imu2 (ADIS16488): arw 8.726646259971648e-5 rad/√s = 0.3 °/√h,
+        //                   vrw 4.8333333333333e-4 m/s/√s = 0.029 m/s/√h.
+        // The difference of two independent white noises has density
+        // √(arw1² + arw2²) = √(3.384638e-7 + 7.615435e-9) = 5.882850e-4 rad/√s (2.0224 °/√h),
+        // √(vrw1² + vrw2²) = √(1.111111e-5 + 2.336111e-7) = 3.368193e-3 m/s/√s (0.20209 m/s/√h).
+        // The common trajectory cancels; the Gauss–Markov biases (100 s) and static
+        // biases barely touch the short-τ −1/2 region. Tolerance 15 % (437 s of data).
+        let (arw1, arw2) = (param(&p1, "arw"), param(&p2, "arw"));
+        let (vrw1, vrw2) = (param(&p1, "vrw"), param(&p2, "vrw"));
+        assert!(
+            (arw1 - 5.8177641733144e-4).abs() < 1e-15
+                && (arw2 - 8.726646259971648e-5).abs() < 1e-15
+        );
+        assert!(
+            (vrw1 - 3.33333333333333e-3).abs() < 1e-15 && (vrw2 - 4.8333333333333e-4).abs() < 1e-15
+        );
+        let arw_exp = arw1.hypot(arw2);
+        let vrw_exp = vrw1.hypot(vrw2);
+        assert!((arw_exp - 5.882850e-4).abs() < 1e-9 && (vrw_exp - 3.368193e-3).abs() < 1e-9);
+        let d1 = read_imu_file(&f1, ImuFormat::Auto).unwrap();
+        let d2 = read_imu_file(&f2, ImuFormat::Auto).unwrap();
+        assert_eq!(d1.format, ImuFormat::NaveGo);
+        assert_eq!(d1.increments.len(), d2.increments.len());
+        assert_eq!(d1.t0_s, d2.t0_s);
+        assert!((d1.dt_s - 0.005).abs() < 1e-9);
+        let dt = d1.dt_s;
+        for ch in 0..6 {
+            let diff: Vec<f64> = d1
+                .increments
+                .iter()
+                .zip(&d2.increments)
+                .map(|(a, b)| {
+                    if ch < 3 {
+                        (a.dtheta_b_rad[ch] - b.dtheta_b_rad[ch]) / dt
+                    } else {
+                        (a.dv_b_mps[ch - 3] - b.dv_b_mps[ch - 3]) / dt
+                    }
+                })
+                .collect();
+            let f = fit(&allan_deviation(&diff, dt));
+            let n = f.white.unwrap();
+            let exp = if ch < 3 { arw_exp } else { vrw_exp };
+            println!("navego imu1−imu2 channel {ch}: white {n:.6e} (expected {exp:.6e}, ratio {:.4}), τ {:?}", n / exp, f.white_tau_s);
+            assert!((n / exp - 1.0).abs() < 0.15, "channel {ch}: {n} vs {exp}");
+        }
     }
 }

@@ -171,7 +171,8 @@ pub struct PsinsHeader {
 pub struct ImuData {
     /// the format actually read (never `Auto`)
     pub format: ImuFormat,
-    /// sample period [s] (median interval for files with a time column)
+    /// sample period [s] (mean interval `(t_last − t_0)/(n − 1)` for files with a time
+    /// column, after every interval was checked against the median)
     pub dt_s: f64,
     /// time stamp of the first sample as given by the file [s]
     pub t0_s: f64,
@@ -530,7 +531,8 @@ impl Parser<'_> {
                 });
             }
         }
-        Ok((t[0], median))
+        // the mean interval: more accurate than the median of rounded differences
+        Ok((t[0], (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64))
     }
 
     /// Magnitude checks on one converted sample.

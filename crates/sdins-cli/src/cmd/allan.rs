@@ -12,7 +12,9 @@ use crate::error::CliError;
 use crate::output::write_string;
 use plotters::prelude::*;
 use sdins_sim::allan::{allan_deviation, fit, AllanCurve, AllanFit};
-use sdins_sim::imu_error::{DPH, DPHPSH, DPSH, MPS_PER_SQRT_H, UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ};
+use sdins_sim::imu_error::{
+    ARCSEC, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H, UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ,
+};
 use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -121,55 +123,80 @@ fn range(r: Option<(f64, f64)>) -> String {
     r.map_or_else(|| "—".to_string(), |(a, b)| format!("{a:.3}–{b:.3}"))
 }
 
-/// The fit table in datasheet units.
+fn row(s: &mut String, cells: &[String]) {
+    let _ = write!(s, "{:<8}", cells[0]);
+    for c in &cells[1..] {
+        let _ = write!(s, " {c:>15}");
+    }
+    s.push('\n');
+}
+
+fn tau(t: Option<f64>) -> String {
+    t.map_or_else(|| "—".to_string(), |t| format!("{t:.3}"))
+}
+
+/// The fit table in datasheet units (— where a term was not found).
 pub fn table(r: &AllanReport) -> String {
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "{:<8} {:>12} {:>12} {:>17} {:>12} {:>14} {:>12}",
-        "gyro", "ARW °/√h", "BI °/h", "(τ_min s)", "RRW °/h/√h", "white τ s", "RRW τ s"
+    let h = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    row(
+        &mut s,
+        &h(&[
+            "gyro",
+            "ARW °/√h",
+            "BI °/h",
+            "BI at τ s",
+            "RRW °/h/√h",
+            "Q arcsec",
+            "white fit τ s",
+            "RRW fit τ s",
+        ]),
     );
     for ch in 0..3 {
         let f = &r.fits[ch];
-        let _ = writeln!(
-            s,
-            "{:<8} {:>12} {:>12} {:>17} {:>12} {:>14} {:>12}",
-            CHANNELS[ch],
-            cell(opt(f.white, DPSH)),
-            cell(opt(f.bias_instability, DPH)),
-            f.bias_instability_tau_s
-                .map_or("—".into(), |t| format!("{t:.3}")),
-            cell(opt(f.rate_random_walk, DPHPSH)),
-            range(f.white_tau_s),
-            range(f.rrw_tau_s),
+        row(
+            &mut s,
+            &[
+                CHANNELS[ch].to_string(),
+                cell(opt(f.white, DPSH)),
+                cell(opt(f.bias_instability, DPH)),
+                tau(f.bias_instability_tau_s),
+                cell(opt(f.rate_random_walk, DPHPSH)),
+                cell(opt(f.quantization, ARCSEC)),
+                range(f.white_tau_s),
+                range(f.rrw_tau_s),
+            ],
         );
     }
-    let _ = writeln!(
-        s,
-        "{:<8} {:>12} {:>12} {:>12} {:>17} {:>12} {:>14} {:>12}",
-        "accel",
-        "VRW m/s/√h",
-        "VRW μg/√Hz",
-        "BI μg",
-        "(τ_min s)",
-        "RRW μg/√h",
-        "white τ s",
-        "RRW τ s"
+    row(
+        &mut s,
+        &h(&[
+            "accel",
+            "VRW m/s/√h",
+            "VRW μg/√Hz",
+            "BI μg",
+            "BI at τ s",
+            "RRW μg/√h",
+            "Q m/s",
+            "white fit τ s",
+            "RRW fit τ s",
+        ]),
     );
     for ch in 3..6 {
         let f = &r.fits[ch];
-        let _ = writeln!(
-            s,
-            "{:<8} {:>12} {:>12} {:>12} {:>17} {:>12} {:>14} {:>12}",
-            CHANNELS[ch],
-            cell(opt(f.white, MPS_PER_SQRT_H)),
-            cell(opt(f.white, UG_PER_SQRT_HZ)),
-            cell(opt(f.bias_instability, UG)),
-            f.bias_instability_tau_s
-                .map_or("—".into(), |t| format!("{t:.3}")),
-            cell(opt(f.rate_random_walk, UG_PER_SQRT_H)),
-            range(f.white_tau_s),
-            range(f.rrw_tau_s),
+        row(
+            &mut s,
+            &[
+                CHANNELS[ch].to_string(),
+                cell(opt(f.white, MPS_PER_SQRT_H)),
+                cell(opt(f.white, UG_PER_SQRT_HZ)),
+                cell(opt(f.bias_instability, UG)),
+                tau(f.bias_instability_tau_s),
+                cell(opt(f.rate_random_walk, UG_PER_SQRT_H)),
+                cell(f.quantization),
+                range(f.white_tau_s),
+                range(f.rrw_tau_s),
+            ],
         );
     }
     s
@@ -186,6 +213,7 @@ pub fn json(r: &AllanReport) -> String {
                     "arw_dpsh": opt(f.white, DPSH),
                     "bias_instability_dph": opt(f.bias_instability, DPH),
                     "rrw_dphph": opt(f.rate_random_walk, DPHPSH),
+                    "quantization_arcsec": opt(f.quantization, ARCSEC),
                 })
             } else {
                 serde_json::json!({
@@ -194,6 +222,7 @@ pub fn json(r: &AllanReport) -> String {
                     "vrw_ugpsqrthz": opt(f.white, UG_PER_SQRT_HZ),
                     "bias_instability_ug": opt(f.bias_instability, UG),
                     "rrw_ugph": opt(f.rate_random_walk, UG_PER_SQRT_H),
+                    "quantization_mps": f.quantization,
                 })
             }
         })
@@ -414,5 +443,31 @@ mod tests {
         assert_eq!(e.exit_code(), 2);
         assert!(e.to_string().contains("bad.csv:2"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn lasergyro_runs_and_reports_fits() {
+        // real navigation-grade RLG IMU, parked (shared data; skipped if absent)
+        let p = Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/data/psins/lasergyro.imu"
+        ));
+        if !p.exists() {
+            println!("skipped: {} not found", p.display());
+            return;
+        }
+        let data = read_imu_file(p, ImuFormat::Auto).unwrap();
+        assert_eq!(data.format, ImuFormat::Psins);
+        assert_eq!(data.increments.len(), 184_718);
+        assert!((data.dt_s - 0.01).abs() < 1e-15);
+        let r = analyse(&data.increments, data.dt_s);
+        println!("{}", table(&r));
+        println!("{}", json(&r));
+        // parked: the mean specific force is gravity (header g = 9.780327) along −z FRD
+        let n = data.increments.len() as f64;
+        let fz: f64 = data.increments.iter().map(|i| i.dv_b_mps[2]).sum::<f64>() / (n * data.dt_s);
+        assert!((fz + 9.78).abs() < 0.05, "{fz}");
+        assert_eq!(r.curves.len(), 6);
+        assert!(r.curves.iter().all(|c| c.tau_s.len() > 40));
     }
 }
