@@ -38,7 +38,8 @@
 //!   number of independent clusters), over that region (the fitted white
 //!   and random-walk contributions removed in variance). Not reported when the
 //!   curve is still falling at the last usable point (log-log slope over the last
-//!   half decade below −1/4) or nothing is left after the subtraction.
+//!   half decade below −0.35, nearer −1/2 than 0) or nothing is left after the
+//!   subtraction.
 
 /// Cluster sizes per decade of τ.
 pub const POINTS_PER_DECADE: usize = 10;
@@ -236,14 +237,14 @@ pub fn fit(c: &AllanCurve) -> AllanFit {
         }
     }
     // still falling at the end of the usable range (slope over the last half
-    // decade below −1/4): no floor reached, nothing reported
+    // decade below −0.35, nearer white noise than a floor): nothing reported
     let k = usable.saturating_sub(MIN_RUN);
     let end_slope = if usable >= 2 && k + 1 < usable {
         (c.adev[usable - 1] / c.adev[k]).ln() / (c.tau_s[usable - 1] / c.tau_s[k]).ln()
     } else {
         -1.0
     };
-    if imin + 1 < usable || end_slope > -0.25 {
+    if imin + 1 < usable || end_slope > -0.35 {
         let lim = c.adev[imin] * FLAT_BAND;
         let (mut a, mut b) = (imin, imin);
         while a > 0 && c.adev[a - 1] <= lim {

@@ -573,7 +573,7 @@ impl Parser<'_> {
         &self,
         from: usize,
         names: &[&str],
-    ) -> Result<(Vec<f64>, Vec<[Vec3; 2]>, f64, f64), ImuFileError> {
+    ) -> Result<(Vec<[Vec3; 2]>, f64, f64), ImuFileError> {
         if from >= self.lines.len() {
             return Err(ImuFileError::NoData {
                 file: self.f(),
@@ -587,7 +587,7 @@ impl Parser<'_> {
             .map(|r| [Vec3::new(r[1], r[2], r[3]), Vec3::new(r[4], r[5], r[6])])
             .collect();
         let (t0, dt) = self.times(from, &t)?;
-        Ok((t, v, t0, dt))
+        Ok((v, t0, dt))
     }
 
     fn csv(&self, format: ImuFormat) -> Result<ImuData, ImuFileError> {
@@ -627,7 +627,7 @@ impl Parser<'_> {
                 line: line_no,
             });
         }
-        let (_, v, t0, dt) = self.timed(1, names)?;
+        let (v, t0, dt) = self.timed(1, names)?;
         let cols = if gyro_first {
             ("2-4", "5-7")
         } else {
@@ -655,7 +655,7 @@ impl Parser<'_> {
     }
 
     fn kfgins(&self) -> Result<ImuData, ImuFileError> {
-        let (_, v, t0, dt) = self.timed(0, &KFGINS_NAMES)?;
+        let (v, t0, dt) = self.timed(0, &KFGINS_NAMES)?;
         let mut incs = Vec::with_capacity(v.len());
         for (k, [g, f]) in v.into_iter().enumerate() {
             let inc = Increment::new(g, f);

@@ -152,12 +152,11 @@ pub fn table(r: &AllanReport) -> String {
             "RRW fit τ s",
         ]),
     );
-    for ch in 0..3 {
-        let f = &r.fits[ch];
+    for (name, f) in CHANNELS[..3].iter().zip(&r.fits[..3]) {
         row(
             &mut s,
             &[
-                CHANNELS[ch].to_string(),
+                name.to_string(),
                 cell(opt(f.white, DPSH)),
                 cell(opt(f.bias_instability, DPH)),
                 tau(f.bias_instability_tau_s),
@@ -182,12 +181,11 @@ pub fn table(r: &AllanReport) -> String {
             "RRW fit τ s",
         ]),
     );
-    for ch in 3..6 {
-        let f = &r.fits[ch];
+    for (name, f) in CHANNELS[3..].iter().zip(&r.fits[3..]) {
         row(
             &mut s,
             &[
-                CHANNELS[ch].to_string(),
+                name.to_string(),
                 cell(opt(f.white, MPS_PER_SQRT_H)),
                 cell(opt(f.white, UG_PER_SQRT_HZ)),
                 cell(opt(f.bias_instability, UG)),
