@@ -1,20 +1,471 @@
-//! `sdins allan`: overlapping Allan deviation with noise fits (issue 4; to be filled).
+//! `sdins allan`: overlapping Allan deviation of the six channels of an IMU file with
+//! the IEEE Std 952 noise fits (see `sdins_sim::allan`).
+//!
+//! Outputs (in `--out`, default the current folder): `allan.csv` (τ and the six
+//! deviations: gyro in °/h, accelerometer in μg), `allan.svg` and `allan.png`
+//! (log-log plots; text drawn with the DejaVu Sans font embedded by the `dejavu`
+//! crate). The fits are printed as a table in datasheet units, or as JSON with `--json`.
+//!
+//! Example: `sdins allan --imu lasergyro.imu --out allan_lasergyro`
 
 use crate::error::CliError;
-use std::path::PathBuf;
+use crate::output::write_string;
+use plotters::prelude::*;
+use sdins_sim::allan::{allan_deviation, fit, AllanCurve, AllanFit};
+use sdins_sim::imu_error::{
+    ARCSEC, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H, UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ,
+};
+use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `sdins allan`.
 #[derive(clap::Args, Debug)]
+#[command(
+    after_help = "Example: sdins allan --imu lasergyro.imu --format psins --out allan_lasergyro"
+)]
 pub struct Args {
-    /// IMU file (sdins CSV, PSINS .imu, ...)
+    /// IMU file (sdins CSV, PSINS .imu or trj CSV, KF-GINS text, NaveGo CSV)
     #[arg(long)]
     pub imu: PathBuf,
+    /// file format: auto, sdins, psins, psins-csv, kfgins, navego
+    #[arg(long, default_value = "auto", value_parser = parse_format)]
+    pub format: ImuFormat,
+    /// output folder for allan.csv, allan.svg and allan.png
+    #[arg(long, default_value = ".")]
+    pub out: PathBuf,
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
 }
 
+fn parse_format(s: &str) -> Result<ImuFormat, String> {
+    s.parse()
+}
+
+/// Channel names, in order.
+pub const CHANNELS: [&str; 6] = [
+    "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+];
+
+/// Allan curves and fits of the six channels, SI units (rad/s, m/s²).
+pub struct AllanReport {
+    /// one curve per channel
+    pub curves: Vec<AllanCurve>,
+    /// one fit per channel
+    pub fits: Vec<AllanFit>,
+}
+
+/// Compute the six Allan curves and fits of FRD increments with period `dt_s`.
+pub fn analyse(incs: &[sdins_core::coning::Increment], dt_s: f64) -> AllanReport {
+    let mut curves = Vec::with_capacity(6);
+    for ch in 0..6 {
+        let rate: Vec<f64> = incs
+            .iter()
+            .map(|i| if ch < 3 { i.dtheta_b_rad[ch] } else { i.dv_b_mps[ch - 3] } / dt_s)
+            .collect();
+        curves.push(allan_deviation(&rate, dt_s));
+    }
+    let fits = curves.iter().map(fit).collect();
+    AllanReport { curves, fits }
+}
+
+fn file_error(e: ImuFileError) -> CliError {
+    match e {
+        ImuFileError::Io { file, source } => CliError::Io { path: file, source },
+        other => CliError::BadInput(other.to_string()),
+    }
+}
+
 /// Run the command.
-pub fn run(_args: Args) -> Result<(), CliError> {
-    Err(CliError::Other("allan: not implemented yet".into()))
+pub fn run(args: Args) -> Result<(), CliError> {
+    let data = read_imu_file(&args.imu, args.format).map_err(file_error)?;
+    let n = data.increments.len();
+    if n < 20 {
+        return Err(CliError::bad(format!(
+            "{}: {n} samples, expected at least 20 for an Allan deviation",
+            args.imu.display()
+        )));
+    }
+    let report = analyse(&data.increments, data.dt_s);
+    write_string(&args.out.join("allan.csv"), &csv(&report))?;
+    let svg = plot_svg(&report)?;
+    write_string(&args.out.join("allan.svg"), &svg)?;
+    plot_png(&report, &args.out.join("allan.png"))?;
+    if args.json {
+        println!("{}", json(&report));
+    } else {
+        println!(
+            "{}: format {}, {n} samples, dt {} s, {:.1} s",
+            args.imu.display(),
+            data.format,
+            data.dt_s,
+            n as f64 * data.dt_s
+        );
+        print!("{}", table(&report));
+        println!(
+            "wrote {}/allan.csv, allan.svg, allan.png",
+            args.out.display()
+        );
+    }
+    Ok(())
+}
+
+fn opt(v: Option<f64>, unit: f64) -> Option<f64> {
+    v.map(|x| x / unit)
+}
+
+fn cell(v: Option<f64>) -> String {
+    v.map_or_else(|| "—".to_string(), |x| format!("{x:.4e}"))
+}
+
+fn range(r: Option<(f64, f64)>) -> String {
+    r.map_or_else(|| "—".to_string(), |(a, b)| format!("{a:.3}–{b:.3}"))
+}
+
+fn row(s: &mut String, cells: &[String]) {
+    let _ = write!(s, "{:<8}", cells[0]);
+    for c in &cells[1..] {
+        let _ = write!(s, " {c:>15}");
+    }
+    s.push('\n');
+}
+
+fn tau(t: Option<f64>) -> String {
+    t.map_or_else(|| "—".to_string(), |t| format!("{t:.3}"))
+}
+
+/// The fit table in datasheet units (— where a term was not found).
+pub fn table(r: &AllanReport) -> String {
+    let mut s = String::new();
+    let h = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    row(
+        &mut s,
+        &h(&[
+            "gyro",
+            "ARW °/√h",
+            "BI °/h",
+            "BI at τ s",
+            "RRW °/h/√h",
+            "Q arcsec",
+            "white fit τ s",
+            "RRW fit τ s",
+        ]),
+    );
+    for (name, f) in CHANNELS[..3].iter().zip(&r.fits[..3]) {
+        row(
+            &mut s,
+            &[
+                name.to_string(),
+                cell(opt(f.white, DPSH)),
+                cell(opt(f.bias_instability, DPH)),
+                tau(f.bias_instability_tau_s),
+                cell(opt(f.rate_random_walk, DPHPSH)),
+                cell(opt(f.quantization, ARCSEC)),
+                range(f.white_tau_s),
+                range(f.rrw_tau_s),
+            ],
+        );
+    }
+    row(
+        &mut s,
+        &h(&[
+            "accel",
+            "VRW m/s/√h",
+            "VRW μg/√Hz",
+            "BI μg",
+            "BI at τ s",
+            "RRW μg/√h",
+            "Q m/s",
+            "white fit τ s",
+            "RRW fit τ s",
+        ]),
+    );
+    for (name, f) in CHANNELS[3..].iter().zip(&r.fits[3..]) {
+        row(
+            &mut s,
+            &[
+                name.to_string(),
+                cell(opt(f.white, MPS_PER_SQRT_H)),
+                cell(opt(f.white, UG_PER_SQRT_HZ)),
+                cell(opt(f.bias_instability, UG)),
+                tau(f.bias_instability_tau_s),
+                cell(opt(f.rate_random_walk, UG_PER_SQRT_H)),
+                cell(f.quantization),
+                range(f.white_tau_s),
+                range(f.rrw_tau_s),
+            ],
+        );
+    }
+    s
+}
+
+/// The JSON summary (`null` where a term could not be fitted).
+pub fn json(r: &AllanReport) -> String {
+    let ch: Vec<serde_json::Value> = (0..6)
+        .map(|c| {
+            let f = &r.fits[c];
+            if c < 3 {
+                serde_json::json!({
+                    "name": CHANNELS[c],
+                    "arw_dpsh": opt(f.white, DPSH),
+                    "bias_instability_dph": opt(f.bias_instability, DPH),
+                    "rrw_dphph": opt(f.rate_random_walk, DPHPSH),
+                    "quantization_arcsec": opt(f.quantization, ARCSEC),
+                })
+            } else {
+                serde_json::json!({
+                    "name": CHANNELS[c],
+                    "vrw_mpsph": opt(f.white, MPS_PER_SQRT_H),
+                    "vrw_ugpsqrthz": opt(f.white, UG_PER_SQRT_HZ),
+                    "bias_instability_ug": opt(f.bias_instability, UG),
+                    "rrw_ugph": opt(f.rate_random_walk, UG_PER_SQRT_H),
+                    "quantization_mps": f.quantization,
+                })
+            }
+        })
+        .collect();
+    serde_json::json!({ "channels": ch }).to_string()
+}
+
+/// `allan.csv`: τ and the six deviations (gyro °/h, accelerometer μg).
+pub fn csv(r: &AllanReport) -> String {
+    let mut s =
+        String::from("tau_s,gyro_x_dph,gyro_y_dph,gyro_z_dph,accel_x_ug,accel_y_ug,accel_z_ug\n");
+    let n = r.curves.iter().map(|c| c.tau_s.len()).min().unwrap_or(0);
+    for i in 0..n {
+        let _ = write!(s, "{}", r.curves[0].tau_s[i]);
+        for (ch, c) in r.curves.iter().enumerate() {
+            let unit = if ch < 3 { DPH } else { UG };
+            let _ = write!(s, ",{}", c.adev[i] / unit);
+        }
+        s.push('\n');
+    }
+    s
+}
+
+const SIZE: (u32, u32) = (1400, 560);
+
+fn register_font() -> Result<(), CliError> {
+    plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
+        .map_err(|_| CliError::Other("cannot load the embedded DejaVu Sans font".into()))
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    r: &AllanReport,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let panels = root.split_evenly((1, 2));
+    let colors = [RED, GREEN, BLUE];
+    for (p, area) in panels.iter().enumerate() {
+        let (unit, ylabel, title) = if p == 0 {
+            (DPH, "Allan deviation [°/h]", "Gyroscopes")
+        } else {
+            (UG, "Allan deviation [μg]", "Accelerometers")
+        };
+        let chans = 3 * p..3 * p + 3;
+        let pts = |c: usize| -> Vec<(f64, f64)> {
+            let cv = &r.curves[c];
+            cv.tau_s
+                .iter()
+                .zip(&cv.adev)
+                .filter(|(_, s)| **s > 0.0)
+                .map(|(t, s)| (*t, s / unit))
+                .collect()
+        };
+        let all: Vec<(f64, f64)> = chans.clone().flat_map(&pts).collect();
+        if all.is_empty() {
+            continue;
+        }
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for (x, y) in &all {
+            x0 = x0.min(*x);
+            x1 = x1.max(*x);
+            y0 = y0.min(*y);
+            y1 = y1.max(*y);
+        }
+        let mut chart = ChartBuilder::on(area)
+            .caption(title, ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(80)
+            .build_cartesian_2d(
+                (x0 * 0.8..x1 * 1.25).log_scale(),
+                (y0 * 0.7..y1 * 1.4).log_scale(),
+            )
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("cluster time τ [s]")
+            .y_desc(ylabel)
+            .label_style(("sans-serif", 14))
+            .axis_desc_style(("sans-serif", 16))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        for (k, c) in chans.enumerate() {
+            let color = colors[k];
+            chart
+                .draw_series(LineSeries::new(pts(c), color.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label(CHANNELS[c])
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .label_font(("sans-serif", 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| e.to_string())?;
+    }
+    root.present().map_err(|e| e.to_string())
+}
+
+/// The log-log plot as an SVG string.
+pub fn plot_svg(r: &AllanReport) -> Result<String, CliError> {
+    register_font()?;
+    let mut s = String::new();
+    {
+        let root = SVGBackend::with_string(&mut s, SIZE).into_drawing_area();
+        draw(root, r).map_err(|e| CliError::Other(format!("SVG plot: {e}")))?;
+    }
+    Ok(s)
+}
+
+/// The log-log plot as a PNG file (drawn to a temporary file, then renamed).
+pub fn plot_png(r: &AllanReport, dest: &Path) -> Result<(), CliError> {
+    register_font()?;
+    if let Some(dir) = dest.parent() {
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+        }
+    }
+    let tmp = dest.with_file_name(format!(".allan.tmp-{}.png", std::process::id()));
+    let result = {
+        let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
+        draw(root, r)
+    };
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(CliError::Other(format!("PNG plot {}: {e}", dest.display())));
+    }
+    std::fs::rename(&tmp, dest).map_err(|source| CliError::Io {
+        path: dest.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+    use sdins_sim::imu_error::{ImuErrorModel, ImuErrorState};
+
+    #[test]
+    fn end_to_end_on_a_simulated_file() {
+        // 20 min at 100 Hz of a tactical-grade IMU at rest, written as an sdins CSV
+        let m = ImuErrorModel::preset("tactical").unwrap();
+        let mut s = ImuErrorState::new(&m, 3, 0).unwrap();
+        let dt = 0.01;
+        let mut text =
+            String::from("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n");
+        let still = sdins_core::coning::Increment::new(
+            sdins_core::Vec3::zeros(),
+            sdins_core::Vec3::new(0.0, 0.0, -9.8 * dt),
+        );
+        for k in 0..120_000 {
+            let o = s.apply(&still, dt);
+            let _ = writeln!(
+                text,
+                "{},{},{},{},{},{},{}",
+                (k + 1) as f64 * dt,
+                o.dtheta_b_rad[0],
+                o.dtheta_b_rad[1],
+                o.dtheta_b_rad[2],
+                o.dv_b_mps[0],
+                o.dv_b_mps[1],
+                o.dv_b_mps[2]
+            );
+        }
+        let dir = std::env::temp_dir().join(format!("sdins-allan-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("imu.csv");
+        std::fs::write(&file, text).unwrap();
+        run(Args {
+            imu: file.clone(),
+            format: ImuFormat::Auto,
+            out: dir.clone(),
+            json: true,
+        })
+        .unwrap();
+        for f in ["allan.csv", "allan.svg", "allan.png"] {
+            assert!(std::fs::metadata(dir.join(f)).unwrap().len() > 100, "{f}");
+        }
+        let svg = std::fs::read_to_string(dir.join("allan.svg")).unwrap();
+        assert!(
+            svg.contains("Allan deviation [°/h]") && svg.contains("gyro_x"),
+            "axis label and legend"
+        );
+        let data = read_imu_file(&file, ImuFormat::Auto).unwrap();
+        let r = analyse(&data.increments, data.dt_s);
+        // tactical preset: ARW 0.01 °/√h, VRW 100 μg/√Hz; 20 min of data → 10 %
+        for ch in 0..3 {
+            let arw = r.fits[ch].white.unwrap() / DPSH;
+            assert!((arw / 0.01 - 1.0).abs() < 0.10, "{arw}");
+            let vrw = r.fits[ch + 3].white.unwrap() / UG_PER_SQRT_HZ;
+            assert!((vrw / 100.0 - 1.0).abs() < 0.10, "{vrw}");
+        }
+        let j: serde_json::Value = serde_json::from_str(&json(&r)).unwrap();
+        assert_eq!(j["channels"][0]["name"], "gyro_x");
+        assert!(j["channels"][0]["arw_dpsh"].as_f64().is_some());
+        // a bad file is BadInput (exit code 2) naming file and line
+        std::fs::write(
+            dir.join("bad.csv"),
+            "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n0.01,1,2\n",
+        )
+        .unwrap();
+        let e = run(Args {
+            imu: dir.join("bad.csv"),
+            format: ImuFormat::Auto,
+            out: dir.clone(),
+            json: false,
+        })
+        .unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        assert!(e.to_string().contains("bad.csv:2"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn lasergyro_runs_and_reports_fits() {
+        // real navigation-grade RLG IMU, parked (shared data; skipped if absent)
+        let p = Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/data/psins/lasergyro.imu"
+        ));
+        if !p.exists() {
+            println!("skipped: {} not found", p.display());
+            return;
+        }
+        let data = read_imu_file(p, ImuFormat::Auto).unwrap();
+        assert_eq!(data.format, ImuFormat::Psins);
+        assert_eq!(data.increments.len(), 184_718);
+        assert!((data.dt_s - 0.01).abs() < 1e-15);
+        let r = analyse(&data.increments, data.dt_s);
+        println!("{}", table(&r));
+        println!("{}", json(&r));
+        // parked: the mean specific force is gravity (header g = 9.780327) along −z FRD
+        let n = data.increments.len() as f64;
+        let fz: f64 = data.increments.iter().map(|i| i.dv_b_mps[2]).sum::<f64>() / (n * data.dt_s);
+        assert!((fz + 9.78).abs() < 0.05, "{fz}");
+        assert_eq!(r.curves.len(), 6);
+        assert!(r.curves.iter().all(|c| c.tau_s.len() > 40));
+    }
 }
