@@ -1027,4 +1027,63 @@ mod tests {
             Err(LinearModelError::BadSample(1))
         );
     }
+
+    /// Body-frame bias states with `SpecificForce::Body` equal NED bias states with
+    /// `SpecificForce::Nav` when the biases are resolved with the same constant C_b^n
+    /// (stationary; identical arithmetic up to roundoff).
+    #[test]
+    fn body_and_nav_force_descriptions_agree() {
+        let opts = opts_sph();
+        let c = sdins_core::math::c_b_n_from_euler(&sdins_core::math::Euler {
+            roll_rad: 2.0 * D2R,
+            pitch_rad: -3.0 * D2R,
+            yaw_rad: 40.0 * D2R,
+        });
+        let nav = stationary_samples(L, 0.0, 3.0 * 3600.0, 10.0, &opts.earth);
+        let body: Vec<TrajectorySample> = nav
+            .iter()
+            .map(|s| {
+                let SpecificForce::Nav(f_n) = s.force else {
+                    unreachable!()
+                };
+                TrajectorySample {
+                    force: SpecificForce::Body {
+                        c_b_n: c,
+                        f_b: c.transpose() * f_n,
+                    },
+                    ..*s
+                }
+            })
+            .collect();
+        let (b_a, b_g) = (
+            Vec3::new(50.0, -80.0, 30.0) * MICRO_G,
+            Vec3::new(0.01, -0.02, 0.015) * DEG_PER_HOUR,
+        );
+        let xb = ErrorVector {
+            b_a,
+            b_g,
+            ..Default::default()
+        }
+        .to_state(&nav[0], &opts.earth);
+        let xn = ErrorVector {
+            b_a: c * b_a,
+            b_g: c * b_g,
+            ..Default::default()
+        }
+        .to_state(&nav[0], &opts.earth);
+        // isotropic ARW: C diag(σ²) Cᵀ = σ² I, so the envelopes must agree too
+        let noise = ProcessNoise {
+            arw_rad_per_sqrt_s: Vec3::repeat(2e-6),
+            ..Default::default()
+        };
+        let eb = propagate(&body, &opts, &noise, &xb, &StateMat::zeros()).unwrap();
+        let en = propagate(&nav, &opts, &noise, &xn, &StateMat::zeros()).unwrap();
+        let (a, b) = (eb.last().unwrap(), en.last().unwrap());
+        assert!(b.dp_n_m[0].abs() > 100.0);
+        for i in 0..3 {
+            assert!((a.dp_n_m[i] - b.dp_n_m[i]).abs() < 1e-6 * (1.0 + b.dp_n_m[i].abs()));
+            assert!((a.sigma_p_m[i] - b.sigma_p_m[i]).abs() < 1e-9 * (1.0 + b.sigma_p_m[i]));
+            assert!((a.phi[i] - b.phi[i]).abs() < 1e-12);
+        }
+    }
 }

@@ -550,6 +550,14 @@ mod tests {
         assert!(rel(1.0) < 0.02, "{}", rel(1.0));
         assert!(rel(2.0) < 0.06, "{}", rel(2.0));
         assert!(rel(4.0) > 0.20, "{}", rel(4.0));
+        // ... and the checked entry point refuses them beyond 2 h
+        let inp = super::super::short_term::ShortTermInputs {
+            lat_rad: L,
+            eps_n: Vec3::new(0.0, e, 0.0),
+            ..Default::default()
+        };
+        assert!(super::super::short_term::position_error(&inp, 2.0 * H, &p).is_ok());
+        assert!(super::super::short_term::position_error(&inp, 2.0 * H + 1.0, &p).is_err());
         // spec measured values 1 % and 4.7 %
         assert!((rel(1.0) - 0.010).abs() < 0.002 && (rel(2.0) - 0.047).abs() < 0.003);
         // (2) and (3) against the model at 1 h: (3) matches up to the Foucault factor
@@ -564,5 +572,30 @@ mod tests {
         });
         let s3 = eq3_accel(da, H, &p);
         assert!(((s3 - acc.eval(H).dp_n[0]) / s3).abs() < 0.01);
+    }
+
+    /// spec §6 REF: body biases b_a = [50, −80, 30] μg, b_g = [0.01, −0.02, 0.015] °/h at
+    /// roll 2°, pitch −3°, yaw 40° resolve to δa = [89.2243, −30.8676, 29.7693] μg and
+    /// ε = [0.020261, −0.009774, 0.014797] °/h (printed digits).
+    #[test]
+    fn body_biases_resolve_to_spec_ref_ned_values() {
+        let c = sdins_core::math::c_b_n_from_euler(&sdins_core::math::Euler {
+            roll_rad: 2.0 * D2R,
+            pitch_rad: -3.0 * D2R,
+            yaw_rad: 40.0 * D2R,
+        });
+        let e = StationaryErrors::from_body(
+            &c,
+            &(Vec3::new(0.01, -0.02, 0.015) * DEG_PER_HOUR),
+            &(Vec3::new(50.0, -80.0, 30.0) * MICRO_G),
+        );
+        let da = e.da_n / MICRO_G;
+        let eps = e.eps_n / DEG_PER_HOUR;
+        for (g, w) in da.iter().zip([89.2243, -30.8676, 29.7693]) {
+            assert!((g - w).abs() < 0.00006, "{g} vs {w}");
+        }
+        for (g, w) in eps.iter().zip([0.020261, -0.009774, 0.014797]) {
+            assert!((g - w).abs() < 0.0000006, "{g} vs {w}");
+        }
     }
 }
