@@ -2,7 +2,7 @@
 //!
 //! This is a small, self-contained copy of the spec §4.5 table so that the error analysis
 //! does not depend on the IMU-error presets of issue 4. Sources, per column:
-//! * `p2_*`: the grade boxes of [P2] Table 1 (spec §4.4/§4.5);
+//! * `p2_*`: the grade boxes of \[P2\] Table 1 (spec §4.4/§4.5);
 //! * `typical_*`: Groves Tables 4.1/4.2 "as commonly quoted" (spec §4.5; quoted there from
 //!   memory of the 2nd edition; the lower end of each quoted range is used);
 //! * noise: **bold** spec values (aviation, tactical, consumer) are the presets of Groves'
@@ -17,13 +17,13 @@ use serde::Serialize;
 pub struct Grade {
     /// grade name (lower case, as accepted by the CLI)
     pub name: &'static str,
-    /// [P2] accelerometer-bias box [μg] (min, max); `None` if [P2] gives none
+    /// \[P2\] accelerometer-bias box \[μg\] (min, max); `None` if \[P2\] gives none
     pub p2_accel_bias_ug: Option<(f64, f64)>,
-    /// [P2] gyro-bias box [°/h] (min, max)
+    /// \[P2\] gyro-bias box [°/h] (min, max)
     pub p2_gyro_bias_dph: Option<(f64, f64)>,
-    /// [P2]'s reported Schuler share [%] (min, max)
+    /// \[P2\]'s reported Schuler share [%] (min, max)
     pub p2_share_pct: Option<(f64, f64)>,
-    /// typical accelerometer bias [μg] (Groves, lower end of the quoted range)
+    /// typical accelerometer bias \[μg\] (Groves, lower end of the quoted range)
     pub typical_accel_bias_ug: f64,
     /// typical gyro bias [°/h]
     pub typical_gyro_bias_dph: f64,

@@ -83,7 +83,7 @@ pub enum LinearModelError {
     NonIncreasingTime {
         /// sample index
         index: usize,
-        /// its time [s]
+        /// its time \[s\]
         t_s: f64,
     },
     /// A sample has a non-finite value or |lat| ≥ 89.9°.
@@ -101,7 +101,7 @@ pub enum ModelEarth {
 }
 
 impl ModelEarth {
-    /// (meridian radius R_M, prime-vertical radius R_N) [m].
+    /// (meridian radius R_M, prime-vertical radius R_N) \[m\].
     fn radii(&self, lat: f64) -> (f64, f64) {
         match self {
             ModelEarth::Spherical(p) => (p.r0_m, p.r0_m),
@@ -154,11 +154,11 @@ pub enum SpecificForce {
 /// One sample of the reference trajectory.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrajectorySample {
-    /// time [s]
+    /// time \[s\]
     pub t_s: f64,
-    /// latitude [rad]
+    /// latitude \[rad\]
     pub lat_rad: f64,
-    /// height [m]
+    /// height \[m\]
     pub h_m: f64,
     /// NED velocity [m/s]
     pub v_n: Vec3,
@@ -197,7 +197,7 @@ impl TrajectorySample {
             && c.iter().all(|x| x.is_finite())
     }
 
-    /// Position scale `T = diag(R_M + h, (R_N + h) cos L, −1)`: `δp_NED[m] = T (δL, δλ, δh)`.
+    /// Position scale `T = diag(R_M + h, (R_N + h) cos L, −1)`: `δp_NED = T (δL, δλ, δh)` (metres).
     pub fn position_scale(&self, earth: &ModelEarth) -> Vec3 {
         let (rm, rn) = earth.radii(self.lat_rad);
         Vec3::new(rm + self.h_m, (rn + self.h_m) * self.lat_rad.cos(), -1.0)
@@ -242,11 +242,11 @@ pub struct ProcessNoise {
 /// Initial errors or 1σ uncertainties, in user units (metres NED for position).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ErrorVector {
-    /// position error [m] NED
+    /// position error \[m\] NED
     pub dp_n_m: Vec3,
     /// velocity error [m/s] NED
     pub dv_n: Vec3,
-    /// attitude error φ (convention G) [rad]
+    /// attitude error φ (convention G) \[rad\]
     pub phi: Vec3,
     /// accelerometer bias (body; NED if the trajectory gives f^n) [m/s²]
     pub b_a: Vec3,
@@ -400,19 +400,19 @@ fn zero_vertical(x: &mut StateVec, p: &mut StateMat, opts: &ModelOptions) {
 /// Propagated mean (deterministic error) and 1σ envelope at one sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct EnvelopePoint {
-    /// time [s]
+    /// time \[s\]
     pub t_s: f64,
-    /// deterministic position error [m] NED (propagated initial state `x0`)
+    /// deterministic position error \[m\] NED (propagated initial state `x0`)
     pub dp_n_m: [f64; 3],
     /// deterministic velocity error [m/s] NED
     pub dv_n: [f64; 3],
-    /// deterministic attitude error φ [rad]
+    /// deterministic attitude error φ \[rad\]
     pub phi: [f64; 3],
-    /// 1σ position [m] NED
+    /// 1σ position \[m\] NED
     pub sigma_p_m: [f64; 3],
     /// 1σ velocity [m/s] NED
     pub sigma_v: [f64; 3],
-    /// 1σ attitude [rad]
+    /// 1σ attitude \[rad\]
     pub sigma_phi: [f64; 3],
 }
 
@@ -548,9 +548,9 @@ mod tests {
     struct Case {
         name: &'static str,
         e: StationaryErrors,
-        /// amplitude of the slow 24 h terms (bound) [m]
+        /// amplitude of the slow 24 h terms (bound) \[m\]
         a_slow: f64,
-        /// amplitude of the Schuler oscillation (bound) [m]
+        /// amplitude of the Schuler oscillation (bound) \[m\]
         a_osc: f64,
     }
 

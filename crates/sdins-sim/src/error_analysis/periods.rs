@@ -1,9 +1,9 @@
 //! Schuler, Foucault and Earth-rate periods (spec §4.1, constants of §0.4).
 //!
 //! * Schuler: `ω_s = √(g/R0)`, `T_s = 2π √(R0/g)` = 84.41 min for R0 = 6371 km,
-//!   g = 9.80665 m/s². (The paper [P2] calls `√(g/R0)` "about 84.4 min"; that is the
+//!   g = 9.80665 m/s². (The paper \[P2\] calls `√(g/R0)` "about 84.4 min"; that is the
 //!   period `2π/ω_s`, not `√(g/R0)`, which is a frequency.)
-//! * Foucault: `ω_F = Ω sin L`, `T_F = 2π/(Ω sin L)` (39.32 h at 37.5°; [P2]'s "about
+//! * Foucault: `ω_F = Ω sin L`, `T_F = 2π/(Ω sin L)` (39.32 h at 37.5°; \[P2\]'s "about
 //!   30 h" holds only near 53°).
 //! * Earth rate ("24 h"): `2π/Ω` = 86 164 s = 23.93 h.
 
@@ -12,7 +12,7 @@ use core::f64::consts::TAU;
 /// Spherical-Earth constants of the Schuler analysis (spec §0.4).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct SchulerParams {
-    /// Earth radius R0 [m]
+    /// Earth radius R0 \[m\]
     pub r0_m: f64,
     /// gravity magnitude g [m/s²]
     pub g_mps2: f64,
@@ -54,7 +54,7 @@ impl SchulerParams {
         schuler_frequency(self.g_mps2, self.r0_m)
     }
 
-    /// Schuler period `T_s = 2π/ω_s` [s].
+    /// Schuler period `T_s = 2π/ω_s` \[s\].
     pub fn schuler_period_s(&self) -> f64 {
         TAU / self.omega_s()
     }
@@ -70,7 +70,7 @@ pub fn schuler_frequency(g_mps2: f64, r0_m: f64) -> f64 {
     (g_mps2 / r0_m).sqrt()
 }
 
-/// Schuler period `T_s = 2π √(R0/g)` [s] (spec §4.1).
+/// Schuler period `T_s = 2π √(R0/g)` \[s\] (spec §4.1).
 pub fn schuler_period_s(g_mps2: f64, r0_m: f64) -> f64 {
     TAU / schuler_frequency(g_mps2, r0_m)
 }
@@ -80,12 +80,12 @@ pub fn foucault_frequency(omega_ie_rps: f64, lat_rad: f64) -> f64 {
     omega_ie_rps * lat_rad.sin()
 }
 
-/// Foucault period `T_F = 2π/|Ω sin L|` [s] (spec §4.1); infinite on the equator.
+/// Foucault period `T_F = 2π/|Ω sin L|` \[s\] (spec §4.1); infinite on the equator.
 pub fn foucault_period_s(omega_ie_rps: f64, lat_rad: f64) -> f64 {
     TAU / foucault_frequency(omega_ie_rps, lat_rad).abs()
 }
 
-/// Earth-rate ("24 h") period `2π/Ω` [s] (spec §4.1).
+/// Earth-rate ("24 h") period `2π/Ω` \[s\] (spec §4.1).
 pub fn earth_rate_period_s(omega_ie_rps: f64) -> f64 {
     TAU / omega_ie_rps
 }

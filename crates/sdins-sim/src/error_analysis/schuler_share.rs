@@ -1,6 +1,6 @@
-//! "Schuler share" of the position error — the reconstruction of [P2] Table 1 (spec §4.4).
+//! "Schuler share" of the position error — the reconstruction of \[P2\] Table 1 (spec §4.4).
 //!
-//! [P2] does not define its ratio; the spec's best reconstruction (rms 0.40 percentage
+//! \[P2\] does not define its ratio; the spec's best reconstruction (rms 0.40 percentage
 //! points over the paper's six numbers, one fitted parameter t*) is, with
 //! `δB_gE = δB_gD = δω` and `δB_aN = δa`:
 //!
@@ -27,11 +27,11 @@ use serde::Serialize;
 
 /// The fitted evaluation time of the reconstruction, t* = 6573 s (spec §4.4).
 pub const T_STAR_S: f64 = 6573.0;
-/// Latitude of the reconstruction, 37.5° [rad].
+/// Latitude of the reconstruction, 37.5° \[rad\].
 pub const SHARE_LAT_RAD: f64 = 37.5 * core::f64::consts::PI / 180.0;
 
 /// Schuler share [%] of the spec §4.4 reconstruction for accelerometer bias `da`
-/// [m/s²] and gyro bias `dw` [rad/s] at time `t` [s]. Uses the single-channel formulas
+/// [m/s²] and gyro bias `dw` [rad/s] at time `t` \[s\]. Uses the single-channel formulas
 /// beyond their 2 h validity on purpose (that is the definition). Returns 0 where the
 /// denominator vanishes (t = 0 or zero biases).
 pub fn schuler_share(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerParams) -> f64 {
@@ -90,7 +90,7 @@ pub fn schuler_share_full(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerPar
 pub struct ShareRow {
     /// grade name
     pub grade: String,
-    /// accelerometer bias [μg]
+    /// accelerometer bias \[μg\]
     pub accel_bias_ug: f64,
     /// gyro bias [°/h]
     pub gyro_bias_dph: f64,
@@ -98,7 +98,7 @@ pub struct ShareRow {
     pub share_pct: f64,
 }
 
-/// The reconstruction of [P2] Table 1: every grade with a [P2] bias box (spec §4.5) ×
+/// The reconstruction of \[P2\] Table 1: every grade with a \[P2\] bias box (spec §4.5) ×
 /// the four corners of its box, evaluated with [`schuler_share`] at `t` (use
 /// [`T_STAR_S`]), latitude `lat_rad` (use [`SHARE_LAT_RAD`]) and `p` (use
 /// [`SchulerParams::P2`]).

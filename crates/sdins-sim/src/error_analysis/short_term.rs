@@ -1,4 +1,4 @@
-//! Single-channel (short-term) position-error formulas: the corrected [P2] (1)–(3) and
+//! Single-channel (short-term) position-error formulas: the corrected \[P2\] (1)–(3) and
 //! their companion terms (spec §4.2).
 //!
 //! The formulas ignore the Earth-rate (24 h) loop and the Foucault rotation; the spec
@@ -10,7 +10,7 @@
 //! because the spec §4.4 Schuler-share reconstruction deliberately evaluates them at
 //! any t; their doc comments say so.
 //!
-//! Units: R0 [m], t [s], ε [rad/s], δa [m/s²], results in metres. NED, convention G,
+//! Units: R0 \[m\], t \[s\], ε [rad/s], δa [m/s²], results in metres. NED, convention G,
 //! bias = measured − true.
 
 use super::periods::SchulerParams;
@@ -30,9 +30,9 @@ pub enum ShortTermError {
          (spec §4.2); use the stationary closed form (§4.3)"
     )]
     BeyondValidity {
-        /// requested time [s]
+        /// requested time \[s\]
         t_s: f64,
-        /// validity limit [s]
+        /// validity limit \[s\]
         limit_s: f64,
     },
     /// The time is negative or not finite.
@@ -40,14 +40,14 @@ pub enum ShortTermError {
     InvalidTime(f64),
 }
 
-/// [P2] (1), corrected sign: north error from an east gyro bias ε_E,
+/// \[P2\] (1), corrected sign: north error from an east gyro bias ε_E,
 /// `δp_N = −R0 ε_E (t − sin(ω_s t)/ω_s)`. No validity check.
 pub fn eq1_east_gyro(eps_e: f64, t: f64, p: &SchulerParams) -> f64 {
     let ws = p.omega_s();
     -p.r0_m * eps_e * (t - (ws * t).sin() / ws)
 }
 
-/// [P2] (2): north error from a down gyro bias ε_D,
+/// \[P2\] (2): north error from a down gyro bias ε_D,
 /// `δp_N = −R0 λ̇ cos L (t²/2 − (1 − cos ω_s t)/ω_s²) ε_D`, `λ̇ = Ω + v_E/(R0 cos L)`
 /// (stationary: `λ̇ cos L = Ω cos L`). No validity check.
 pub fn eq2_down_gyro(eps_d: f64, lat_rad: f64, v_e_mps: f64, t: f64, p: &SchulerParams) -> f64 {
@@ -56,7 +56,7 @@ pub fn eq2_down_gyro(eps_d: f64, lat_rad: f64, v_e_mps: f64, t: f64, p: &Schuler
     -p.r0_m * lam_dot_cos * (0.5 * t * t - (1.0 - (ws * t).cos()) / (ws * ws)) * eps_d
 }
 
-/// [P2] (3): north error from a north accelerometer bias,
+/// \[P2\] (3): north error from a north accelerometer bias,
 /// `δp_N = (1 − cos ω_s t)/ω_s² · δa_N = R0 (δa_N/g)(1 − cos ω_s t)`. The same formula gives
 /// the east error from δa_E (spec §4.2 companion term). No validity check.
 pub fn eq3_accel(da: f64, t: f64, p: &SchulerParams) -> f64 {
@@ -88,7 +88,7 @@ pub fn from_initial_velocity(dv0_n: &Vec3, t: f64, p: &SchulerParams) -> (f64, f
 /// Inputs of the single-channel formulas (NED, SI units, convention G).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ShortTermInputs {
-    /// latitude L [rad]
+    /// latitude L \[rad\]
     pub lat_rad: f64,
     /// east velocity for (2) [m/s] (0 when stationary)
     pub v_e_mps: f64,
@@ -96,13 +96,13 @@ pub struct ShortTermInputs {
     pub eps_n: Vec3,
     /// NED accelerometer bias δa [m/s²]
     pub da_n: Vec3,
-    /// initial attitude error φ0 [rad]
+    /// initial attitude error φ0 \[rad\]
     pub phi0: Vec3,
     /// initial velocity error δv0 [m/s] (vertical ignored)
     pub dv0_n: Vec3,
 }
 
-/// The individual terms of the single-channel formulas at one time [m].
+/// The individual terms of the single-channel formulas at one time \[m\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct ShortTermTerms {
     /// (1): δp_N from ε_E
@@ -126,7 +126,7 @@ pub struct ShortTermTerms {
 }
 
 impl ShortTermTerms {
-    /// Total north error [m].
+    /// Total north error \[m\].
     pub fn north(&self) -> f64 {
         self.north_east_gyro
             + self.north_down_gyro
@@ -134,7 +134,7 @@ impl ShortTermTerms {
             + self.north_tilt
             + self.north_velocity
     }
-    /// Total east error [m].
+    /// Total east error \[m\].
     pub fn east(&self) -> f64 {
         self.east_north_gyro + self.east_accel + self.east_tilt + self.east_velocity
     }

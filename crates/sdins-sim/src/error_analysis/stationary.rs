@@ -73,11 +73,11 @@ pub struct StationaryErrors {
     pub eps_n: Vec3,
     /// NED accelerometer bias δa [m/s²] (the down component has no effect: vertical held)
     pub da_n: Vec3,
-    /// initial attitude error φ0 (convention G) [rad]
+    /// initial attitude error φ0 (convention G) \[rad\]
     pub phi0: Vec3,
     /// initial velocity error [m/s] (north, east used; down ignored, vertical held)
     pub dv0_n: Vec3,
-    /// initial position error [m] (north, east used; down ignored)
+    /// initial position error \[m\] (north, east used; down ignored)
     pub dp0_n: Vec3,
 }
 
@@ -92,7 +92,7 @@ impl StationaryErrors {
     }
 }
 
-/// Decomposition of the horizontal position error [m] (components N, E, D = 0):
+/// Decomposition of the horizontal position error \[m\] (components N, E, D = 0):
 /// `total = constant + secular + earth_rate + schuler + foucault`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct PositionDecomposition {
@@ -111,15 +111,15 @@ pub struct PositionDecomposition {
 /// Closed-form errors at one time.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct StationarySolution {
-    /// time [s]
+    /// time \[s\]
     pub t_s: f64,
-    /// position error [m] NED (down = 0, vertical held)
+    /// position error \[m\] NED (down = 0, vertical held)
     pub dp_n: [f64; 3],
     /// velocity error [m/s] NED (down = 0)
     pub dv_n: [f64; 3],
-    /// attitude error φ (convention G) [rad]
+    /// attitude error φ (convention G) \[rad\]
     pub phi: [f64; 3],
-    /// psi angle ψ [rad]
+    /// psi angle ψ \[rad\]
     pub psi: [f64; 3],
     /// decomposition of `dp_n`
     pub parts: PositionDecomposition,
@@ -228,13 +228,13 @@ impl StationaryClosedForm {
         }
     }
 
-    /// Psi angle `ψ(t)` (step 2) [rad].
+    /// Psi angle `ψ(t)` (step 2) \[rad\].
     pub fn psi(&self, t: f64) -> Vec3 {
         let (s, c) = (self.params.omega_ie_rps * t).sin_cos();
         self.c0 + self.c1 * t + self.cs * s + self.ck * (1.0 - c)
     }
 
-    /// Evaluate position, velocity and attitude errors at time `t` [s].
+    /// Evaluate position, velocity and attitude errors at time `t` \[s\].
     pub fn eval(&self, t: f64) -> StationarySolution {
         let p = &self.params;
         let om = p.omega_ie_rps;
@@ -293,7 +293,7 @@ impl StationaryClosedForm {
     }
 }
 
-/// Convenience: the closed form of `errors` at latitude `lat_rad`, evaluated at `t` [s].
+/// Convenience: the closed form of `errors` at latitude `lat_rad`, evaluated at `t` \[s\].
 pub fn closed_form_full(
     t: f64,
     lat_rad: f64,
@@ -534,7 +534,7 @@ mod tests {
         }
     }
 
-    /// T9 last bullet: the [P2] formulas (1)–(3) for the east-gyro case are within 2 % of
+    /// T9 last bullet: the \[P2\] formulas (1)–(3) for the east-gyro case are within 2 % of
     /// the full model at 1 h and 6 % at 2 h (spec: 1.0 % and 4.7 %), and wrong by > 20 %
     /// at 4 h (spec 21 %) — which is why [`super::super::short_term::position_error`] refuses t > 2 h.
     #[test]
