@@ -33,6 +33,8 @@ enum Command {
     Run(cmd::run::Args),
     /// Allan deviation of an IMU file with noise-parameter fits.
     Allan(cmd::allan::Args),
+    /// Analytic INS error propagation: closed form, linear model, Schuler share.
+    Errors(cmd::errors::Args),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +46,7 @@ fn main() -> ExitCode {
         Command::Truth(a) => cmd::truth::run(a),
         Command::Run(a) => cmd::run::run(a),
         Command::Allan(a) => cmd::allan::run(a),
+        Command::Errors(a) => cmd::errors::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,6 +2,7 @@
 
 pub mod allan;
 pub mod demo;
+pub mod errors;
 pub mod run;
 pub mod scenarios;
 pub mod truth;

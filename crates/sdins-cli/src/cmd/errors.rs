@@ -1,0 +1,356 @@
+//! `sdins errors`: analytic INS error propagation (issue 6, analytic part).
+//!
+//! Prints the full stationary closed form (spec `alignment_and_errors.md` §4.3) for a
+//! set of NED sensor biases, next to the 15-state linear model's deterministic error and
+//! 1σ covariance envelope, at a few epochs; or, with `--schuler-share`, the
+//! reconstruction of \[P2\] Table 1 (spec §4.4).
+//!
+//! Examples:
+//! ```text
+//! sdins errors --grade aviation --hours 24
+//! sdins errors --gyro-bias-dph 0,0.01,0 --accel-bias-ug 30,0,0 --lat 37.5 --json
+//! sdins errors --schuler-share --json
+//! ```
+
+use crate::error::CliError;
+use sdins_core::Vec3;
+use sdins_sim::error_analysis::grades::{grade_by_name, Grade, GRADES};
+use sdins_sim::error_analysis::linear_model::{
+    propagate, stationary_samples, EnvelopePoint, ErrorVector, ModelEarth, ModelOptions,
+    ProcessNoise, VerticalChannel,
+};
+use sdins_sim::error_analysis::periods::SchulerParams;
+use sdins_sim::error_analysis::schuler_share::{schuler_share_table_p2, ShareRow, T_STAR_S};
+use sdins_sim::error_analysis::stationary::{
+    StationaryClosedForm, StationaryErrors, StationarySolution,
+};
+use sdins_sim::error_analysis::{DEG_PER_HOUR, MICRO_G};
+
+/// Arguments of `sdins errors`.
+#[derive(clap::Args, Debug)]
+#[command(
+    after_help = "Examples:\n  sdins errors --grade aviation --hours 24\n  \
+    sdins errors --gyro-bias-dph 0,0.01,0 --accel-bias-ug 30,0,0 --json\n  \
+    sdins errors --schuler-share --json"
+)]
+pub struct Args {
+    /// sensor grade (marine, aviation, intermediate, tactical, consumer): its typical bias
+    /// on every NED axis, and its ARW/VRW for the covariance envelope
+    #[arg(long, conflicts_with_all = ["gyro_bias_dph", "accel_bias_ug"])]
+    pub grade: Option<String>,
+    /// NED gyro bias [°/h] as N,E,D
+    #[arg(long, value_delimiter = ',', num_args = 1, allow_hyphen_values = true)]
+    pub gyro_bias_dph: Option<Vec<f64>>,
+    /// NED accelerometer bias [μg] as N,E,D
+    #[arg(long, value_delimiter = ',', num_args = 1, allow_hyphen_values = true)]
+    pub accel_bias_ug: Option<Vec<f64>>,
+    /// duration [h] (0 < H ≤ 240)
+    #[arg(long, default_value_t = 24.0)]
+    pub hours: f64,
+    /// latitude [deg] (|lat| ≤ 89)
+    #[arg(long, default_value_t = 37.5, allow_hyphen_values = true)]
+    pub lat: f64,
+    /// print the Schuler-share table (reconstruction of [P2] Table 1) instead
+    #[arg(long)]
+    pub schuler_share: bool,
+    /// JSON output on stdout
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Linear-model step [s] (see `linear_model` docs: Taylor-3 is accurate to < 1e-4 rad of
+/// Schuler phase over 24 h at this step).
+const DT_S: f64 = 10.0;
+
+/// One output epoch.
+#[derive(serde::Serialize)]
+struct Epoch {
+    t_h: f64,
+    closed_form: StationarySolution,
+    linear: EnvelopePoint,
+    /// TODO(issue 6, nonlinear part): the nonlinear free-inertial simulation column goes
+    /// here (filled by [`nonlinear_column`]); `null` until then.
+    nonlinear: Option<NonlinearPoint>,
+}
+
+/// Placeholder for the nonlinear-simulation result at one epoch.
+#[derive(serde::Serialize, Clone, Copy)]
+struct NonlinearPoint {
+    dp_n_m: [f64; 3],
+    phi: [f64; 3],
+}
+
+/// TODO(issue 6, nonlinear part): run the nonlinear stationary INS (vertical channel held,
+/// same biases, spec §6 T9) and return its errors at `t_h`. Returns `None` until someone
+/// implements it; the table prints "—" and the JSON `null`.
+fn nonlinear_column(
+    _lat_rad: f64,
+    _errors: &StationaryErrors,
+    _t_h: f64,
+) -> Option<NonlinearPoint> {
+    None
+}
+
+#[derive(serde::Serialize)]
+struct Report<'a> {
+    lat_deg: f64,
+    hours: f64,
+    grade: Option<&'a str>,
+    gyro_bias_dph_ned: [f64; 3],
+    accel_bias_ug_ned: [f64; 3],
+    params: SchulerParams,
+    epochs: Vec<Epoch>,
+}
+
+fn vec3(name: &str, v: &Option<Vec<f64>>) -> Result<Vec3, CliError> {
+    match v {
+        None => Ok(Vec3::zeros()),
+        Some(x) if x.len() == 3 && x.iter().all(|a| a.is_finite()) => {
+            Ok(Vec3::new(x[0], x[1], x[2]))
+        }
+        Some(x) => Err(CliError::bad(format!(
+            "--{name}: expected three finite numbers N,E,D, got {x:?}"
+        ))),
+    }
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    if args.schuler_share {
+        return print_share(args.json);
+    }
+    if !(args.hours.is_finite() && args.hours > 0.0 && args.hours <= 240.0) {
+        return Err(CliError::bad(format!(
+            "--hours: must be in (0, 240], got {}",
+            args.hours
+        )));
+    }
+    if !(args.lat.is_finite() && args.lat.abs() <= 89.0) {
+        return Err(CliError::bad(format!(
+            "--lat: must be within ±89°, got {}",
+            args.lat
+        )));
+    }
+    let grade: Option<&Grade> = match &args.grade {
+        Some(name) => Some(grade_by_name(name).ok_or_else(|| {
+            let names: Vec<&str> = GRADES.iter().map(|g| g.name).collect();
+            CliError::bad(format!(
+                "--grade: unknown grade {name:?} (known: {})",
+                names.join(", ")
+            ))
+        })?),
+        None => None,
+    };
+    let (gyro_dph, accel_ug) = match grade {
+        Some(g) => (
+            Vec3::repeat(g.typical_gyro_bias_dph),
+            Vec3::repeat(g.typical_accel_bias_ug),
+        ),
+        None => (
+            vec3("gyro-bias-dph", &args.gyro_bias_dph)?,
+            vec3("accel-bias-ug", &args.accel_bias_ug)?,
+        ),
+    };
+    if grade.is_none() && args.gyro_bias_dph.is_none() && args.accel_bias_ug.is_none() {
+        return Err(CliError::bad(
+            "give --grade, --gyro-bias-dph/--accel-bias-ug, or --schuler-share",
+        ));
+    }
+    let lat = args.lat.to_radians();
+    let earth = sdins_core::earth::EarthModel::WGS84;
+    let params = SchulerParams::with_local_gravity(&earth, lat, 0.0);
+    let errors = StationaryErrors {
+        eps_n: gyro_dph * DEG_PER_HOUR,
+        da_n: accel_ug * MICRO_G,
+        ..Default::default()
+    };
+    let closed = StationaryClosedForm::new(lat, &errors, params);
+
+    // linear model on the same spherical earth: deterministic error from the biases, and a
+    // 1σ envelope with the biases as 1σ bias uncertainty plus the grade's ARW/VRW
+    let opts = ModelOptions {
+        earth: ModelEarth::Spherical(params),
+        vertical: VerticalChannel::Held,
+        bias_states: true,
+    };
+    let duration = args.hours * 3600.0;
+    let samples = stationary_samples(lat, 0.0, duration, DT_S, &opts.earth);
+    let ev = ErrorVector {
+        b_a: errors.da_n,
+        b_g: errors.eps_n,
+        ..Default::default()
+    };
+    let s0 = samples
+        .first()
+        .copied()
+        .ok_or_else(|| CliError::Other("no samples".into()))?;
+    let x0 = ev.to_state(&s0, &opts.earth);
+    let p0 = ev.to_diag_covariance(&s0, &opts.earth);
+    let noise = grade
+        .map(|g| ProcessNoise {
+            arw_rad_per_sqrt_s: Vec3::repeat(g.arw_si()),
+            vrw_mps_per_sqrt_s: Vec3::repeat(g.vrw_si()),
+            ..Default::default()
+        })
+        .unwrap_or_default();
+    let env =
+        propagate(&samples, &opts, &noise, &x0, &p0).map_err(|e| CliError::Other(e.to_string()))?;
+
+    let mut hours: Vec<f64> = [0.5, 1.0, 2.0, 4.0, 6.0, 12.0, 24.0, 48.0, 96.0, 168.0]
+        .into_iter()
+        .filter(|h| *h < args.hours - 1e-9)
+        .collect();
+    hours.push(args.hours);
+    let epochs: Vec<Epoch> = hours
+        .iter()
+        .map(|&h| {
+            let t = h * 3600.0;
+            let k = ((t / DT_S).round() as usize).min(env.len().saturating_sub(1));
+            let linear = env.get(k).copied().unwrap_or_default();
+            Epoch {
+                t_h: h,
+                closed_form: closed.eval(t),
+                linear,
+                nonlinear: nonlinear_column(lat, &errors, h),
+            }
+        })
+        .collect();
+
+    let report = Report {
+        lat_deg: args.lat,
+        hours: args.hours,
+        grade: grade.map(|g| g.name),
+        gyro_bias_dph_ned: gyro_dph.into(),
+        accel_bias_ug_ned: accel_ug.into(),
+        params,
+        epochs,
+    };
+    if args.json {
+        let s =
+            serde_json::to_string_pretty(&report).map_err(|e| CliError::Other(e.to_string()))?;
+        println!("{s}");
+    } else {
+        print_table(&report);
+    }
+    Ok(())
+}
+
+fn print_table(r: &Report<'_>) {
+    println!(
+        "Stationary free-inertial errors, L = {:.3}°, vertical channel held, R0 = {:.0} m, g = {:.6} m/s²",
+        r.lat_deg, r.params.r0_m, r.params.g_mps2
+    );
+    println!(
+        "NED gyro bias [°/h] = {:?}, accel bias [μg] = {:?}{}",
+        r.gyro_bias_dph_ned,
+        r.accel_bias_ug_ned,
+        r.grade
+            .map(|g| format!(" (grade {g}, typical biases, ARW/VRW in σ)"))
+            .unwrap_or_default()
+    );
+    println!(
+        "closed = spec §4.3 closed form; linear = 15-state model (same biases); 1σ = covariance with the biases as 1σ"
+    );
+    println!(
+        "{:>6} | {:>10} {:>10} | {:>10} {:>10} | {:>9} {:>9} | {:>9} {:>9} | {:>9}",
+        "t [h]",
+        "dpN clsd",
+        "dpE clsd",
+        "dpN lin",
+        "dpE lin",
+        "1σ N",
+        "1σ E",
+        "φD [mrad]",
+        "1σ φD",
+        "nonlinear"
+    );
+    for e in &r.epochs {
+        let nl = e
+            .nonlinear
+            .map(|n| format!("{:.0},{:.0}", n.dp_n_m[0], n.dp_n_m[1]))
+            .unwrap_or_else(|| "—".to_string());
+        println!(
+            "{:>6.2} | {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>9.1} {:>9.1} | {:>9.4} {:>9.4} | {:>9}",
+            e.t_h,
+            e.closed_form.dp_n[0],
+            e.closed_form.dp_n[1],
+            e.linear.dp_n_m[0],
+            e.linear.dp_n_m[1],
+            e.linear.sigma_p_m[0],
+            e.linear.sigma_p_m[1],
+            e.closed_form.phi[2] * 1e3,
+            e.linear.sigma_phi[2] * 1e3,
+            nl
+        );
+    }
+}
+
+fn print_share(json: bool) -> Result<(), CliError> {
+    let rows: Vec<ShareRow> = schuler_share_table_p2();
+    if json {
+        let s = serde_json::to_string_pretty(&rows).map_err(|e| CliError::Other(e.to_string()))?;
+        println!("{s}");
+        return Ok(());
+    }
+    println!(
+        "Schuler share (spec §4.4 reconstruction of [P2] Table 1): t* = {T_STAR_S} s, L = 37.5°, R0 = 6371 km, g = 9.80665"
+    );
+    println!(
+        "{:>13} {:>10} {:>10} {:>10} {:>14}",
+        "grade", "accel [μg]", "gyro [°/h]", "share [%]", "paper [%]"
+    );
+    for r in &rows {
+        let paper = grade_by_name(&r.grade)
+            .and_then(|g| g.p2_share_pct)
+            .map(|(a, b)| format!("{a:.1}–{b:.1}"))
+            .unwrap_or_default();
+        println!(
+            "{:>13} {:>10.1} {:>10.4} {:>10.2} {:>14}",
+            r.grade, r.accel_bias_ug, r.gyro_bias_dph, r.share_pct, paper
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args() -> Args {
+        Args {
+            grade: None,
+            gyro_bias_dph: Some(vec![0.0, 0.01, 0.0]),
+            accel_bias_ug: None,
+            hours: 2.0,
+            lat: 37.5,
+            schuler_share: false,
+            json: true,
+        }
+    }
+
+    #[test]
+    fn bad_inputs_exit_2() {
+        let mut a = args();
+        a.hours = -1.0;
+        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        let mut a = args();
+        a.lat = 91.0;
+        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        let mut a = args();
+        a.gyro_bias_dph = Some(vec![1.0]);
+        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        let mut a = args();
+        a.gyro_bias_dph = None;
+        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        let mut a = args();
+        a.gyro_bias_dph = None;
+        a.grade = Some("nope".into());
+        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        assert_eq!(CliError::bad("x").exit_code(), 2);
+    }
+
+    #[test]
+    fn nonlinear_hook_is_empty_until_implemented() {
+        assert!(nonlinear_column(0.6, &StationaryErrors::default(), 1.0).is_none());
+    }
+}
