@@ -4,6 +4,7 @@
 //! fed the same block; each algorithm's time is measured around its own update loop only
 //! (the `wall_s` of `sdins run --json`).
 
+use crate::imu_error::{ImuErrorModel, ImuErrorState};
 use crate::scenario::Scenario;
 use crate::truth::{lon_diff, TruthConfig, TruthGenerator, TruthSample};
 use sdins_core::coning::Increment;
@@ -111,6 +112,8 @@ pub struct RunOptions {
     pub every: u64,
     /// stop after this time [s] (None: whole scenario)
     pub until_s: Option<f64>,
+    /// apply the scenario's IMU error model as run number `run` (None: ideal sensors)
+    pub sensor_run: Option<u64>,
 }
 
 /// Run the scenario's truth through every algorithm; `observe(i, state, truth, err)` is
@@ -143,6 +146,12 @@ pub fn run(
         .iter()
         .map(|a| AnyMechanization::new(a, earth, cfg.dt_s, &init))
         .collect();
+    let mut sensor = match opts.sensor_run {
+        Some(run) if scn.imu.model != ImuErrorModel::ideal() => {
+            ImuErrorState::new(&scn.imu.model, scn.imu.seed, run).ok()
+        }
+        _ => None,
+    };
     let mut total_updates = truth.len_samples() / n as u64;
     if let Some(t) = opts.until_s {
         total_updates = total_updates.min((t / (cfg.dt_s * n as f64)).round() as u64);
@@ -163,7 +172,10 @@ pub fn run(
             let mut end = None;
             for _ in 0..n {
                 if let Some(s) = truth.next() {
-                    incs.push(s.inc);
+                    incs.push(match sensor.as_mut() {
+                        Some(st) => st.apply(&s.inc, cfg.dt_s),
+                        None => s.inc,
+                    });
                     end = Some(s);
                 }
             }

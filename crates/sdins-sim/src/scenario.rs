@@ -246,6 +246,8 @@ pub struct ImuConfig {
     pub grade: Option<String>,
     /// error-model overrides (interpreted by the IMU error model)
     pub errors: Option<toml::Table>,
+    /// the resolved error model: the grade preset (default `ideal`) with the overrides
+    pub model: crate::imu_error::ImuErrorModel,
 }
 
 impl ImuConfig {
@@ -523,11 +525,34 @@ impl Scenario {
                 format!("{rate_hz} Hz is beyond 100 kHz"),
             );
         }
+        let grade = im.grade.as_ref().map(|g| g.get_ref().clone());
+        let base = match &im.grade {
+            None => crate::imu_error::ImuErrorModel::ideal(),
+            Some(g) => match crate::imu_error::ImuErrorModel::preset(g.get_ref()) {
+                Ok(m) => m,
+                Err(e) => return cx.err(g.span(), "imu.grade", e.to_string()),
+            },
+        };
+        let model = match &im.errors {
+            None => base,
+            Some(t) => {
+                let r = if t.contains_key("preset") {
+                    crate::imu_error::ImuErrorModel::from_table(t)
+                } else {
+                    base.with_overrides(t)
+                };
+                match r {
+                    Ok(m) => m,
+                    Err(e) => return cx.err(doc.imu.span(), "imu.errors", e.to_string()),
+                }
+            }
+        };
         let imu = ImuConfig {
             rate_hz,
             seed: im.seed.unwrap_or(1),
-            grade: im.grade.as_ref().map(|g| g.get_ref().clone()),
+            grade,
             errors: im.errors.clone(),
+            model,
         };
 
         let nav = parse_nav(&cx, doc.nav.as_ref())?;

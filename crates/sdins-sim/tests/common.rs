@@ -39,6 +39,7 @@ pub fn run_at(
         algos,
         vertical_hold: hold,
         every: 1,
+        sensor_run: None,
         until_s: Some(until),
     };
     let want: Vec<u64> = epochs.iter().map(|t| (t / dt_u).round() as u64).collect();

@@ -29,6 +29,8 @@ fn run_args(scenario: &str, algo: &str, out: PathBuf, quiet: bool) -> RunArgs {
         vertical: None,
         out: Some(out),
         every_s: 1.0,
+        ideal: false,
+        run: 0,
         json: false,
         quiet,
     }

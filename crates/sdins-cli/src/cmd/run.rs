@@ -45,6 +45,12 @@ pub struct Args {
     /// output epoch spacing in seconds for the CSV files (default 1 s)
     #[arg(long, default_value_t = 1.0)]
     pub every_s: f64,
+    /// ignore the scenario's IMU error model (ideal sensors)
+    #[arg(long)]
+    pub ideal: bool,
+    /// run index of the sensor-error random stream (seed from the scenario)
+    #[arg(long, default_value_t = 0)]
+    pub run: u64,
     /// print the JSON summary on stdout
     #[arg(long)]
     pub json: bool,
@@ -188,6 +194,7 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
         vertical_hold: hold,
         every,
         until_s: None,
+        sensor_run: if args.ideal { None } else { Some(args.run) },
     };
     let summaries = run_pipeline(
         &scn,
