@@ -29,6 +29,8 @@ enum Command {
     Scenarios(cmd::scenarios::Args),
     /// Write the exact truth trajectory and IMU increments of a scenario.
     Truth(cmd::truth::Args),
+    /// Run one navigation algorithm over a recorded IMU file.
+    Nav(cmd::nav::Args),
     /// Truth → IMU → navigation → errors for one or more algorithms side by side.
     Run(cmd::run::Args),
     /// Allan deviation of an IMU file with noise-parameter fits.
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
         Command::Scenarios(a) => cmd::scenarios::run(a),
         Command::Truth(a) => cmd::truth::run(a),
         Command::Run(a) => cmd::run::run(a),
+        Command::Nav(a) => cmd::nav::run(a),
         Command::Allan(a) => cmd::allan::run(a),
         Command::Errors(a) => cmd::errors::run(a),
     };

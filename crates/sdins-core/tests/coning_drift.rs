@@ -18,7 +18,11 @@ fn q_cone(alpha: f64, omega: f64, t: f64) -> Quat {
 /// Δθ over [t1, t2] in the cancellation-free product form of the spec's closed form.
 fn dtheta(alpha: f64, omega: f64, t1: f64, h: f64) -> Vec3 {
     let (m, d) = (omega * (t1 + 0.5 * h), 0.5 * omega * h);
-    Vec3::new(-2.0 * alpha.sin() * m.sin() * d.sin(), 2.0 * alpha.sin() * m.cos() * d.sin(), -omega * (1.0 - alpha.cos()) * h)
+    Vec3::new(
+        -2.0 * alpha.sin() * m.sin() * d.sin(),
+        2.0 * alpha.sin() * m.cos() * d.sin(),
+        -omega * (1.0 - alpha.cos()) * h,
+    )
 }
 
 fn drift_z(set: ConingSet, lambda: f64, alpha: f64) -> f64 {
@@ -27,7 +31,10 @@ fn drift_z(set: ConingSet, lambda: f64, alpha: f64) -> f64 {
     let dt = DT_UPDATE / n as f64;
     let updates = 200.max((20.0 * 2.0 * std::f64::consts::PI / lambda).ceil() as usize);
     let t0 = 0.123456789;
-    let mut prev = Increment::new(dtheta(alpha, omega, t0 - DT_UPDATE, DT_UPDATE), Vec3::zeros());
+    let mut prev = Increment::new(
+        dtheta(alpha, omega, t0 - DT_UPDATE, DT_UPDATE),
+        Vec3::zeros(),
+    );
     let mut sum = Vec3::zeros();
     for k in 0..updates {
         let ta = t0 + k as f64 * DT_UPDATE;
@@ -85,18 +92,34 @@ fn drift_matches_spec_table_and_prediction() {
     for (set, m04, m08) in MEAS {
         let d08 = drift_z(set, 0.8, ALPHA);
         let rel08 = (d08 - m08).abs() / m08.abs();
-        eprintln!("{:>10}: λ=0.8 {d08:+.4e} (spec {m08:+.4e}, {:+.2}%)", set.name(), 100.0 * (d08 / m08 - 1.0));
+        eprintln!(
+            "{:>10}: λ=0.8 {d08:+.4e} (spec {m08:+.4e}, {:+.2}%)",
+            set.name(),
+            100.0 * (d08 / m08 - 1.0)
+        );
         assert!(rel08 <= 0.03, "{} λ=0.8: {d08:e} vs {m08:e}", set.name());
         if set == ConingSet::FourOpt {
             continue; // at roundoff below λ = 0.8 (spec §3.4)
         }
         let d04 = drift_z(set, 0.4, ALPHA);
-        eprintln!("{:>10}: λ=0.4 {d04:+.4e} (spec {m04:+.4e}, {:+.2}%)", set.name(), 100.0 * (d04 / m04 - 1.0));
-        assert!((d04 - m04).abs() <= 0.03 * m04.abs(), "{} λ=0.4: {d04:e} vs {m04:e}", set.name());
+        eprintln!(
+            "{:>10}: λ=0.4 {d04:+.4e} (spec {m04:+.4e}, {:+.2}%)",
+            set.name(),
+            100.0 * (d04 / m04 - 1.0)
+        );
+        assert!(
+            (d04 - m04).abs() <= 0.03 * m04.abs(),
+            "{} λ=0.4: {d04:e} vs {m04:e}",
+            set.name()
+        );
         for lambda in [0.2, 0.3, 0.4] {
             let d = drift_z(set, lambda, ALPHA);
             let p = predicted(set, lambda, ALPHA);
-            assert!((d - p).abs() <= 0.10 * p.abs(), "{} λ={lambda}: {d:e} vs predicted {p:e}", set.name());
+            assert!(
+                (d - p).abs() <= 0.10 * p.abs(),
+                "{} λ={lambda}: {d:e} vs predicted {p:e}",
+                set.name()
+            );
         }
     }
 }
@@ -111,13 +134,24 @@ fn drift_order_fitted_on_small_lambda() {
         }
         let (_, p) = coefficient(set);
         let xs = [0.2_f64, 0.3, 0.4];
-        let ys: Vec<f64> = xs.iter().map(|&l| drift_z(set, l, ALPHA).abs().ln()).collect();
+        let ys: Vec<f64> = xs
+            .iter()
+            .map(|&l| drift_z(set, l, ALPHA).abs().ln())
+            .collect();
         let lx: Vec<f64> = xs.iter().map(|x| x.ln()).collect();
         let mx = lx.iter().sum::<f64>() / 3.0;
         let my = ys.iter().sum::<f64>() / 3.0;
-        let slope = lx.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum::<f64>()
+        let slope = lx
+            .iter()
+            .zip(&ys)
+            .map(|(x, y)| (x - mx) * (y - my))
+            .sum::<f64>()
             / lx.iter().map(|x| (x - mx).powi(2)).sum::<f64>();
         eprintln!("{:>10}: fitted order {slope:.3} (theory {p})", set.name());
-        assert!((slope - p as f64).abs() <= 0.1, "{}: order {slope} vs {p}", set.name());
+        assert!(
+            (slope - p as f64).abs() <= 0.1,
+            "{}: order {slope} vs {p}",
+            set.name()
+        );
     }
 }

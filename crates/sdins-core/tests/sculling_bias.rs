@@ -16,10 +16,10 @@ const A0: f64 = 1.0;
 const GL8: [(f64, f64); 8] = [
     (-0.960_289_856_497_536_2, 0.101_228_536_290_376_26),
     (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
-    (-0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
+    (-0.525_532_409_916_329, 0.313_706_645_877_887_3),
     (-0.183_434_642_495_649_8, 0.362_683_783_378_362),
     (0.183_434_642_495_649_8, 0.362_683_783_378_362),
-    (0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
+    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
     (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
     (0.960_289_856_497_536_2, 0.101_228_536_290_376_26),
 ];
@@ -38,7 +38,8 @@ fn dv_true(omega: f64, t1: f64, t2: f64) -> Vec3 {
         let (a, b) = (t1 + p as f64 * h, t1 + (p + 1) as f64 * h);
         for (x, w) in GL8 {
             let t = 0.5 * (a + b) + 0.5 * (b - a) * x;
-            acc += 0.5 * (b - a) * w * (c_b_r(omega, t) * Vec3::new(0.0, A0 * (omega * t).sin(), 0.0));
+            acc +=
+                0.5 * (b - a) * w * (c_b_r(omega, t) * Vec3::new(0.0, A0 * (omega * t).sin(), 0.0));
         }
     }
     acc
@@ -68,7 +69,8 @@ fn bias_z(set: ConingSet, lambda: f64) -> f64 {
             *inc = increments(omega, ta + j as f64 * dt, dt);
         }
         let c = compensate(set, &s[..n], &Increment::default());
-        let dv_alg = c_b_r(omega, ta) * (c.dv_b_mps + 0.5 * c.dtheta_b_rad.cross(&c.dv_b_mps) + c.dv_scul_b_mps);
+        let dv_alg = c_b_r(omega, ta)
+            * (c.dv_b_mps + 0.5 * c.dtheta_b_rad.cross(&c.dv_b_mps) + c.dv_scul_b_mps);
         sum += (dv_alg - dv_true(omega, ta, tb)).z / DT_UPDATE;
     }
     sum / updates as f64
@@ -87,13 +89,21 @@ fn sculling_bias_matches_spec_table() {
     for (set, m04, m08, _) in MEAS {
         let b08 = bias_z(set, 0.8);
         eprintln!("{:>10}: λ=0.8 {b08:+.4e} (spec {m08:+.4e})", set.name());
-        assert!((b08 - m08).abs() <= 0.05 * m08.abs(), "{} λ=0.8: {b08:e} vs {m08:e}", set.name());
+        assert!(
+            (b08 - m08).abs() <= 0.05 * m08.abs(),
+            "{} λ=0.8: {b08:e} vs {m08:e}",
+            set.name()
+        );
         if m04.is_nan() {
             continue;
         }
         let b04 = bias_z(set, 0.4);
         eprintln!("{:>10}: λ=0.4 {b04:+.4e} (spec {m04:+.4e})", set.name());
-        assert!((b04 - m04).abs() <= 0.05 * m04.abs(), "{} λ=0.4: {b04:e} vs {m04:e}", set.name());
+        assert!(
+            (b04 - m04).abs() <= 0.05 * m04.abs(),
+            "{} λ=0.4: {b04:e} vs {m04:e}",
+            set.name()
+        );
     }
 }
 
@@ -105,7 +115,11 @@ fn sculling_bias_order() {
         let b4 = bias_z(set, 0.4).abs();
         let slope = (b4 / b3).ln() / (0.4_f64 / 0.3).ln();
         eprintln!("{:>10}: order {slope:.3} (theory {order})", set.name());
-        assert!((slope - order as f64).abs() <= 0.15, "{}: {slope}", set.name());
+        assert!(
+            (slope - order as f64).abs() <= 0.15,
+            "{}: {slope}",
+            set.name()
+        );
     }
 }
 

@@ -12,3 +12,4 @@ pub mod pipeline;
 pub mod scenario;
 pub mod trajectory;
 pub mod truth;
+pub mod truth_file;

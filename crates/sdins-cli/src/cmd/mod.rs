@@ -3,6 +3,7 @@
 pub mod allan;
 pub mod demo;
 pub mod errors;
+pub mod nav;
 pub mod run;
 pub mod scenarios;
 pub mod truth;

@@ -1,0 +1,275 @@
+//! `sdins nav`: run one navigation algorithm over a recorded IMU file.
+
+use super::run::{algorithms, Args as RunArgs};
+use crate::error::CliError;
+use crate::output::AtomicFile;
+use sdins_core::earth::EarthModel;
+use sdins_core::math::{c_b_n_from_euler, Euler, Vec3};
+use sdins_core::nav::InitialState;
+use sdins_sim::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::pipeline::{nav_error, navigate_recorded, NavError};
+use sdins_sim::scenario::Scenario;
+use sdins_sim::truth_file::{c_b_n_from_psins, read_truth};
+use std::io::Write;
+use std::path::PathBuf;
+
+const D2R: f64 = std::f64::consts::PI / 180.0;
+
+/// Arguments of `sdins nav`.
+#[derive(clap::Args, Debug)]
+#[command(
+    after_help = "Examples:\n  sdins nav --imu imu.csv --init 37.5,127,0,0,340.29,0,0,0,90 --algo songlee\n  sdins nav --imu trj10ms_imu.csv --format psins-csv --earth psins --truth trj10ms_avp.csv --algo songlee-complete --samples 1"
+)]
+pub struct Args {
+    /// IMU file: sdins CSV, PSINS .imu, PSINS trj CSV (psins-csv), KF-GINS text, NaveGo CSV
+    #[arg(long)]
+    pub imu: PathBuf,
+    /// file format: auto, sdins, psins, psins-csv, kfgins, navego
+    #[arg(long, default_value = "auto")]
+    pub format: String,
+    /// initial state lat_deg,lon_deg,h_m,v_n,v_e,v_d,roll_deg,pitch_deg,yaw_deg (NED, FRD);
+    /// default: the first row of --truth, or the PSINS .imu header
+    #[arg(long, allow_hyphen_values = true)]
+    pub init: Option<String>,
+    /// algorithm: savage, songlee, songlee-complete, dualquat
+    #[arg(long, default_value = "songlee-complete")]
+    pub algo: String,
+    /// IMU samples per navigation update (1..=4)
+    #[arg(long, default_value_t = 1)]
+    pub samples: usize,
+    /// coning/sculling set (default: the polynomial set of N)
+    #[arg(long)]
+    pub coning: Option<String>,
+    /// earth model: wgs84, psins, flat
+    #[arg(long, default_value = "wgs84")]
+    pub earth: String,
+    /// reference trajectory (sdins truth.csv or PSINS avp CSV); errors are written too
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
+    /// output folder (default ./sdins-out/nav)
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// print a JSON summary
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_init(s: &str) -> Result<InitialState, CliError> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<f64>()
+                .map_err(|_| CliError::bad(format!("--init: `{x}` is not a number")))
+        })
+        .collect::<Result<_, _>>()?;
+    if v.len() != 9 {
+        return Err(CliError::bad(format!(
+            "--init: expected 9 values lat,lon,h,vn,ve,vd,roll,pitch,yaw, got {}",
+            v.len()
+        )));
+    }
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(CliError::bad("--init: values must be finite"));
+    }
+    if v[0].abs() > 89.99 {
+        return Err(CliError::bad(format!(
+            "--init: latitude {} is outside [-89.99, 89.99] deg",
+            v[0]
+        )));
+    }
+    if !(-1000.0..=100_000.0).contains(&v[2]) {
+        return Err(CliError::bad(format!(
+            "--init: height {} m is outside [-1000, 100000]",
+            v[2]
+        )));
+    }
+    Ok(InitialState {
+        lat_rad: v[0] * D2R,
+        lon_rad: v[1] * D2R,
+        h_m: v[2],
+        v_n_mps: Vec3::new(v[3], v[4], v[5]),
+        c_b_n: c_b_n_from_euler(&Euler::new(v[6] * D2R, v[7] * D2R, v[8] * D2R)),
+    })
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let format: ImuFormat = args.format.parse().map_err(CliError::BadInput)?;
+    let earth = match args.earth.as_str() {
+        "wgs84" => EarthModel::WGS84,
+        "psins" => EarthModel::PSINS,
+        "flat" => EarthModel::flat(9.806_65),
+        o => {
+            return Err(CliError::bad(format!(
+                "--earth {o}: expected wgs84, psins or flat"
+            )))
+        }
+    };
+    let data = read_imu_file(&args.imu, format).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let truth = match &args.truth {
+        Some(p) => Some(read_truth(p).map_err(|e| CliError::BadInput(e.to_string()))?),
+        None => None,
+    };
+    let init = match (&args.init, &truth, &data.psins) {
+        (Some(s), _, _) => parse_init(s)?,
+        (None, Some(tr), _) if !tr.is_empty() => {
+            // the truth's first row is one sample after the start: use it only if it is at t0
+            let r = &tr[0];
+            InitialState {
+                lat_rad: r.lat_rad,
+                lon_rad: r.lon_rad,
+                h_m: r.h_m,
+                v_n_mps: r.v_n_mps,
+                c_b_n: r.c_b_n,
+            }
+        }
+        (None, _, Some(h)) => InitialState {
+            lat_rad: h.lat_deg * D2R,
+            lon_rad: h.lon_deg * D2R,
+            h_m: h.h_m,
+            v_n_mps: Vec3::new(h.vel0_enu_mps[1], h.vel0_enu_mps[0], -h.vel0_enu_mps[2]),
+            c_b_n: c_b_n_from_psins(
+                h.att0_deg[0] * D2R,
+                h.att0_deg[1] * D2R,
+                h.att0_deg[2] * D2R,
+            ),
+        },
+        _ => {
+            return Err(CliError::bad(
+                "--init is required (no truth file or PSINS header to take it from)",
+            ))
+        }
+    };
+    // reuse `run`'s algorithm parsing
+    let run_args = RunArgs {
+        scenario: String::new(),
+        algo: Some(args.algo.clone()),
+        samples: Some(args.samples),
+        coning: args.coning.clone(),
+        attitude: None,
+        rot3: false,
+        rotvec: None,
+        vertical: None,
+        out: None,
+        every_s: 1.0,
+        ideal: true,
+        run: 0,
+        json: false,
+        quiet: true,
+    };
+    let dummy = Scenario::load("stationary")?;
+    let specs = algorithms(&run_args, &dummy)?;
+    let Some(spec) = specs.first().copied() else {
+        return Err(CliError::bad("--algo: no algorithm given"));
+    };
+    if specs.len() > 1 {
+        return Err(CliError::bad("--algo: `nav` runs one algorithm"));
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("sdins-out/nav"));
+    let mut nav_file = AtomicFile::create(&out.join(format!("nav_{}.csv", spec.kind.name())))?;
+    let io = |source| CliError::Io {
+        path: out.clone(),
+        source,
+    };
+    writeln!(
+        nav_file.writer(),
+        "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg"
+    )
+    .map_err(io)?;
+    let mut errs: Vec<NavError> = Vec::new();
+    let mut ti = 0usize;
+    let mut write_err = None;
+    let t0 = data.t0_s - data.dt_s; // state epoch before the first sample
+    let wall = navigate_recorded(&spec, earth, data.dt_s, &init, &data.increments, |st| {
+        let t = t0 + st.t_s;
+        let e = st.euler();
+        if let Err(err) = writeln!(
+            nav_file.writer(),
+            "{},{},{},{},{},{},{},{},{},{}",
+            t,
+            st.lat_rad / D2R,
+            st.lon_rad / D2R,
+            st.h_m,
+            st.v_n_mps.x,
+            st.v_n_mps.y,
+            st.v_n_mps.z,
+            e.roll_rad / D2R,
+            e.pitch_rad / D2R,
+            e.yaw_rad / D2R
+        ) {
+            write_err.get_or_insert(err);
+        }
+        if let Some(tr) = &truth {
+            while ti < tr.len() && tr[ti].t_s < t - 0.1 * data.dt_s {
+                ti += 1;
+            }
+            if let Some(r) = tr.get(ti) {
+                if (r.t_s - t).abs() <= 0.1 * data.dt_s {
+                    let mut e = nav_error(&earth, st, r);
+                    e.t_s = t;
+                    errs.push(e);
+                }
+            }
+        }
+    });
+    if let Some(e) = write_err {
+        return Err(io(e));
+    }
+    nav_file.commit()?;
+    if truth.is_some() {
+        let mut ef = AtomicFile::create(&out.join(format!("err_{}.csv", spec.kind.name())))?;
+        writeln!(ef.writer(), "t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,vel_err_n_mps,vel_err_e_mps,vel_err_d_mps,att_err_n_rad,att_err_e_rad,att_err_d_rad").map_err(io)?;
+        for e in &errs {
+            let (p, v, a) = (e.pos_err_ned_m, e.vel_err_ned_mps, e.att_err_rad);
+            writeln!(
+                ef.writer(),
+                "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+                e.t_s,
+                p[0],
+                p[1],
+                p[2],
+                v[0],
+                v[1],
+                v[2],
+                a[0],
+                a[1],
+                a[2]
+            )
+            .map_err(io)?;
+        }
+        ef.commit()?;
+    }
+    let last = errs.last();
+    if args.json {
+        let v = serde_json::json!({
+            "algo": spec.kind.name(), "samples": spec.samples, "imu_samples": data.increments.len(),
+            "dt_s": data.dt_s, "wall_s": wall, "final": last,
+        });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?
+        );
+    } else {
+        println!(
+            "{}: {} samples at {} s, {} updates in {:.3} s",
+            spec.kind.name(),
+            data.increments.len(),
+            data.dt_s,
+            data.increments.len() / spec.samples.max(1),
+            wall
+        );
+        if let Some(e) = last {
+            println!(
+                "final errors at t = {} s: pos N,E,D {:.4e} {:.4e} {:.4e} m; vel {:.3e} {:.3e} {:.3e} m/s; att {:.3e} {:.3e} {:.3e} rad",
+                e.t_s, e.pos_err_ned_m[0], e.pos_err_ned_m[1], e.pos_err_ned_m[2], e.vel_err_ned_mps[0], e.vel_err_ned_mps[1],
+                e.vel_err_ned_mps[2], e.att_err_rad[0], e.att_err_rad[1], e.att_err_rad[2]
+            );
+        }
+        println!("files in {}", out.display());
+    }
+    Ok(())
+}
