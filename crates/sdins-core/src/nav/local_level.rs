@@ -56,6 +56,12 @@ pub struct LocalLevelConfig {
     pub samples: usize,
     /// rotation vector of the rotation compensation
     pub rot_vector: RotVector,
+    /// evaluate ω_ie, ω_en and g of the velocity update at the interval midpoint,
+    /// extrapolated linearly from the last two updates (`1.5 x_{k−1} − 0.5 x_{k−2}`).
+    /// Holding them at t_{k−1} (S1, Savage baseline) leaves a per-step error
+    /// `½ΔT² Ȧ v`, i.e. first order globally; near the poles Ȧ is large (tanL grows with
+    /// the northward motion) and this dominates. Used by `songlee-complete`.
+    pub midpoint_rates: bool,
     /// third-order rotation compensation `+ (1/6) Δφ×(Δφ×Δv)` (spec §4.1)
     pub rot3: bool,
     /// earth model (must equal the truth's)
@@ -83,6 +89,8 @@ pub struct LocalLevel {
     c_b_n: Mat3,
     updates: u64,
     prev: Increment,
+    /// ω_ie, ω_en, g at t_{k−2} (for midpoint extrapolation)
+    rates_prev: Option<(Vec3, Vec3, Vec3)>,
 }
 
 impl LocalLevel {
@@ -104,6 +112,7 @@ impl LocalLevel {
             c_b_n: q.to_dcm(),
             updates: 0,
             prev: Increment::default(),
+            rates_prev: None,
         }
     }
 
@@ -136,9 +145,18 @@ impl Mechanization for LocalLevel {
 
         // 1.–2. increments and rates at t_{k−1}
         let comp = compensate(self.cfg.coning, samples, &self.prev);
-        let w_ie = e.omega_ie_n(lat);
-        let w_en = e.omega_en_n(lat, h, &v);
-        let g_n = e.gravity_n(lat, h);
+        let w_ie_k1 = e.omega_ie_n(lat);
+        let w_en_k1 = e.omega_en_n(lat, h, &v);
+        let g_k1 = e.gravity_n(lat, h);
+        let (w_ie, w_en, g_n) = match (self.cfg.midpoint_rates, self.rates_prev) {
+            (true, Some((a, b, c))) => (
+                1.5 * w_ie_k1 - 0.5 * a,
+                1.5 * w_en_k1 - 0.5 * b,
+                1.5 * g_k1 - 0.5 * c,
+            ),
+            _ => (w_ie_k1, w_en_k1, g_k1),
+        };
+        self.rates_prev = Some((w_ie_k1, w_en_k1, g_k1));
         let w_in = w_ie + w_en;
         let w_cor = 2.0 * w_ie + w_en;
 

@@ -213,6 +213,7 @@ impl AnyMechanization {
                     samples: spec.samples,
                     rot3: spec.rot3.unwrap_or(rot3),
                     rot_vector: spec.rot_vector.unwrap_or(rotv),
+                    midpoint_rates: kind == AlgorithmKind::SongLeeComplete,
                     earth,
                     dt_s,
                 };
