@@ -172,16 +172,47 @@ fn nav_over_a_recorded_file_matches_run() {
     // errors of `sdins run` on the same scenario (same increments, same algorithm).
     let d = tmp("nav");
     let p = d.join("s.toml");
-    std::fs::write(&p, GOOD.replace("type = \"static\"\nduration_s = 1.0", "type = \"static\"\nduration_s = 3.0")).unwrap();
-    let (code, _, err) = sdins(&["truth", p.to_str().unwrap(), "--out", d.to_str().unwrap(), "--quiet"]);
+    std::fs::write(
+        &p,
+        GOOD.replace(
+            "type = \"static\"\nduration_s = 1.0",
+            "type = \"static\"\nduration_s = 3.0",
+        ),
+    )
+    .unwrap();
+    let (code, _, err) = sdins(&[
+        "truth",
+        p.to_str().unwrap(),
+        "--out",
+        d.to_str().unwrap(),
+        "--quiet",
+    ]);
     assert_eq!(code, 0, "{err}");
     let (code, out, err) = sdins(&[
-        "nav", "--imu", d.join("imu.csv").to_str().unwrap(), "--truth", d.join("truth.csv").to_str().unwrap(),
-        "--algo", "songlee", "--samples", "3", "--out", d.join("n").to_str().unwrap(), "--json",
+        "nav",
+        "--imu",
+        d.join("imu.csv").to_str().unwrap(),
+        "--truth",
+        d.join("truth.csv").to_str().unwrap(),
+        "--algo",
+        "songlee",
+        "--samples",
+        "3",
+        "--out",
+        d.join("n").to_str().unwrap(),
+        "--json",
     ]);
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let (code, out2, err) = sdins(&["run", p.to_str().unwrap(), "--algo", "songlee", "--json", "--out", d.join("r").to_str().unwrap()]);
+    let (code, out2, err) = sdins(&[
+        "run",
+        p.to_str().unwrap(),
+        "--algo",
+        "songlee",
+        "--json",
+        "--out",
+        d.join("r").to_str().unwrap(),
+    ]);
     assert_eq!(code, 0, "{err}");
     let w: serde_json::Value = serde_json::from_str(&out2).unwrap();
     // the truth file carries 12-15 significant digits, so agree to that level
@@ -195,12 +226,30 @@ fn nav_bad_inputs_exit_2() {
     let d = tmp("navbad");
     let imu = d.join("imu.csv");
     std::fs::write(&imu, "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n0.01,0,0,0,0,0,-0.098\n0.02,0,0,nan,0,0,-0.098\n").unwrap();
-    let (code, _, err) = sdins(&["nav", "--imu", imu.to_str().unwrap(), "--init", "37.5,127,0,0,0,0,0,0,0"]);
+    let (code, _, err) = sdins(&[
+        "nav",
+        "--imu",
+        imu.to_str().unwrap(),
+        "--init",
+        "37.5,127,0,0,0,0,0,0,0",
+    ]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("imu.csv") && err.contains(":3"), "{err}");
-    let (code, _, err) = sdins(&["nav", "--imu", imu.to_str().unwrap(), "--init", "95,127,0,0,0,0,0,0,0"]);
+    let (code, _, err) = sdins(&[
+        "nav",
+        "--imu",
+        imu.to_str().unwrap(),
+        "--init",
+        "95,127,0,0,0,0,0,0,0",
+    ]);
     assert_eq!(code, 2, "{err}");
-    let (code, _, err) = sdins(&["nav", "--imu", d.join("missing.csv").to_str().unwrap(), "--init", "1,2,3,0,0,0,0,0,0"]);
+    let (code, _, err) = sdins(&[
+        "nav",
+        "--imu",
+        d.join("missing.csv").to_str().unwrap(),
+        "--init",
+        "1,2,3,0,0,0,0,0,0",
+    ]);
     assert_ne!(code, 0, "{err}");
     assert!(err.contains("missing.csv"), "{err}");
 }
