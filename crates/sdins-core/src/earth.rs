@@ -66,7 +66,106 @@ pub struct Radii {
     pub r_n_m: f64,
 }
 
+/// Latitude-dependent earth quantities computed from one `sin/cos(L)` and one square
+/// root (the hot path of the mechanizations).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalEarth {
+    /// sin L
+    pub sin_lat: f64,
+    /// cos L
+    pub cos_lat: f64,
+    /// meridian radius R_M [m]
+    pub r_m_m: f64,
+    /// prime-vertical radius R_N [m]
+    pub r_n_m: f64,
+    /// normal gravity g(L, h) [m/s²]
+    pub g_mps2: f64,
+}
+
+/// `sin(a + d)`, `cos(a + d)` from `sin a`, `cos a` for a small step `d` (|d| < 1e-3 rad:
+/// series to d⁶, truncation below 1e-24; larger steps fall back to libm).
+#[inline]
+pub fn sin_cos_shift(s: f64, c: f64, d: f64) -> (f64, f64) {
+    if libm::fabs(d) >= 1e-3 {
+        let (sd, cd) = (libm::sin(d), libm::cos(d));
+        return (s * cd + c * sd, c * cd - s * sd);
+    }
+    let d2 = d * d;
+    let sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
+    let cdm1 = -d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0)); // cos d − 1
+    (s + (s * cdm1 + c * sd), c + (c * cdm1 - s * sd))
+}
+
 impl EarthModel {
+    /// Radii from `sin L` (no trigonometry): see [`EarthModel::radii`].
+    #[inline]
+    pub fn radii_sin(&self, sin_lat: f64) -> Radii {
+        let w2 = 1.0 - self.e2 * sin_lat * sin_lat;
+        let r_n_m = self.a_m / libm::sqrt(w2);
+        Radii {
+            r_m_m: r_n_m * (1.0 - self.e2) / w2,
+            r_n_m,
+        }
+    }
+
+    /// [`LocalEarth`] at latitude `lat_rad` and height `h_m`.
+    #[inline]
+    pub fn local(&self, lat_rad: f64, h_m: f64) -> LocalEarth {
+        let (s, c) = (libm::sin(lat_rad), libm::cos(lat_rad));
+        self.local_sc(s, c, h_m)
+    }
+
+    /// [`LocalEarth`] from precomputed `sin L`, `cos L`.
+    #[inline]
+    pub fn local_sc(&self, sin_lat: f64, cos_lat: f64, h_m: f64) -> LocalEarth {
+        let s2 = sin_lat * sin_lat;
+        let w2 = 1.0 - self.e2 * s2;
+        let w = libm::sqrt(w2);
+        let r_n_m = self.a_m / w;
+        let g_mps2 = match self.gravity {
+            Gravity::Somigliana { gamma_e, k, m } => {
+                let gamma = gamma_e * (1.0 + k * s2) / w;
+                let a = self.a_m;
+                gamma
+                    * (1.0 - (2.0 / a) * (1.0 + self.f + m - 2.0 * self.f * s2) * h_m
+                        + (3.0 / (a * a)) * h_m * h_m)
+            }
+            Gravity::Psins { g0, c2, c4, dh } => g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h_m,
+            Gravity::Constant { g_mps2 } => g_mps2,
+        };
+        LocalEarth {
+            sin_lat,
+            cos_lat,
+            r_m_m: r_n_m * (1.0 - self.e2) / w2,
+            r_n_m,
+            g_mps2,
+        }
+    }
+
+    /// Earth rate in NED from a [`LocalEarth`].
+    #[inline]
+    pub fn omega_ie_n_local(&self, le: &LocalEarth) -> Vec3 {
+        Vec3::new(
+            self.omega_ie_rps * le.cos_lat,
+            0.0,
+            -self.omega_ie_rps * le.sin_lat,
+        )
+    }
+
+    /// Transport rate in NED from a [`LocalEarth`] (zero for the flat model).
+    #[inline]
+    pub fn omega_en_n_local(&self, le: &LocalEarth, h_m: f64, v_n_mps: &Vec3) -> Vec3 {
+        if !self.transport {
+            return Vec3::zeros();
+        }
+        let rn = le.r_n_m + h_m;
+        Vec3::new(
+            v_n_mps.y / rn,
+            -v_n_mps.x / (le.r_m_m + h_m),
+            -v_n_mps.y * (le.sin_lat / le.cos_lat) / rn,
+        )
+    }
+
     /// WGS-84 (mechanization.md §2): a = 6378137, f = 1/298.257223563,
     /// Ω = 7.292115e-5 rad/s, Somigliana gravity with the TR8350.2 height series.
     pub const WGS84: EarthModel = EarthModel {
@@ -318,6 +417,31 @@ mod tests {
         let e = EarthModel::WGS84;
         let w = c * Vec3::new(0.0, 0.0, e.omega_ie_rps);
         assert!((w - e.omega_ie_n(lat)).norm() < 1e-20);
+    }
+
+    #[test]
+    fn local_earth_matches_separate_functions() {
+        for e in [EarthModel::WGS84, EarthModel::PSINS] {
+            for &(lat, h) in &[(0.3_f64, 100.0), (-1.2, 5000.0), (1.55, -300.0)] {
+                let le = e.local(lat, h);
+                let r = e.radii(lat);
+                assert!(rel(le.r_m_m, r.r_m_m) < 1e-15 && rel(le.r_n_m, r.r_n_m) < 1e-15);
+                assert!(rel(le.g_mps2, e.gravity(lat, h)) < 1e-15);
+                let v = Vec3::new(100.0, -50.0, 3.0);
+                let w = e.omega_en_n(lat, h, &v);
+                assert!(
+                    (e.omega_en_n_local(&le, h, &v) - w).norm() <= 4.0 * f64::EPSILON * w.norm()
+                );
+                assert!((e.omega_ie_n_local(&le) - e.omega_ie_n(lat)).norm() < 1e-20);
+            }
+        }
+        for d in [1e-9, 3e-7, 9e-4, 2e-3, -0.5] {
+            let (s, c) = sin_cos_shift(0.7_f64.sin(), 0.7_f64.cos(), d);
+            assert!(
+                (s - (0.7 + d).sin()).abs() < 3e-16 && (c - (0.7 + d).cos()).abs() < 3e-16,
+                "{d}"
+            );
+        }
     }
 
     #[test]

@@ -28,10 +28,12 @@ impl DualQuat {
         }
     }
 
-    /// Translation in old-frame coordinates, `t^O = 2 d ⊗ r*` (vector part).
+    /// Translation in old-frame coordinates, `t^O = 2 d ⊗ r*` (vector part):
+    /// `2 (r_w d_v − d_w r_v − d_v × r_v)`.
     #[inline]
     pub fn translation_old(&self) -> Vec3 {
-        self.d.mul(&self.r.conj()).vec() * 2.0
+        let (dv, rv) = (self.d.vec(), self.r.vec());
+        (dv * self.r.w - rv * self.d.w - dv.cross(&rv)) * 2.0
     }
 
     /// Translation in new-frame coordinates, `t^N = 2 r* ⊗ d` (vector part).
@@ -59,19 +61,31 @@ impl DualQuat {
     /// `r = [cos(x/2), gσ]`, `d = [−½ s g, gσ' + s h σ]` (series below x = 1e-4).
     #[inline]
     pub fn exp(sigma: &Vec3, sigma_d: &Vec3) -> DualQuat {
-        let x2 = sigma.norm_squared();
-        let s = sigma.dot(sigma_d);
-        let (c, g, h) = if x2 < 1e-8 {
+        let (c, g, h) = Self::exp_coefficients(libm::sqrt(sigma.norm_squared()));
+        Self::exp_with(sigma, sigma_d, c, g, h)
+    }
+
+    /// The coefficients `(cos(x/2), g(x), h(x))` of [`DualQuat::exp`] for `|σ| = x`
+    /// (precompute them when the real part is constant, e.g. the earth rotation per update).
+    #[inline]
+    pub fn exp_coefficients(x: f64) -> (f64, f64, f64) {
+        let x2 = x * x;
+        if x2 < 1e-8 {
             (
                 1.0 - x2 / 8.0 + x2 * x2 / 384.0,
                 0.5 - x2 / 48.0 + x2 * x2 / 3840.0,
                 -1.0 / 24.0 + x2 / 960.0 - x2 * x2 / 107_520.0,
             )
         } else {
-            let x = libm::sqrt(x2);
             let (sh, ch) = (libm::sin(0.5 * x), libm::cos(0.5 * x));
             (ch, sh / x, (0.5 * x * ch - sh) / (x2 * x))
-        };
+        }
+    }
+
+    /// [`DualQuat::exp`] with precomputed coefficients ([`DualQuat::exp_coefficients`]).
+    #[inline]
+    pub fn exp_with(sigma: &Vec3, sigma_d: &Vec3, c: f64, g: f64, h: f64) -> DualQuat {
+        let s = sigma.dot(sigma_d);
         DualQuat {
             r: Quat::from_parts(c, &(sigma * g)),
             d: Quat::from_parts(-0.5 * s * g, &(sigma_d * g + sigma * (s * h))),

@@ -4,9 +4,11 @@
 //! Computation order per update (S1 §IV, spec §5.4): velocity, then position, then
 //! attitude; every rate term is evaluated at t_{k−1}.
 
-use super::{transport_matrix, wrap_pi, InitialState, Mechanization, NavState};
+use super::{
+    transport_matrix, transport_matrix_sc, wrap_pi, InitialState, Mechanization, NavState,
+};
 use crate::coning::{compensate, ConingSet, Increment};
-use crate::earth::EarthModel;
+use crate::earth::{sin_cos_shift, EarthModel};
 use crate::math::{Mat3, Quat, Vec3};
 
 /// Velocity-update formula (spec §5.2).
@@ -145,9 +147,10 @@ impl Mechanization for LocalLevel {
 
         // 1.–2. increments and rates at t_{k−1}
         let comp = compensate(self.cfg.coning, samples, &self.prev);
-        let w_ie_k1 = e.omega_ie_n(lat);
-        let w_en_k1 = e.omega_en_n(lat, h, &v);
-        let g_k1 = e.gravity_n(lat, h);
+        let le = e.local(lat, h);
+        let w_ie_k1 = e.omega_ie_n_local(&le);
+        let w_en_k1 = e.omega_en_n_local(&le, h, &v);
+        let g_k1 = Vec3::new(0.0, 0.0, le.g_mps2);
         let (w_ie, w_en, g_n) = match (self.cfg.midpoint_rates, self.rates_prev) {
             (true, Some((a, b, c))) => (
                 1.5 * w_ie_k1 - 0.5 * a,
@@ -189,16 +192,24 @@ impl Mechanization for LocalLevel {
         let h_bar = 0.5 * (h + h_new);
         let vn_bar = 0.5 * (v.x + v_new.x);
         let ve_bar = 0.5 * (v.y + v_new.y);
-        let dlat_new = if e.transport {
-            let lat_pred = lat + vn_bar * dt / (e.radii(lat).r_m_m + h_bar);
-            self.dlat_rad + vn_bar * dt / (e.radii(0.5 * (lat + lat_pred)).r_m_m + h_bar)
+        // sin/cos of the latitudes needed below are shifted from sin/cos L_{k−1}
+        // (steps are ~1e-7 rad: series exact to 1e-24), so one sin/cos serves the update.
+        let (dlat_new, s_bar, c_bar) = if e.transport {
+            let lat_pred = lat + vn_bar * dt / (le.r_m_m + h_bar);
+            let (s_m, _) = sin_cos_shift(le.sin_lat, le.cos_lat, 0.5 * (lat_pred - lat));
+            let dlat_new = self.dlat_rad + vn_bar * dt / (e.radii_sin(s_m).r_m_m + h_bar);
+            let (s_bar, c_bar) =
+                sin_cos_shift(le.sin_lat, le.cos_lat, 0.5 * (dlat_new - self.dlat_rad));
+            (dlat_new, s_bar, c_bar)
         } else {
-            self.dlat_rad + vn_bar * dt / (e.radii(self.lat0_rad).r_m_m + h_bar)
+            let (s0, c0) = (self.s_lat0, self.c_lat0);
+            (
+                self.dlat_rad + vn_bar * dt / (e.radii_sin(s0).r_m_m + h_bar),
+                s0,
+                c0,
+            )
         };
-        let lat_bar = self.lat0_rad + 0.5 * (self.dlat_rad + dlat_new);
-        let lat_for_lon = if e.transport { lat_bar } else { self.lat0_rad };
-        let dlon_new = self.dlon_rad
-            + ve_bar * dt / ((e.radii(lat_for_lon).r_n_m + h_bar) * libm::cos(lat_for_lon));
+        let dlon_new = self.dlon_rad + ve_bar * dt / ((e.radii_sin(s_bar).r_n_m + h_bar) * c_bar);
 
         // 5. attitude
         match self.cfg.attitude {
@@ -210,8 +221,11 @@ impl Mechanization for LocalLevel {
                 self.updates += 1;
                 let t = self.updates as f64 * dt;
                 let tm = if e.transport {
-                    transport_matrix(
-                        self.lat0_rad + dlat_new,
+                    let (s_new, c_new) =
+                        sin_cos_shift(le.sin_lat, le.cos_lat, dlat_new - self.dlat_rad);
+                    transport_matrix_sc(
+                        s_new,
+                        c_new,
                         self.s_lat0,
                         self.c_lat0,
                         dlon_new + e.omega_ie_rps * t,

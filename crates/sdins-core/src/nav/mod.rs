@@ -14,7 +14,7 @@ mod transport;
 pub use dual::DualQuat;
 pub use dualquat::DualQuatNav;
 pub use local_level::{AttitudeMode, LocalLevel, LocalLevelConfig, RotVector, VelocityMode};
-pub use transport::transport_matrix;
+pub use transport::{transport_matrix, transport_matrix_sc};
 
 use crate::coning::{ConingSet, Increment};
 use crate::earth::EarthModel;

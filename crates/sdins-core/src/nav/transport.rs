@@ -15,6 +15,12 @@ use crate::math::Mat3;
 #[inline]
 pub fn transport_matrix(lat_rad: f64, s_l0: f64, c_l0: f64, delta_rad: f64) -> Mat3 {
     let (sl, cl) = (libm::sin(lat_rad), libm::cos(lat_rad));
+    transport_matrix_sc(sl, cl, s_l0, c_l0, delta_rad)
+}
+
+/// [`transport_matrix`] from precomputed `sin L`, `cos L`.
+#[inline]
+pub fn transport_matrix_sc(sl: f64, cl: f64, s_l0: f64, c_l0: f64, delta_rad: f64) -> Mat3 {
     let (sd, cd) = (libm::sin(delta_rad), libm::cos(delta_rad));
     Mat3::new(
         sl * s_l0 * cd + cl * c_l0,
