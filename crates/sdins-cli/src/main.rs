@@ -8,7 +8,9 @@ mod cmd;
 mod error;
 #[allow(dead_code)]
 mod output;
+mod plot;
 mod progress;
+mod report;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -134,8 +134,31 @@ pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, Cli
         .collect()
 }
 
+/// Error-norm time series of one algorithm, at the output epochs:
+/// (t, horizontal position, |down position|, velocity norm, attitude norm).
+pub type ErrSeries = Vec<(f64, f64, f64, f64, f64)>;
+
+/// Everything a run produced.
+pub struct Outcome {
+    /// the scenario
+    pub scn: Scenario,
+    /// per-algorithm summaries
+    pub sums: Vec<RunSummary>,
+    /// output folder
+    pub out: PathBuf,
+    /// per-algorithm error time series
+    pub series: Vec<ErrSeries>,
+}
+
 /// Run and return the summaries (used by `demo` too).
+#[allow(dead_code)]
 pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliError> {
+    let o = execute_full(args)?;
+    Ok((o.scn, o.sums, o.out))
+}
+
+/// Run, write the CSV files, the report and run.toml, and return everything.
+pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let scn = Scenario::load(&args.scenario)?;
     let algos = algorithms(args, &scn)?;
     if algos.is_empty() {
@@ -188,6 +211,7 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
     let total = (scn.duration_s() / dt_u).round() as u64;
     let mut bar = Progress::new(total, "navigate", args.quiet);
     let mut io_error = None;
+    let mut series: Vec<ErrSeries> = vec![Vec::new(); algos.len()];
     let d = 180.0 / std::f64::consts::PI;
     let opts = RunOptions {
         algos: algos.clone(),
@@ -221,6 +245,8 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
                 e.att_err_rad,
                 e.euler_err_rad,
             );
+            let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
             let r2 = writeln!(
                 err_files[i].writer(),
                 "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
@@ -255,7 +281,142 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
     for f in nav_files.into_iter().chain(err_files) {
         f.commit()?;
     }
-    Ok((scn, summaries, out))
+    write_run_toml(&out, &scn, args)?;
+    let outcome = Outcome {
+        scn,
+        sums: summaries,
+        out,
+        series,
+    };
+    write_report(&outcome)?;
+    Ok(outcome)
+}
+
+/// `run.toml`: everything needed to reproduce the run (scenario text, options, seed,
+/// sdins version, git commit).
+fn write_run_toml(out: &std::path::Path, scn: &Scenario, args: &Args) -> Result<(), CliError> {
+    let scenario_text = match sdins_sim::scenario::builtin(&args.scenario) {
+        Some(b) => b.toml.to_string(),
+        None => std::fs::read_to_string(&args.scenario).unwrap_or_default(),
+    };
+    let mut t = toml::Table::new();
+    t.insert("sdins_version".into(), env!("CARGO_PKG_VERSION").into());
+    t.insert("git_commit".into(), crate::report::git_commit().into());
+    t.insert(
+        "command".into(),
+        std::env::args().collect::<Vec<_>>().join(" ").into(),
+    );
+    t.insert("scenario_name".into(), scn.name.clone().into());
+    t.insert("seed".into(), (scn.imu.seed as i64).into());
+    t.insert(
+        "sensor_run".into(),
+        (if args.ideal { -1 } else { args.run as i64 }).into(),
+    );
+    t.insert("scenario".into(), scenario_text.into());
+    let text = toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?;
+    crate::output::write_string(&out.join("run.toml"), &text)
+}
+
+/// The error figure of a run: log-scale error norms per algorithm.
+pub fn error_figure(o: &Outcome) -> crate::plot::Figure {
+    use crate::plot::{Figure, Panel, Series};
+    let panel = |title: &str, unit: &str, k: usize| Panel {
+        title: title.to_string(),
+        x_label: "time [s]".into(),
+        y_label: unit.to_string(),
+        log_y: true,
+        series: o
+            .sums
+            .iter()
+            .zip(&o.series)
+            .map(|(s, ser)| Series {
+                name: s.algo.clone(),
+                points: ser.iter().map(|r| (r.0, [r.1, r.2, r.3, r.4][k])).collect(),
+            })
+            .collect(),
+    };
+    Figure {
+        panels: vec![
+            panel("horizontal position error", "|δN, δE| [m]", 0),
+            panel("vertical position error", "|δD| [m]", 1),
+            panel("velocity error", "|δv| [m/s]", 2),
+            panel("attitude error", "|ε| [rad]", 3),
+        ],
+        cols: 2,
+        size: (1400, 900),
+    }
+}
+
+/// Summary rows for the report tables.
+pub fn summary_rows(sums: &[RunSummary]) -> Vec<Vec<String>> {
+    sums.iter()
+        .map(|s| {
+            let e = &s.final_err;
+            let mut r = vec![s.algo.clone()];
+            r.extend(
+                e.pos_err_ned_m
+                    .iter()
+                    .chain(&e.vel_err_ned_mps)
+                    .chain(&e.att_err_rad)
+                    .map(|x| format!("{x:.3e}")),
+            );
+            r.push(format!(
+                "{:.1}",
+                s.wall_s / s.nav_updates.max(1) as f64 * 1e9
+            ));
+            r
+        })
+        .collect()
+}
+
+/// Header of [`summary_rows`].
+pub const SUMMARY_HEADER: [&str; 11] = [
+    "algorithm",
+    "pos N [m]",
+    "pos E [m]",
+    "pos D [m]",
+    "vel N [m/s]",
+    "vel E [m/s]",
+    "vel D [m/s]",
+    "att N [rad]",
+    "att E [rad]",
+    "att D [rad]",
+    "time [ns/update]",
+];
+
+fn write_report(o: &Outcome) -> Result<(), CliError> {
+    use crate::plot::Bars;
+    let mut r = crate::report::Report::new(&format!("sdins run: {}", o.scn.name));
+    r.para(&format!(
+        "{} — {} s, {} Hz IMU, {} samples per update. Final errors at t = {} s.",
+        o.scn.description,
+        o.scn.duration_s(),
+        o.scn.imu.rate_hz,
+        o.sums.first().map_or(0, |s| s.samples),
+        o.sums.first().map_or(0.0, |s| s.final_err.t_s)
+    ));
+    r.table(&SUMMARY_HEADER, &summary_rows(&o.sums));
+    let fig = error_figure(o);
+    r.figure(
+        &fig,
+        "Error norms against the exact truth (log scale), one line per algorithm.",
+    )?;
+    fig.png(&o.out.join("errors.png"))?;
+    let bars = Bars {
+        title: "navigation time per update".into(),
+        y_label: "time [ns/update]".into(),
+        bars: o
+            .sums
+            .iter()
+            .map(|s| (s.algo.clone(), s.wall_s / s.nav_updates.max(1) as f64 * 1e9))
+            .collect(),
+        size: (900, 400),
+    };
+    r.bars(
+        &bars,
+        "Wall time of each algorithm's navigation loop (truth generation excluded), this machine.",
+    )?;
+    r.write(&o.out.join("report.html"))
 }
 
 /// Print a summary table of final errors.

@@ -1,0 +1,115 @@
+//! Self-contained HTML reports: tables and inline SVG figures, no scripts, no network.
+
+use crate::error::CliError;
+use crate::plot::Figure;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// An HTML report under construction.
+#[derive(Default)]
+pub struct Report {
+    title: String,
+    body: String,
+}
+
+/// Escape text for HTML.
+pub fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+impl Report {
+    /// New report with a title.
+    pub fn new(title: &str) -> Self {
+        Self {
+            title: title.to_string(),
+            body: String::new(),
+        }
+    }
+
+    /// A section heading.
+    pub fn heading(&mut self, text: &str) {
+        let _ = writeln!(self.body, "<h2>{}</h2>", esc(text));
+    }
+
+    /// A paragraph of plain text.
+    pub fn para(&mut self, text: &str) {
+        let _ = writeln!(self.body, "<p>{}</p>", esc(text));
+    }
+
+    /// Preformatted text (e.g. a console table).
+    #[allow(dead_code)]
+    pub fn pre(&mut self, text: &str) {
+        let _ = writeln!(self.body, "<pre>{}</pre>", esc(text));
+    }
+
+    /// A table with a header row.
+    pub fn table(&mut self, header: &[&str], rows: &[Vec<String>]) {
+        let _ = write!(self.body, "<table><tr>");
+        for h in header {
+            let _ = write!(self.body, "<th>{}</th>", esc(h));
+        }
+        let _ = writeln!(self.body, "</tr>");
+        for r in rows {
+            let _ = write!(self.body, "<tr>");
+            for c in r {
+                let _ = write!(self.body, "<td>{}</td>", esc(c));
+            }
+            let _ = writeln!(self.body, "</tr>");
+        }
+        let _ = writeln!(self.body, "</table>");
+    }
+
+    /// An inline SVG figure with a caption.
+    pub fn figure(&mut self, fig: &Figure, caption: &str) -> Result<(), CliError> {
+        let svg = fig.svg()?;
+        // drop the XML prolog if any: the SVG is embedded in HTML
+        let svg = svg.find("<svg").map_or(svg.as_str(), |i| &svg[i..]);
+        let _ = writeln!(
+            self.body,
+            "<figure>{svg}<figcaption>{}</figcaption></figure>",
+            esc(caption)
+        );
+        Ok(())
+    }
+
+    /// An inline SVG bar chart with a caption.
+    pub fn bars(&mut self, b: &crate::plot::Bars, caption: &str) -> Result<(), CliError> {
+        let svg = b.svg()?;
+        let svg = svg.find("<svg").map_or(svg.as_str(), |i| &svg[i..]);
+        let _ = writeln!(
+            self.body,
+            "<figure>{svg}<figcaption>{}</figcaption></figure>",
+            esc(caption)
+        );
+        Ok(())
+    }
+
+    /// The whole HTML document.
+    pub fn html(&self) -> String {
+        format!(
+            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{t}</title>\n<style>\
+body{{font-family:sans-serif;max-width:1500px;margin:2em auto;padding:0 1em;color:#222}}\
+table{{border-collapse:collapse;margin:1em 0;font-size:14px}}th,td{{border:1px solid #bbb;padding:3px 8px;text-align:right}}\
+th{{background:#eee}}td:first-child,th:first-child{{text-align:left}}pre{{background:#f6f6f6;padding:8px;overflow-x:auto;font-size:13px}}\
+figure{{margin:1em 0}}figure svg{{max-width:100%;height:auto}}figcaption{{font-size:13px;color:#555}}</style></head>\n\
+<body><h1>{t}</h1>\n<p>sdins {v}. Conventions: NED navigation frame, FRD body frame; attitude error ε from \
+C_alg C_true<sup>T</sup> = I + [ε×]; position error δN = δL(R<sub>M</sub>+h), δE = δλ(R<sub>N</sub>+h)cos L, δD = −δh.</p>\n{b}</body></html>\n",
+            t = esc(&self.title),
+            v = env!("CARGO_PKG_VERSION"),
+            b = self.body
+        )
+    }
+
+    /// Write the report atomically.
+    pub fn write(&self, dest: &Path) -> Result<(), CliError> {
+        crate::output::write_string(dest, &self.html())
+    }
+}
+
+/// The git commit sdins was built from, if known at build time.
+pub fn git_commit() -> &'static str {
+    option_env!("SDINS_GIT_COMMIT").unwrap_or("unknown")
+}
