@@ -17,7 +17,12 @@ use std::process::ExitCode;
 
 /// sdins: exact strapdown inertial navigation simulation, algorithms and analysis.
 #[derive(Parser, Debug)]
-#[command(name = "sdins", version, about, long_about = None)]
+#[command(
+    name = "sdins",
+    version,
+    about = "sdins: exact strapdown inertial navigation simulation, algorithms and analysis",
+    long_about = None
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
