@@ -202,12 +202,12 @@ fn smsfusion_coning_sculling_attitude_at_8s() {
 #[test]
 fn broad_mems_gyro_only_attitude_at_10s() {
     // Real MEMS (BROAD trials 02, 07): gyro-only attitude over the first 10 s of optical
-    // truth, the gyro bias being the mean of the first second of the file (at rest), the
-    // initial attitude the mean optical quaternion over 0.25 s. Bound from theory: the
+    // truth, the gyro bias being the mean of the second of gyro data just before (at rest),
+    // the initial attitude the mean optical quaternion over 0.25 s. Bound from theory: the
     // 1 s bias estimate has σ_b = σ_ω/√n (σ_ω from the same second), so after 10 s the
     // drift is within 3σ_b·10 s; the optical truth adds its own sample jitter σ_q (twice:
-    // start and end). The 0.2° is met by trial 02; trial 07 has a noisier gyro
-    // second and its 3σ bound is larger (see the printed numbers).
+    // start and end). The bar is 0.2°. (A bias taken from the first second of the
+    // file instead, seconds earlier, leaves 0.23° on trial 07: the MEMS bias drifts.)
     for trial in [
         "02_undisturbed_slow_rotation_B",
         "07_undisturbed_fast_rotation_B",
@@ -229,16 +229,18 @@ fn broad_mems_gyro_only_attitude_at_10s() {
             }
         };
         let n_bias = (1.0 / dt).round() as usize;
-        let bias = rows[..n_bias].iter().map(rate).sum::<Vec3>() / n_bias as f64;
-        let var = rows[..n_bias]
+        let start = (n_bias..rows.len())
+            .find(|&i| !rows[i][q].is_nan())
+            .unwrap();
+        // the second of gyro data just before the start (the vehicle is at rest there)
+        let win = &rows[start - n_bias..start];
+        let bias = win.iter().map(rate).sum::<Vec3>() / n_bias as f64;
+        let var = win
             .iter()
             .map(|r| (rate(r) - bias).norm_squared())
             .sum::<f64>()
             / (n_bias - 1) as f64;
         let sigma_b = (var / n_bias as f64).sqrt(); // 3-axis RMS of the mean [rad/s]
-        let start = (n_bias..rows.len())
-            .find(|&i| !rows[i][q].is_nan())
-            .unwrap();
         let mean_q = |a: usize, b: usize| {
             let mut acc = Quat::new(0.0, 0.0, 0.0, 0.0);
             for r in &rows[a..b] {
@@ -277,8 +279,6 @@ fn broad_mems_gyro_only_attitude_at_10s() {
             err.to_degrees(),
             bound.to_degrees()
         );
-        if trial.starts_with("02") {
-            assert!(err.to_degrees() <= 0.2);
-        }
+        assert!(err.to_degrees() <= 0.2, "{trial}: {} deg", err.to_degrees());
     }
 }
