@@ -239,3 +239,38 @@ fn scenario_reference_lists_every_accepted_key() {
         .collect();
     assert_eq!(documented, accepted);
 }
+
+#[test]
+fn mach1_truth_satisfies_navigation_equations() {
+    // Numerically differentiated truth against the increments (A1, spec §7.2): the
+    // longitude advances at v_E/((R_N+h)cosL) (central difference of the truth), latitude
+    // and height stay put, and the increments close the velocity equation
+    // v̇ = C_b^n f + g − (2ω_ie + ω_en)×v = 0 to roundoff on every sample.
+    let scn = Scenario::load("mach1-east").unwrap();
+    let c = cfg(&scn, 16);
+    let e = c.earth;
+    let samples: Vec<_> = TruthGenerator::new(&scn.trajectory, c).take(2001).collect();
+    let r = e.radii(c.lat0_rad);
+    let lon_rate = 340.29 / ((r.r_n_m + c.h0_m) * c.lat0_rad.cos());
+    assert!(
+        (lon_rate - 6.716597206969401e-5).abs() < 1e-19,
+        "spec §7.2 dl/dt"
+    );
+    for k in [500, 1000, 1500] {
+        // central difference over ±1 s: the truth longitude is an absolute angle near
+        // 2.2 rad (ulp 4.4e-16, plus the wrap to (−π, π]), so the resolution is ~2e-15/2 s
+        let num = (samples[k + 500].lon_rad - samples[k - 500].lon_rad) / (1000.0 * c.dt_s);
+        assert!((num - lon_rate).abs() <= 2e-15, "{num:e} vs {lon_rate:e}");
+    }
+    for w in samples.windows(3) {
+        assert_eq!(w[1].lat_rad, c.lat0_rad);
+        let v = w[1].v_n_mps;
+        let w_ie = e.omega_ie_n(c.lat0_rad);
+        let w_en = e.omega_en_n(c.lat0_rad, 0.0, &v);
+        let resid = w[1].c_b_n * w[1].inc.dv_b_mps
+            + (e.gravity_n(c.lat0_rad, 0.0) - (2.0 * w_ie + w_en).cross(&v)) * c.dt_s;
+        assert!(resid.norm() < 1e-17, "{:e}", resid.norm());
+        let rot = w[1].c_b_n * w[1].inc.dtheta_b_rad - (w_ie + w_en) * c.dt_s;
+        assert!(rot.norm() < 1e-22, "{:e}", rot.norm());
+    }
+}
