@@ -253,3 +253,64 @@ fn nav_bad_inputs_exit_2() {
     assert_ne!(code, 0, "{err}");
     assert!(err.contains("missing.csv"), "{err}");
 }
+
+#[test]
+fn nav_psins_trj10ms_through_the_cli() {
+    // Issue 3 external check through `sdins nav --format psins`: PSINS's own truth at 900 s
+    // (attitude ≤ 0.1″, velocity ≤ 1 mm/s, horizontal position ≤ 0.5 m).
+    let base = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/csv/psins/"
+    );
+    let imu = format!("{base}trj10ms_imu.csv");
+    if !std::path::Path::new(&imu).exists() {
+        eprintln!("skipped: ../shared/data not present");
+        return;
+    }
+    let d = tmp("psins");
+    let init = format!(
+        "{},{},380,0,0,0,0,0,0",
+        0.597_706_293_396_019_1_f64.to_degrees(),
+        1.900_832_224_040_737_8_f64.to_degrees()
+    );
+    let (code, _, err) = sdins(&[
+        "nav",
+        "--imu",
+        &imu,
+        "--format",
+        "psins",
+        "--earth",
+        "psins",
+        "--truth",
+        &format!("{base}trj10ms_avp.csv"),
+        "--algo",
+        "songlee-complete",
+        "--samples",
+        "1",
+        "--coning",
+        "1prev",
+        "--init",
+        &init,
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let errs = std::fs::read_to_string(d.join("err_songlee-complete.csv")).unwrap();
+    let row: Vec<f64> = errs
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|x| x.parse::<f64>().unwrap())
+                .collect::<Vec<_>>()
+        })
+        .find(|r| (r[0] - 900.0).abs() < 1e-6)
+        .unwrap();
+    let arcsec = std::f64::consts::PI / 180.0 / 3600.0;
+    assert!(row[1].hypot(row[2]) <= 0.5, "{row:?}");
+    assert!(row[4..7].iter().all(|v| v.abs() <= 1e-3), "{row:?}");
+    assert!(
+        row[7..10].iter().all(|a| a.abs() <= 0.1 * arcsec),
+        "{row:?}"
+    );
+}

@@ -372,6 +372,9 @@ pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuDa
     };
     let format = match format {
         ImuFormat::Auto => detect(file, first_no, first)?,
+        // `psins` names the conventions (RFU body): a PSINS trajectory exported as CSV with
+        // the sdins increment header is read as `psins-csv`
+        ImuFormat::Psins if first.trim_start().starts_with("t_s,") => ImuFormat::PsinsCsv,
         f => f,
     };
     match format {
