@@ -440,8 +440,11 @@ fn nees_monte_carlo(runs: u64) {
     }
 }
 
+/// KNOWN FAILING (left as found, not loosened): the mean pseudo-state NEES is ≈ 7.1–7.5
+/// at 300/900/1800 s against the 95 % band [7.86, 10.21] — the filter is ≈ 20 %
+/// conservative in these coordinates. Cause not yet found.
 #[test]
-#[ignore = "Monte Carlo, 50 runs: run with --release -- --ignored"]
+#[ignore = "Monte Carlo, 50 runs (KNOWN FAILING, see doc): run with --release -- --ignored"]
 fn t5_nees_pseudo_states_consistent() {
     nees_monte_carlo(50);
 }
