@@ -373,17 +373,31 @@ fn chi2_mean_band(k: usize, n: usize) -> (f64, f64) {
     (q(-1.959964), q(1.959964))
 }
 
-/// Consistency: initial error (δv, φ, biases) drawn per run from N(0, P0), aviation
-/// noise; the NEES of the 9 observable (pseudo) coordinates of spec §2.4, averaged over
-/// the runs, lies in its 95 % χ² band at 60, 300, 900 and 1800 s.
-fn nees_monte_carlo(runs: u64) {
+/// NEES epochs [s].
+const NEES_TIMES: [u64; 4] = [60, 300, 900, 1800];
+
+/// Consistency Monte Carlo: initial error (δv, φ, biases) drawn per run from N(0, P0),
+/// aviation noise (VRW 20 μg/√Hz, ARW 0.002 °/√h) at 100 Hz, KF at 1 Hz with
+/// `R = σ_z² I3`. If `meas_noise`, the zero-velocity measurement is `ṽ = 0 + ν`,
+/// `ν ~ N(0, σ_z² I3)` (exactly the R of the filter); otherwise `ṽ = 0` (noise-free).
+///
+/// Returns, per epoch of [`NEES_TIMES`], the run-mean of
+/// `[NEES of the 9 observable coordinates p = T9 e (spec §2.4), marginal NEES of δv
+/// (3 dof), marginal NEES of the 6 pseudo states φ', ε'_N, ε'_D, δa_D (6 dof)]`, with
+/// `e` = true error − estimate (estimate = 0 after the closed-loop reset; convention G,
+/// `φ = log(Ĉ Cᵀ)`; residual biases resolved with the true C) and the covariance
+/// `T9 P T9ᵀ`.
+fn nees_monte_carlo(runs: u64, sigma_z: f64, meas_noise: bool) -> Vec<[f64; 3]> {
     let tr = ref_truth();
     let s = ref_site();
-    let cfg = reference_config(s, vrw(), arw());
+    let cfg = FineConfig {
+        sigma_z_mps: sigma_z,
+        ..reference_config(s, vrw(), arw())
+    };
     let t9 = pseudo9_transform(&s);
-    let times = [60u64, 300, 900, 1800];
+    let times = NEES_TIMES;
     let p0 = p0_reference();
-    let out: Vec<[f64; 4]> = (0..runs)
+    let out: Vec<[[f64; 3]; 4]> = (0..runs)
         .into_par_iter()
         .map(|run| {
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1000 + run);
@@ -396,16 +410,27 @@ fn nees_monte_carlo(runs: u64) {
             let dv0 = x0.fixed_rows::<3>(0).into_owned();
             let incs = corrupt(&tr.increments, tr.dt_s, &noisy_model(&ba, &bg), 77, run).unwrap();
             let mut fa = FineAlign::new(cfg, &(dcm_from_rotvec(&phi0) * c));
-            let mut nees = [0.0; 4];
+            let mut nees = [[0.0; 3]; 4];
             let mut v_off = dv0;
+            let mut vrng = rand_chacha::ChaCha8Rng::seed_from_u64(5000 + run);
             for (j, inc) in incs.iter().enumerate() {
+                // ṽ = 0 + ν, ν ~ N(0, σ_z² I3), drawn afresh for every sample so that
+                // whichever sample closes a KF interval uses an independent draw
+                let v_meas = if meas_noise {
+                    Vec3::from_fn(|_, _| {
+                        let w: f64 = StandardNormal.sample(&mut vrng);
+                        sigma_z * w
+                    })
+                } else {
+                    Vec3::zeros()
+                };
                 let mut inc2 = *inc;
                 if j == 0 {
                     // inject δv0 as a velocity step in the first sample
                     inc2.dv_b_mps += fa.c_b_n_ins().transpose() * v_off;
                     v_off = Vec3::zeros();
                 }
-                if fa.step(&inc2, tr.dt_s) {
+                if fa.step_with_velocity(&inc2, tr.dt_s, &v_meas) {
                     let t = ((j + 1) as f64 * tr.dt_s).round() as u64;
                     if let Some(k) = times.iter().position(|&x| x == t) {
                         let ct = tr.c_b_n[j];
@@ -419,34 +444,90 @@ fn nees_monte_carlo(runs: u64) {
                             .copy_from(&(ct * (bg - fa.gyro_bias_b())));
                         let ep: SVector<f64, 9> = t9 * e;
                         let pp: SMatrix<f64, 9, 9> = t9 * fa.kf().p * t9.transpose();
-                        nees[k] = (ep.transpose() * pp.try_inverse().unwrap() * ep)[0];
+                        nees[k][0] = (ep.transpose() * pp.try_inverse().unwrap() * ep)[0];
+                        // marginal NEES of δv (3 dof) and of the 6 pseudo states (6 dof)
+                        let ev = ep.fixed_rows::<3>(0);
+                        let pv = pp.fixed_view::<3, 3>(0, 0).into_owned();
+                        nees[k][1] = (ev.transpose() * pv.try_inverse().unwrap() * ev)[0];
+                        let e6 = ep.fixed_rows::<6>(3);
+                        let p6 = pp.fixed_view::<6, 6>(3, 3).into_owned();
+                        nees[k][2] = (e6.transpose() * p6.try_inverse().unwrap() * e6)[0];
                     }
                 }
             }
             nees
         })
         .collect();
+    let mean = |k: usize, c: usize| out.iter().map(|r| r[k][c]).sum::<f64>() / runs as f64;
     let (lo, hi) = chi2_mean_band(9, runs as usize);
-    let means: Vec<f64> = (0..times.len())
-        .map(|k| out.iter().map(|r| r[k]).sum::<f64>() / runs as f64)
-        .collect();
-    for (m, t) in means.iter().zip(times) {
-        println!("NEES (pseudo, 9 dof) at {t} s: mean {m:.2}, 95 % band [{lo:.2}, {hi:.2}]");
+    println!(
+        "NEES, {runs} runs, σ_z = {:.0e} m/s, simulated measurement noise: {meas_noise}",
+        sigma_z
+    );
+    for (k, t) in times.iter().enumerate() {
+        println!(
+            "  {t:>4} s: pseudo-9 {:.2} (band [{lo:.2}, {hi:.2}]), δv {:.2} (3), pseudo-6 {:.2} (6)",
+            mean(k, 0),
+            mean(k, 1),
+            mean(k, 2)
+        );
     }
-    // Asserted from 300 s on (the acceptance epochs of T5); at 60 s the filter is still
-    // in its large-heading-error transient and is reported only.
-    for (m, t) in means.iter().zip(times).skip(1) {
-        assert!(*m >= lo && *m <= hi, "NEES at {t} s = {m}");
+    (0..times.len())
+        .map(|k| [mean(k, 0), mean(k, 1), mean(k, 2)])
+        .collect()
+}
+
+/// Filter consistency (NEES) with a statistically matched measurement: the simulated
+/// zero-velocity measurement carries exactly the noise the filter assumes,
+/// `ν ~ N(0, σ_z² I3)`, σ_z = 1 mm/s (spec §2.2). The mean pseudo-state NEES (9 dof)
+/// over 50 runs lies in its 95 % χ² band at 60, 300, 900 and 1800 s.
+///
+/// Why the simulated ν: in the simulation the IMU is exactly at rest, so the plain
+/// zero-velocity update `ṽ = 0` is noise-free, while the filter uses R = (1 mm/s)² — a
+/// tuning value for sway/vibration on a real pad. A filter whose R exceeds the true
+/// measurement noise is conservative by construction; a NEES test must use the truth
+/// of the simulation. (A tiny R with ṽ = 0 does not work either: the posterior δv
+/// variance is then ≈ R while the true δv error is ≈ R/σ⁻, so the δv part of the NEES
+/// tends to 0; see [`nees_without_measurement_noise_is_conservative_in_dv_only`].)
+#[test]
+#[ignore = "Monte Carlo, 50 runs: run with --release -- --ignored"]
+fn t5_nees_pseudo_states_consistent() {
+    let (lo, hi) = chi2_mean_band(9, 50);
+    let means = nees_monte_carlo(50, 1e-3, true);
+    for (m, t) in means.iter().zip(NEES_TIMES) {
+        assert!(m[0] >= lo && m[0] <= hi, "NEES at {t} s = {}", m[0]);
     }
 }
 
-/// KNOWN FAILING (left as found, not loosened): the mean pseudo-state NEES is ≈ 7.1–7.5
-/// at 300/900/1800 s against the 95 % band [7.86, 10.21] — the filter is ≈ 20 %
-/// conservative in these coordinates. Cause not yet found.
+/// The diagnosis of the formerly failing NEES test, kept as a regression check: with
+/// the noise-free `ṽ = 0` and R = (1 mm/s)² the whole NEES deficit is in the 3 velocity
+/// states, whose marginal NEES (≈ 1.1–1.3) lies below its 3-dof band, while the 6 pseudo
+/// states (attitude, observable bias combinations) are consistent.
+///
+/// Scalar derivation (velocity random walk, steady state, q = VRW² Δt, r = σ_z²): the
+/// filter's prior is `p = q/2 + √(q²/4 + q r)` (≈ 2.1e-7 m²/s² here), gain
+/// `K = p/(p + r)` ≈ 0.18 and `P⁺ = p − q`. With ν ≡ 0 the true posterior error obeys
+/// `P_t = (1 − K)² (P_t + q)`, i.e. `P_t = (1 − K)² q / (1 − (1 − K)²)` ≈ 2.1 q, against
+/// the filter's `P⁺` ≈ 4.6 q: ratio ≈ 0.45, δv NEES ≈ 3 · 0.45 ≈ 1.35 (observed 1.1–1.3;
+/// the scalar model ignores the tilt coupling).
 #[test]
-#[ignore = "Monte Carlo, 50 runs (KNOWN FAILING, see doc): run with --release -- --ignored"]
-fn t5_nees_pseudo_states_consistent() {
-    nees_monte_carlo(50);
+#[ignore = "Monte Carlo, 50 runs: run with --release -- --ignored"]
+fn nees_without_measurement_noise_is_conservative_in_dv_only() {
+    let (lo3, _) = chi2_mean_band(3, 50);
+    let (lo6, hi6) = chi2_mean_band(6, 50);
+    let means = nees_monte_carlo(50, 1e-3, false);
+    for (m, t) in means.iter().zip(NEES_TIMES) {
+        assert!(
+            m[1] < lo3,
+            "δv NEES at {t} s = {} (expected below {lo3})",
+            m[1]
+        );
+        assert!(
+            m[2] >= lo6 && m[2] <= hi6,
+            "pseudo-6 NEES at {t} s = {} (band [{lo6}, {hi6}])",
+            m[2]
+        );
+    }
 }
 
 // ---------------------------------------------------------------- multi-heading
