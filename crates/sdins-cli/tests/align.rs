@@ -55,6 +55,39 @@ fn align_scenario_coarse_and_fine_json() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// `--out` with the fine filter writes the history plots (attitude error and bias
+/// estimates with ±3σ), SVG and PNG.
+#[test]
+fn align_fine_writes_plots() {
+    let d = std::env::temp_dir().join(format!("sdins-align-plots-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    let (code, _, err) = sdins(&[
+        "align",
+        "alignment",
+        "--method",
+        "fine",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    for f in [
+        "align_attitude.svg",
+        "align_attitude.png",
+        "align_bias.svg",
+        "align_bias.png",
+    ] {
+        let len = std::fs::metadata(d.join(f)).map(|m| m.len()).unwrap_or(0);
+        assert!(len > 1000, "{f}: {len} bytes");
+    }
+    let svg = std::fs::read_to_string(d.join("align_attitude.svg")).unwrap();
+    assert!(svg.contains("φ_D [μrad]") && svg.contains("time [s]") && svg.contains("±3σ"));
+    let svg = std::fs::read_to_string(d.join("align_bias.svg")).unwrap();
+    assert!(svg.contains("accelerometer bias [μg]") && svg.contains("gyro bias [°/h]"));
+    let png = std::fs::read(d.join("align_bias.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 #[test]
 fn align_observability_table() {
     let (code, out, err) = sdins(&["align", "--observability"]);

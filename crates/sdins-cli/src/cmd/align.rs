@@ -4,13 +4,16 @@
 //!
 //! Input is an IMU file (`--imu`) or a scenario (built-in name or file; its IMU error
 //! model applies with run index `--run`). Outputs in `--out` (if given):
-//! `align_result.csv` (one row: method, attitude, biases and 1σ) and, for the filters,
-//! `align_history.csv` (per Kalman update: attitude, 1σ, biases, and the attitude error
-//! against the truth for scenarios).
+//! `align_result.csv` (one row: method, attitude, biases and 1σ) and, for the filters
+//! (fine, multi-heading Algorithm A), `align_history.csv` (per Kalman update: attitude,
+//! 1σ, biases, and the attitude error against the truth for scenarios) with its plots
+//! `align_attitude.svg/.png` and `align_bias.svg/.png` (attitude error and bias
+//! estimates with ±3σ bounds, see [`super::align_plot`]).
 //!
 //! Attitude errors use convention G (`Ĉ = (I + [φ×]) C`, NED). Biases are body (FRD) axes,
 //! μg and °/h.
 
+use super::align_plot::{write_plots, HistRow};
 use crate::error::CliError;
 use crate::output::write_string;
 use sdins_core::align::coarse::CoarseMethod;
@@ -263,6 +266,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
          bg_x_dph,bg_y_dph,bg_z_dph,sig_bg_x_dph,sig_bg_y_dph,sig_bg_z_dph,\
          phi_n_urad,phi_e_urad,phi_d_urad\n",
     );
+    let mut rows: Vec<HistRow> = Vec::new();
     let truth = inp.truth.clone();
     let dt = inp.dt_s;
     let mut record = |j: usize, fa: &FineAlign| {
@@ -291,6 +295,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
             }
             None => hist.push_str(",,,\n"),
         }
+        let a = |v: Vec3| [v.x, v.y, v.z];
+        rows.push(HistRow {
+            t_s: (j + 1) as f64 * dt,
+            phi_urad: phi.map(a),
+            sig_phi_urad: a(sa),
+            ba_ug: a(ba),
+            sig_ba_ug: a(sba),
+            bg_dph: a(bg),
+            sig_bg_dph: a(sbg),
+        });
     };
     let bad = |e: sdins_core::align::AlignError| CliError::bad(format!("{}: {e}", inp.name));
     let res = match args.method {
@@ -373,6 +387,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
             || args.method == Method::Fine
         {
             write_string(&dir.join("align_history.csv"), &hist)?;
+            if rows.len() >= 2 {
+                write_plots(dir, &rows)?;
+            } else {
+                eprintln!(
+                    "note: {} Kalman cycle(s): too short for the alignment plots",
+                    rows.len()
+                );
+            }
         }
     }
     if args.json {
@@ -432,7 +454,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
             );
         }
         if let Some(d) = &args.out {
-            println!("wrote {}/align_result.csv", d.display());
+            if rows.len() >= 2 {
+                println!(
+                    "wrote {0}/align_result.csv, {0}/align_history.csv, plots {0}/align_attitude.svg/.png, {0}/align_bias.svg/.png",
+                    d.display()
+                );
+            } else {
+                println!("wrote {}/align_result.csv", d.display());
+            }
         }
     }
     Ok(())
