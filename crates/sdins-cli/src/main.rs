@@ -44,6 +44,8 @@ enum Command {
     Allan(cmd::allan::Args),
     /// Analytic INS error propagation: closed form, linear model, Schuler share.
     Errors(cmd::errors::Args),
+    /// Initial alignment: coarse 1-/2-step, Kalman fine, multi-heading; observability.
+    Align(cmd::align::Args),
 }
 
 fn main() -> ExitCode {
@@ -57,6 +59,7 @@ fn main() -> ExitCode {
         Command::Nav(a) => cmd::nav::run(a),
         Command::Allan(a) => cmd::allan::run(a),
         Command::Errors(a) => cmd::errors::run(a),
+        Command::Align(a) => cmd::align::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,6 +4,7 @@
 //! models and sensor grades, Allan variance, IMU file readers, error analysis and
 //! Monte Carlo. Builds on the `no_std` navigation core, `sdins-core`.
 
+pub mod align;
 pub mod allan;
 pub mod error_analysis;
 pub mod imu_error;

@@ -246,7 +246,8 @@ pub fn csv(r: &AllanReport) -> String {
 
 const SIZE: (u32, u32) = (1400, 560);
 
-fn register_font() -> Result<(), CliError> {
+/// Register the embedded DejaVu Sans as the plotters `sans-serif` font.
+pub(crate) fn register_font() -> Result<(), CliError> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
         .map_err(|_| CliError::Other("cannot load the embedded DejaVu Sans font".into()))
 }

@@ -1,5 +1,7 @@
 //! One module per command.
 
+pub mod align;
+pub mod align_plot;
 pub mod allan;
 pub mod demo;
 pub mod errors;

@@ -1,0 +1,118 @@
+//! Initial alignment of a stationary strapdown INS (spec `alignment_and_errors.md` §1–§3).
+//!
+//! One file per concept:
+//! * [`coarse`]: 1-step analytic (TRIAD-type, polar-orthonormalised) and 2-step
+//!   (levelling + gyrocompassing) coarse alignment from averaged static increments,
+//!   and the corrected first-order error table (spec §1.1–§1.3).
+//! * [`model`]: the 12-state stationary error model `F`, its discretisation, the null
+//!   space `n1, n2, n3`, the pseudo (observable) coordinates and the finite-prior
+//!   residual projector `Π` (spec §2.1, §2.3, §2.4).
+//! * [`kf`]: the generic Kalman filter core (prediction, Joseph-form update).
+//! * [`fine`]: the 12-state zero-velocity Kalman fine alignment with its own stationary
+//!   attitude/velocity propagation, closed-loop reset or feed-forward (spec §2.2–§2.3,
+//!   §3.2 Algorithm A with body-frame bias states).
+//! * [`observability`]: numerical rank and unobservable directions of piece-wise
+//!   constant `(F_j, H)` (spec §2.4 procedure, §3.1 stripped observability matrix).
+//! * [`multiheading`]: Algorithm B of spec §3.3 (pseudo-error least squares) with the
+//!   exact attitude-error transition `Φ_k, Γ_k`.
+//!
+//! Conventions: NED / FRD, `c_b_n`, attitude error convention G,
+//! `Ĉ_b^n = (I + [φ×]) C_b^n` (spec §0.2); use [`phi_tw_from_g`] for Titterton & Weston's
+//! ψ. Biases are "measured − true" (spec §0.3); estimator bias states are residuals
+//! (true − current estimate).
+//!
+//! Everything is `no_std` and allocation-free (fixed-size nalgebra matrices).
+
+pub mod coarse;
+pub mod fine;
+pub mod kf;
+pub mod model;
+pub mod multiheading;
+pub mod observability;
+
+use crate::math::Vec3;
+
+/// Converts a convention-G attitude error φ to Titterton & Weston's ψ (spec §0.2:
+/// `ψ_TW = −φ_G`).
+#[inline]
+pub fn phi_tw_from_g(phi_g: &Vec3) -> Vec3 {
+    -phi_g
+}
+
+/// Why an alignment computation cannot be done.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum AlignError {
+    /// |latitude| > 80°: the sec L terms diverge (spec §1.3 "Validity").
+    LatitudeTooHigh,
+    /// The averaged specific force or rate is zero / not finite, or a matrix is singular.
+    Degenerate,
+    /// The static window is empty.
+    NoData,
+}
+
+impl core::fmt::Display for AlignError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            AlignError::LatitudeTooHigh => {
+                "latitude beyond ±80°: gyrocompassing is ill-conditioned (spec §1.3)"
+            }
+            AlignError::Degenerate => {
+                "degenerate input (zero or non-finite specific force or rate, singular matrix)"
+            }
+            AlignError::NoData => "empty static window",
+        })
+    }
+}
+
+/// Site constants used by every alignment algorithm: latitude, gravity magnitude and
+/// earth rate (spec §0.4). The truth and the algorithm must use the same `g`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Site {
+    /// geodetic latitude L [rad]
+    pub lat_rad: f64,
+    /// local gravity magnitude g(L, h) [m/s²]
+    pub g_mps2: f64,
+    /// earth rate Ω [rad/s]
+    pub omega_ie_rps: f64,
+}
+
+impl Site {
+    /// From an earth model at latitude `lat_rad` and height `h_m`.
+    pub fn from_earth(earth: &crate::earth::EarthModel, lat_rad: f64, h_m: f64) -> Self {
+        Self {
+            lat_rad,
+            g_mps2: earth.gravity(lat_rad, h_m),
+            omega_ie_rps: earth.omega_ie_rps,
+        }
+    }
+    /// `ω_ie^n = Ω [cos L, 0, −sin L]` (spec §0.4).
+    #[inline]
+    pub fn omega_ie_n(&self) -> Vec3 {
+        Vec3::new(
+            self.omega_ie_rps * libm::cos(self.lat_rad),
+            0.0,
+            -self.omega_ie_rps * libm::sin(self.lat_rad),
+        )
+    }
+    /// `g^n = [0, 0, g]`.
+    #[inline]
+    pub fn g_n(&self) -> Vec3 {
+        Vec3::new(0.0, 0.0, self.g_mps2)
+    }
+    /// Ω_N = Ω cos L.
+    #[inline]
+    pub fn omega_n(&self) -> f64 {
+        self.omega_ie_rps * libm::cos(self.lat_rad)
+    }
+    /// Ω_D = −Ω sin L.
+    #[inline]
+    pub fn omega_d(&self) -> f64 {
+        -self.omega_ie_rps * libm::sin(self.lat_rad)
+    }
+    /// tan L.
+    #[inline]
+    pub fn tan_lat(&self) -> f64 {
+        libm::tan(self.lat_rad)
+    }
+}
