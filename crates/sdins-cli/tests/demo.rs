@@ -27,7 +27,7 @@ fn demo_report_complete_and_consistent_with_run() {
         "1. Song–Lee Table 1",
         "2. 90°/s turn",
         "3. The dual-quaternion paper",
-        "4. Schuler share",
+        "5. Schuler share",
         "Savage, S1 Table 1 (reconstructed)",
         "Song–Lee, transport attitude (S1 eq. 6)",
         "dual quaternion 2-sample",
