@@ -55,6 +55,9 @@ pub struct TruthConfig {
 struct ClosedForm {
     inc: Increment,
     lon_rate_rps: f64,
+    /// the (constant) velocity and attitude, so that no sample re-evaluates them
+    v_n_mps: Vec3,
+    c_b_n: Mat3,
 }
 
 /// Streaming truth generator (constant memory): an iterator of [`TruthSample`].
@@ -130,6 +133,8 @@ impl<'a> TruthGenerator<'a> {
         ClosedForm {
             inc: Increment::new(dtheta, dv),
             lon_rate_rps,
+            v_n_mps: k.v_n_mps,
+            c_b_n: k.c_b_n,
         }
     }
 
@@ -203,25 +208,30 @@ impl Iterator for TruthGenerator<'_> {
         let t0 = self.k as f64 * dt;
         self.k += 1;
         let t1 = self.k as f64 * dt;
-        let inc = match self.closed {
+        let (inc, v_n_mps, c_b_n) = match &self.closed {
             Some(cf) => {
                 self.dlon = cf.lon_rate_rps * t1;
-                cf.inc
+                // constant state: velocity and attitude are those of t = 0
+                (cf.inc, cf.v_n_mps, cf.c_b_n)
             }
-            None => self.sample_rk4(t0),
+            None => {
+                let inc = self.sample_rk4(t0);
+                // attitude and velocity at the sample end are analytic (branch of the
+                // last substep)
+                let kin = self
+                    .traj
+                    .kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
+                (inc, kin.v_n_mps, kin.c_b_n)
+            }
         };
-        // attitude and velocity at the sample end are analytic (branch of the last substep)
-        let kin = self
-            .traj
-            .kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
         Some(TruthSample {
             t_s: t1,
             inc,
             lat_rad: self.cfg.lat0_rad + self.dlat,
             lon_rad: wrap_pi(self.cfg.lon0_rad + self.dlon),
             h_m: self.h,
-            v_n_mps: kin.v_n_mps,
-            c_b_n: kin.c_b_n,
+            v_n_mps,
+            c_b_n,
         })
     }
 
