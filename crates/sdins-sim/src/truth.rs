@@ -140,8 +140,14 @@ impl<'a> TruthGenerator<'a> {
 
     #[inline]
     fn deriv(&self, t_base: f64, off: f64, t_sel: f64, y: &State) -> State {
-        let e = &self.cfg.earth;
         let kin = self.traj.kinematics_split(t_base, off, t_sel);
+        self.deriv_kin(&kin, y)
+    }
+
+    /// The state derivative given the trajectory kinematics at that time.
+    #[inline]
+    fn deriv_kin(&self, kin: &crate::trajectory::Kinematics, y: &State) -> State {
+        let e = &self.cfg.earth;
         let lat = self.cfg.lat0_rad + y[0];
         let h = y[2];
         let v = kin.v_n_mps;
@@ -183,8 +189,10 @@ impl<'a> TruthGenerator<'a> {
             let ob = (j + 1) as f64 * hs;
             let tm = t0 + om;
             let k1 = self.deriv(t0, oa, tm, &y);
-            let k2 = self.deriv(t0, om, tm, &add(&y, &k1, 0.5 * hs));
-            let k3 = self.deriv(t0, om, tm, &add(&y, &k2, 0.5 * hs));
+            // k2 and k3 share the midpoint kinematics: evaluate the trajectory once
+            let kin_m = self.traj.kinematics_split(t0, om, tm);
+            let k2 = self.deriv_kin(&kin_m, &add(&y, &k1, 0.5 * hs));
+            let k3 = self.deriv_kin(&kin_m, &add(&y, &k2, 0.5 * hs));
             let k4 = self.deriv(t0, ob, tm, &add(&y, &k3, hs));
             for i in 0..9 {
                 y[i] += hs / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
