@@ -33,6 +33,17 @@ fn full_run(rec: &Recorded, spec: &AlgorithmSpec) -> NavError {
     max
 }
 
+/// CPU time of this thread [s] from /proc (10 ms resolution; None off Linux): on a
+/// loaded machine the wall clock counts the time other processes had the core.
+fn thread_cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    // fields after the parenthesised command name: utime and stime are 14 and 15
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let algo = args.get(1).map_or("savage", String::as_str);
@@ -43,13 +54,17 @@ fn main() {
     let max = (secs * scn.imu.rate_hz).round() as usize;
     let rec = record(&scn, n, Some(max));
     let spec = AlgorithmSpec::from_name(algo, n).expect("algorithm name");
+    let c0 = thread_cpu_s();
     let t0 = Instant::now();
     let e = full_run(&rec, &spec);
     let wall = t0.elapsed().as_secs_f64();
+    let cpu = c0.and_then(|c0| thread_cpu_s().map(|c1| c1 - c0));
+    let m = rec.incs.len() as f64 / 1e6;
     println!(
-        "{algo} N={n} {} samples in {wall:.4} s = {:.3} M samples/s; max |pos err| {:?} m",
+        "{algo} N={n} {} samples: wall {wall:.4} s = {:.3} M samples/s; cpu {} ; max |pos err| {:?} m",
         rec.incs.len(),
-        rec.incs.len() as f64 / wall / 1e6,
+        m / wall,
+        cpu.map_or("n/a".to_string(), |c| format!("{c:.2} s = {:.2} M samples/s", m / c)),
         e.pos_err_ned_m
     );
 }
