@@ -21,6 +21,15 @@ pub enum Gravity {
         /// m = ω²a²b/GM
         m: f64,
     },
+    /// Somigliana on the ellipsoid with only the linear free-air factor:
+    /// `g = γ(L)(1 − 2h/a)` (drops the flattening, centrifugal and h² terms of the
+    /// TR8350.2 series; used by simpler INS codes, e.g. pyins).
+    SomiglianaLinear {
+        /// equatorial normal gravity γ_e [m/s²]
+        gamma_e: f64,
+        /// Somigliana constant k
+        k: f64,
+    },
     /// PSINS: `g = g0 (1 + c2 sin²L + c4 sin⁴L) − dh · h`.
     Psins {
         /// g0 [m/s²]
@@ -130,6 +139,9 @@ impl EarthModel {
                     * (1.0 - (2.0 / a) * (1.0 + self.f + m - 2.0 * self.f * s2) * h_m
                         + (3.0 / (a * a)) * h_m * h_m)
             }
+            Gravity::SomiglianaLinear { gamma_e, k } => {
+                gamma_e * (1.0 + k * s2) / w * (1.0 - 2.0 * h_m / self.a_m)
+            }
             Gravity::Psins { g0, c2, c4, dh } => g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h_m,
             Gravity::Constant { g_mps2 } => g_mps2,
         };
@@ -179,6 +191,18 @@ impl EarthModel {
             m: 3.449_786_506_84e-3,
         },
         transport: true,
+    };
+
+    /// WGS-84 with the linear free-air gravity `γ(L)(1 − 2h/a)`
+    /// ([`Gravity::SomiglianaLinear`]), for data generated with that model (the
+    /// pyins comparison of docs/performance.md): the vertical channel is unstable, so a
+    /// 1e-5 m/s² gravity mismatch alone grows to hundreds of metres of height in an hour.
+    pub const WGS84_LINEAR_G: EarthModel = EarthModel {
+        gravity: Gravity::SomiglianaLinear {
+            gamma_e: 9.780_325_335_9,
+            k: 1.931_852_652_41e-3,
+        },
+        ..EarthModel::WGS84
     };
 
     /// PSINS toolbox constant set: Re = 6378137, f = 1/298.257, wie = 7.2921151467e-5,
@@ -237,6 +261,10 @@ impl EarthModel {
                 gamma
                     * (1.0 - (2.0 / a) * (1.0 + self.f + m - 2.0 * self.f * s2) * h_m
                         + (3.0 / (a * a)) * h_m * h_m)
+            }
+            Gravity::SomiglianaLinear { gamma_e, k } => {
+                gamma_e * (1.0 + k * s2) / libm::sqrt(1.0 - self.e2 * s2)
+                    * (1.0 - 2.0 * h_m / self.a_m)
             }
             Gravity::Psins { g0, c2, c4, dh } => g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h_m,
             Gravity::Constant { g_mps2 } => g_mps2,
@@ -345,6 +373,19 @@ mod tests {
     }
 
     #[test]
+    fn linear_free_air_gravity() {
+        let (e, w) = (EarthModel::WGS84_LINEAR_G, EarthModel::WGS84);
+        let lat = 0.96;
+        // same on the ellipsoid, 1 − 2h/a above it
+        assert!((e.gravity(lat, 0.0) - w.gravity(lat, 0.0)).abs() < 1e-15);
+        let h = 1500.0;
+        let want = w.gravity(lat, 0.0) * (1.0 - 2.0 * h / 6_378_137.0);
+        assert!((e.gravity(lat, h) - want).abs() < 1e-14);
+        // the TR8350.2 series is ~9e-6 m/s² weaker at 1.5 km, 55°N
+        assert!((e.gravity(lat, h) - w.gravity(lat, h) - 9.0e-6).abs() < 0.5e-6);
+    }
+
+    #[test]
     fn wgs84_radii_published_values() {
         // NIMA TR8350.2 Table 3.1 / 3.3: b = 6356752.3142 m; R_M(0) = b²/a, R_M(90°) = a²/b.
         let e = EarthModel::WGS84;
@@ -421,7 +462,11 @@ mod tests {
 
     #[test]
     fn local_earth_matches_separate_functions() {
-        for e in [EarthModel::WGS84, EarthModel::PSINS] {
+        for e in [
+            EarthModel::WGS84,
+            EarthModel::PSINS,
+            EarthModel::WGS84_LINEAR_G,
+        ] {
             for &(lat, h) in &[(0.3_f64, 100.0), (-1.2, 5000.0), (1.55, -300.0)] {
                 let le = e.local(lat, h);
                 let r = e.radii(lat);

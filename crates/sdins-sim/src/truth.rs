@@ -55,6 +55,9 @@ pub struct TruthConfig {
 struct ClosedForm {
     inc: Increment,
     lon_rate_rps: f64,
+    /// the (constant) velocity and attitude, so that no sample re-evaluates them
+    v_n_mps: Vec3,
+    c_b_n: Mat3,
 }
 
 /// Streaming truth generator (constant memory): an iterator of [`TruthSample`].
@@ -130,13 +133,21 @@ impl<'a> TruthGenerator<'a> {
         ClosedForm {
             inc: Increment::new(dtheta, dv),
             lon_rate_rps,
+            v_n_mps: k.v_n_mps,
+            c_b_n: k.c_b_n,
         }
     }
 
     #[inline]
     fn deriv(&self, t_base: f64, off: f64, t_sel: f64, y: &State) -> State {
-        let e = &self.cfg.earth;
         let kin = self.traj.kinematics_split(t_base, off, t_sel);
+        self.deriv_kin(&kin, y)
+    }
+
+    /// The state derivative given the trajectory kinematics at that time.
+    #[inline]
+    fn deriv_kin(&self, kin: &crate::trajectory::Kinematics, y: &State) -> State {
+        let e = &self.cfg.earth;
         let lat = self.cfg.lat0_rad + y[0];
         let h = y[2];
         let v = kin.v_n_mps;
@@ -178,8 +189,10 @@ impl<'a> TruthGenerator<'a> {
             let ob = (j + 1) as f64 * hs;
             let tm = t0 + om;
             let k1 = self.deriv(t0, oa, tm, &y);
-            let k2 = self.deriv(t0, om, tm, &add(&y, &k1, 0.5 * hs));
-            let k3 = self.deriv(t0, om, tm, &add(&y, &k2, 0.5 * hs));
+            // k2 and k3 share the midpoint kinematics: evaluate the trajectory once
+            let kin_m = self.traj.kinematics_split(t0, om, tm);
+            let k2 = self.deriv_kin(&kin_m, &add(&y, &k1, 0.5 * hs));
+            let k3 = self.deriv_kin(&kin_m, &add(&y, &k2, 0.5 * hs));
             let k4 = self.deriv(t0, ob, tm, &add(&y, &k3, hs));
             for i in 0..9 {
                 y[i] += hs / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
@@ -203,25 +216,30 @@ impl Iterator for TruthGenerator<'_> {
         let t0 = self.k as f64 * dt;
         self.k += 1;
         let t1 = self.k as f64 * dt;
-        let inc = match self.closed {
+        let (inc, v_n_mps, c_b_n) = match &self.closed {
             Some(cf) => {
                 self.dlon = cf.lon_rate_rps * t1;
-                cf.inc
+                // constant state: velocity and attitude are those of t = 0
+                (cf.inc, cf.v_n_mps, cf.c_b_n)
             }
-            None => self.sample_rk4(t0),
+            None => {
+                let inc = self.sample_rk4(t0);
+                // attitude and velocity at the sample end are analytic (branch of the
+                // last substep)
+                let kin = self
+                    .traj
+                    .kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
+                (inc, kin.v_n_mps, kin.c_b_n)
+            }
         };
-        // attitude and velocity at the sample end are analytic (branch of the last substep)
-        let kin = self
-            .traj
-            .kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
         Some(TruthSample {
             t_s: t1,
             inc,
             lat_rad: self.cfg.lat0_rad + self.dlat,
             lon_rad: wrap_pi(self.cfg.lon0_rad + self.dlon),
             h_m: self.h,
-            v_n_mps: kin.v_n_mps,
-            c_b_n: kin.c_b_n,
+            v_n_mps,
+            c_b_n,
         })
     }
 
@@ -243,6 +261,13 @@ pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
 }
 
 /// Longitude difference wrapped to (−π, π] (for error computation across ±180°).
+#[inline]
 pub fn lon_diff(a: f64, b: f64) -> f64 {
-    wrap_pi(a - b)
+    let d = a - b;
+    // already in range (the usual case): skip the fmod, which would only add rounding
+    if d > -core::f64::consts::PI && d <= core::f64::consts::PI {
+        d
+    } else {
+        wrap_pi(d)
+    }
 }

@@ -274,3 +274,22 @@ fn mach1_truth_satisfies_navigation_equations() {
         assert!(rot.norm() < 1e-22, "{:e}", rot.norm());
     }
 }
+
+#[test]
+fn closed_form_state_equals_the_trajectory_kinematics() {
+    // the closed-form path returns the t = 0 velocity and attitude for every sample (no
+    // per-sample evaluation): they must be exactly what the trajectory gives at the
+    // sample ends, as the RK4 path reports them
+    for name in ["mach1-east", "stationary", "alignment"] {
+        let scn = Scenario::load(name).unwrap();
+        let c = cfg(&scn, 16);
+        let gen = TruthGenerator::new(&scn.trajectory, c);
+        let n = gen.len_samples();
+        for (k, s) in gen.enumerate().step_by(9973) {
+            let t1 = (k + 1) as f64 * c.dt_s;
+            let kin = scn.trajectory.kinematics(t1, t1 - 0.25 * c.dt_s / 16.0);
+            assert_eq!(s.v_n_mps, kin.v_n_mps, "{name} sample {k} of {n}");
+            assert_eq!(s.c_b_n, kin.c_b_n, "{name} sample {k} of {n}");
+        }
+    }
+}

@@ -7,7 +7,7 @@ use sdins_core::earth::EarthModel;
 use sdins_core::math::{c_b_n_from_euler, Euler, Vec3};
 use sdins_core::nav::InitialState;
 use sdins_sim::imu_file::{read_imu_file, ImuFormat};
-use sdins_sim::pipeline::{nav_error, navigate_recorded, NavError};
+use sdins_sim::pipeline::{nav_error, navigate_recorded_timed, NavError};
 use sdins_sim::scenario::Scenario;
 use sdins_sim::truth_file::{c_b_n_from_psins, read_truth};
 use std::io::Write;
@@ -40,7 +40,7 @@ pub struct Args {
     /// coning/sculling set (default: the polynomial set of N)
     #[arg(long)]
     pub coning: Option<String>,
-    /// earth model: wgs84, psins, flat
+    /// earth model: wgs84, wgs84-linear (gravity γ(L)(1 − 2h/a), as pyins), psins, flat
     #[arg(long, default_value = "wgs84")]
     pub earth: String,
     /// reference trajectory (sdins truth.csv or PSINS avp CSV); errors are written too
@@ -98,11 +98,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let format: ImuFormat = args.format.parse().map_err(CliError::BadInput)?;
     let earth = match args.earth.as_str() {
         "wgs84" => EarthModel::WGS84,
+        "wgs84-linear" => EarthModel::WGS84_LINEAR_G,
         "psins" => EarthModel::PSINS,
         "flat" => EarthModel::flat(9.806_65),
         o => {
             return Err(CliError::bad(format!(
-                "--earth {o}: expected wgs84, psins or flat"
+                "--earth {o}: expected wgs84, wgs84-linear, psins or flat"
             )))
         }
     };
@@ -184,7 +185,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut ti = 0usize;
     let mut write_err = None;
     let t0 = data.t0_s - data.dt_s; // state epoch before the first sample
-    let wall = navigate_recorded(&spec, earth, data.dt_s, &init, &data.increments, |st| {
+    let wall = navigate_recorded_timed(&spec, earth, data.dt_s, &init, &data.increments, |st| {
         let t = t0 + st.t_s;
         let e = st.euler();
         if let Err(err) = writeln!(
@@ -255,7 +256,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     } else {
         println!(
-            "{}: {} samples at {} s, {} updates in {:.3} s",
+            "{}: {} samples at {} s, {} updates in {:.3} s (navigation only)",
             spec.kind.name(),
             data.increments.len(),
             data.dt_s,
