@@ -35,6 +35,10 @@ enum Command {
     Allan(cmd::allan::Args),
     /// Analytic INS error propagation: closed form, linear model, Schuler share.
     Errors(cmd::errors::Args),
+    /// Monte Carlo: N seeded runs with the scenario's IMU errors, per-epoch statistics.
+    Montecarlo(cmd::montecarlo::Args),
+    /// Merge Monte Carlo shard states exactly into the statistics of the whole job.
+    Merge(cmd::merge::Args),
 }
 
 fn main() -> ExitCode {
@@ -47,6 +51,8 @@ fn main() -> ExitCode {
         Command::Run(a) => cmd::run::run(a),
         Command::Allan(a) => cmd::allan::run(a),
         Command::Errors(a) => cmd::errors::run(a),
+        Command::Montecarlo(a) => cmd::montecarlo::run(a),
+        Command::Merge(a) => cmd::merge::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,6 +3,8 @@
 pub mod allan;
 pub mod demo;
 pub mod errors;
+pub mod merge;
+pub mod montecarlo;
 pub mod run;
 pub mod scenarios;
 pub mod truth;

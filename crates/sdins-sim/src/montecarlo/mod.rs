@@ -20,7 +20,8 @@
 //!
 //! Files: [`moments`] (Welford/Chan), [`histogram`] (percentiles), [`plan`] (blocks and
 //! shards), [`state`] (the lossless, mergeable accumulator state), [`runner`] (rayon over
-//! blocks), [`stats`] (the final table and its CSV).
+//! blocks), [`stats`] (the final table and its CSV), [`truth_cache`] (the truth computed
+//! once for all runs).
 
 pub mod histogram;
 pub mod moments;
@@ -28,6 +29,7 @@ pub mod plan;
 pub mod runner;
 pub mod state;
 pub mod stats;
+pub mod truth_cache;
 
 pub use plan::{Shard, DEFAULT_BLOCK};
 pub use runner::{run_shard, McOptions};

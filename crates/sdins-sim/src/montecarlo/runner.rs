@@ -9,6 +9,7 @@ use super::histogram::LogHistogram;
 use super::moments::Moments;
 use super::plan::{block_count, block_runs, shard_blocks, Shard};
 use super::state::{fnv1a_hex, BlockResult, McJob, McState, FORMAT};
+use super::truth_cache::{worth_caching, TruthCache};
 use super::{McError, N_CHANNELS};
 use crate::pipeline::{run as run_pipeline, NavError, RunOptions};
 use crate::scenario::Scenario;
@@ -139,6 +140,9 @@ pub fn run_shard(
     // epoch times from a run-free pass would cost a whole run; take them from the runs and
     // check that every run has the same epochs
     let blocks: Vec<u64> = shard_blocks(shard, opts.runs, opts.block).collect();
+    // the truth is the same for every run: generate it once where that is expensive
+    let cache = worth_caching(&s, opts.algo.samples, opts.until_s)
+        .then(|| TruthCache::build(&s, opts.algo.samples, job.every, opts.until_s));
     type Block = (BlockResult, Vec<LogHistogram>, Vec<f64>);
     let results: Vec<Result<Block, McError>> = blocks
         .par_iter()
@@ -150,7 +154,10 @@ pub fn run_shard(
                 if cancelled() {
                     return Err(McError::Interrupted);
                 }
-                let errs = run_one(&s, opts, job.every, r);
+                let errs = match &cache {
+                    Some(c) => c.run(&s.imu.model, s.imu.seed, r, &opts.algo, opts.vertical_hold),
+                    None => run_one(&s, opts, job.every, r),
+                };
                 if times.is_empty() {
                     times = errs.iter().map(|e| e.t_s).collect();
                     moments = vec![Moments::default(); times.len() * N_CHANNELS];
@@ -317,6 +324,34 @@ duration_s = 60.0
             McState::merge(&[other, shards[1].clone()]),
             Err(McError::Mismatch(_))
         ));
+    }
+
+    /// The cached truth replays the streaming pipeline bit for bit (dq-paper: RK4 truth,
+    /// coning overlay; aviation-grade errors; 41 s with a partial last epoch).
+    #[test]
+    fn cached_truth_run_equals_pipeline_run() {
+        let b = crate::scenario::builtin("dq-paper").unwrap();
+        let text = b.toml.replace("[imu]", "[imu]\ngrade = \"aviation\"");
+        let scn = Scenario::from_toml(&text, "dq").unwrap();
+        assert!(worth_caching(&scn, 2, Some(41.0)));
+        let o = McOptions {
+            until_s: Some(41.0),
+            ..opts(1)
+        };
+        let (job, s) = job(&scn, &o).unwrap();
+        let cache = TruthCache::build(&s, 2, job.every, o.until_s);
+        for hold in [true, false] {
+            let o = McOptions {
+                vertical_hold: hold,
+                ..o.clone()
+            };
+            for r in [0, 5] {
+                let a = run_one(&s, &o, job.every, r);
+                let c = cache.run(&s.imu.model, s.imu.seed, r, &o.algo, hold);
+                assert_eq!(a.len(), 5);
+                assert_eq!(a, c);
+            }
+        }
     }
 
     #[test]
