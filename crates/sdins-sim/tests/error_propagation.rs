@@ -162,6 +162,27 @@ fn t9_free_inertial_24h_matches_closed_form() {
             "{}: {diff:?} > {tol}",
             c.name
         );
+
+        // the same INS on the WGS-84 ellipsoid (R_M, R_N ≠ R0; g(37.5°) = 9.79949 equal):
+        // the spherical closed form still holds within the same tolerance
+        run.earth = sdins_core::earth::EarthModel::WGS84;
+        let ins = run.run().unwrap();
+        let mut dw = [0.0_f64; 2];
+        for e in &ins {
+            let cf = closed.eval(e.t_s);
+            for (ch, d) in dw.iter_mut().enumerate() {
+                *d = d.max((e.pos_err_ned_m[ch] - cf.dp_n[ch]).abs());
+            }
+        }
+        println!(
+            "    WGS-84 INS: max|INS-closed| N {:.1} m, E {:.1} m (tol {:.1} m)",
+            dw[0], dw[1], tol
+        );
+        assert!(
+            dw[0] <= tol && dw[1] <= tol,
+            "{} (WGS-84): {dw:?} > {tol}",
+            c.name
+        );
     }
 }
 
