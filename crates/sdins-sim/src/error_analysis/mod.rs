@@ -15,7 +15,7 @@
 //!   covariance propagation `P = ΦPΦᵀ + Q`.
 //! * [`schuler_share`]: the reconstruction of the paper's Table 1 (spec §4.4).
 //! * [`nonlinear`]: stationary nonlinear free-inertial runs with injected biases (§6 T9).
-//! * [`reference`]: reference trajectories and error statistics for the linear model from
+//! * [`reference`](mod@reference): reference trajectories and error statistics for the linear model from
 //!   scenarios and IMU error models.
 //! * [`grades`]: the sensor-grade bias/noise values of spec §4.5 used here.
 

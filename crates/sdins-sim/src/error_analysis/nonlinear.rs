@@ -49,7 +49,7 @@ pub struct NonlinearRun {
     pub rpy_deg: [f64; 3],
     /// body gyro bias [°/h]
     pub gyro_bias_dph: [f64; 3],
-    /// body accelerometer bias [μg]
+    /// body accelerometer bias \[μg\]
     pub accel_bias_ug: [f64; 3],
     /// initial attitude error φ0 (convention G) \[rad\]
     pub phi0: Vec3,

@@ -38,7 +38,7 @@ pub struct McJob {
     pub block: u64,
     /// navigation updates between output epochs
     pub every: u64,
-    /// stop time [s] (None: whole scenario)
+    /// stop time \[s\] (None: whole scenario)
     #[serde(with = "super::bits::opt")]
     pub until_s: Option<f64>,
     /// vertical channel held to the truth

@@ -19,7 +19,7 @@ use sdins_core::coning::Increment;
 use sdins_core::earth::EarthModel;
 use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, Mechanization};
 
-/// Largest cache built automatically [bytes].
+/// Largest cache built automatically (bytes).
 pub const MAX_CACHE_BYTES: u64 = 1 << 30;
 
 /// The cached truth of one scenario for a given N and epoch spacing.
