@@ -110,6 +110,14 @@ fn t9_cases() -> Vec<T9Case> {
 #[ignore = "24 h nonlinear runs; release mode: cargo test --release -- --ignored"]
 fn t9_free_inertial_24h_matches_closed_form() {
     let p = SchulerParams::T9;
+    // the algorithm's own error over 24 h without sensor errors
+    let ideal = NonlinearRun::stationary(L, &p, 86_400.0).run().unwrap();
+    let own = ideal
+        .iter()
+        .map(|e| e.pos_err_ned_m[0].hypot(e.pos_err_ned_m[1]))
+        .fold(0.0, f64::max);
+    println!("T9 ideal sensors: max horizontal error {own:.2e} m");
+    assert!(own < 1e-3, "{own}");
     for c in t9_cases() {
         let mut run = NonlinearRun::stationary(L, &p, 86_400.0);
         run.gyro_bias_dph = c.gyro_dph;
