@@ -46,6 +46,10 @@ enum Command {
     Errors(cmd::errors::Args),
     /// Initial alignment: coarse 1-/2-step, Kalman fine, multi-heading; observability.
     Align(cmd::align::Args),
+    /// Monte Carlo: N seeded runs with the scenario's IMU errors, per-epoch statistics.
+    Montecarlo(cmd::montecarlo::Args),
+    /// Merge Monte Carlo shard states exactly into the statistics of the whole job.
+    Merge(cmd::merge::Args),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +64,8 @@ fn main() -> ExitCode {
         Command::Allan(a) => cmd::allan::run(a),
         Command::Errors(a) => cmd::errors::run(a),
         Command::Align(a) => cmd::align::run(a),
+        Command::Montecarlo(a) => cmd::montecarlo::run(a),
+        Command::Merge(a) => cmd::merge::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -19,6 +19,7 @@ use sdins_sim::error_analysis::linear_model::{
     propagate, stationary_samples, EnvelopePoint, ErrorVector, ModelEarth, ModelOptions,
     ProcessNoise, VerticalChannel,
 };
+use sdins_sim::error_analysis::nonlinear::NonlinearRun;
 use sdins_sim::error_analysis::periods::SchulerParams;
 use sdins_sim::error_analysis::schuler_share::{schuler_share_table_p2, ShareRow, T_STAR_S};
 use sdins_sim::error_analysis::stationary::{
@@ -53,6 +54,9 @@ pub struct Args {
     /// print the Schuler-share table (reconstruction of [P2] Table 1) instead
     #[arg(long)]
     pub schuler_share: bool,
+    /// skip the nonlinear simulation column
+    #[arg(long)]
+    pub no_nonlinear: bool,
     /// JSON output on stdout
     #[arg(long)]
     pub json: bool,
@@ -68,27 +72,50 @@ struct Epoch {
     t_h: f64,
     closed_form: StationarySolution,
     linear: EnvelopePoint,
-    /// TODO(issue 6, nonlinear part): the nonlinear free-inertial simulation column goes
-    /// here (filled by [`nonlinear_column`]); `null` until then.
+    /// the nonlinear free-inertial simulation at this epoch (`null` with `--no-nonlinear`)
     nonlinear: Option<NonlinearPoint>,
 }
 
-/// Placeholder for the nonlinear-simulation result at one epoch.
+/// Nonlinear-simulation errors at one epoch.
 #[derive(serde::Serialize, Clone, Copy)]
 struct NonlinearPoint {
+    /// position error N, E, D \[m\]
     dp_n_m: [f64; 3],
+    /// attitude error ε (convention G) \[rad\]
     phi: [f64; 3],
 }
 
-/// TODO(issue 6, nonlinear part): run the nonlinear stationary INS (vertical channel held,
-/// same biases, spec §6 T9) and return its errors at `t_h`. Returns `None` until someone
-/// implements it; the table prints "—" and the JSON `null`.
+/// The nonlinear column: a full nonlinear free-inertial run
+/// ([`NonlinearRun`], spec §6 T9 set-up): stationary, body = NED at `lat_rad` (so the NED
+/// biases are the body biases, injected as a custom `ImuErrorModel` with fixed
+/// `gyro_bias_dph`/`accel_bias_ug`), spherical earth with the closed form's constants
+/// (R0, g, Ω), 20 Hz IMU, `songlee-complete` with N = 2, vertical channel held; run once
+/// to the last epoch and read at every epoch of `hours`.
 fn nonlinear_column(
-    _lat_rad: f64,
-    _errors: &StationaryErrors,
-    _t_h: f64,
-) -> Option<NonlinearPoint> {
-    None
+    lat_rad: f64,
+    params: &SchulerParams,
+    gyro_dph: &Vec3,
+    accel_ug: &Vec3,
+    hours: &[f64],
+) -> Result<Vec<Option<NonlinearPoint>>, CliError> {
+    let last = hours.iter().copied().fold(0.0, f64::max);
+    let mut run = NonlinearRun::stationary(lat_rad, params, last * 3600.0);
+    run.gyro_bias_dph = (*gyro_dph).into();
+    run.accel_bias_ug = (*accel_ug).into();
+    let errs = run.run().map_err(|e| CliError::Other(e.to_string()))?;
+    Ok(hours
+        .iter()
+        .map(|h| {
+            let t = h * 3600.0;
+            errs.iter()
+                .min_by(|a, b| (a.t_s - t).abs().total_cmp(&(b.t_s - t).abs()))
+                .filter(|e| (e.t_s - t).abs() <= 0.5 * run.every_s + 1e-6)
+                .map(|e| NonlinearPoint {
+                    dp_n_m: e.pos_err_ned_m,
+                    phi: e.att_err_rad,
+                })
+        })
+        .collect())
 }
 
 #[derive(serde::Serialize)]
@@ -201,9 +228,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .filter(|h| *h < args.hours - 1e-9)
         .collect();
     hours.push(args.hours);
+    let nonlinear = if args.no_nonlinear {
+        vec![None; hours.len()]
+    } else {
+        nonlinear_column(lat, &params, &gyro_dph, &accel_ug, &hours)?
+    };
     let epochs: Vec<Epoch> = hours
         .iter()
-        .map(|&h| {
+        .zip(nonlinear)
+        .map(|(&h, nonlinear)| {
             let t = h * 3600.0;
             let k = ((t / DT_S).round() as usize).min(env.len().saturating_sub(1));
             let linear = env.get(k).copied().unwrap_or_default();
@@ -211,7 +244,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 t_h: h,
                 closed_form: closed.eval(t),
                 linear,
-                nonlinear: nonlinear_column(lat, &errors, h),
+                nonlinear,
             }
         })
         .collect();
@@ -249,38 +282,44 @@ fn print_table(r: &Report<'_>) {
             .unwrap_or_default()
     );
     println!(
-        "closed = spec §4.3 closed form; linear = 15-state model (same biases); 1σ = covariance with the biases as 1σ"
+        "closed = spec §4.3 closed form; nonlin = nonlinear INS (body = NED, spherical earth R0/g, 20 Hz, songlee-complete, vertical held);\nlinear = 15-state model (same biases); 1σ = covariance with the biases as 1σ"
     );
     println!(
-        "{:>6} | {:>10} {:>10} | {:>10} {:>10} | {:>9} {:>9} | {:>9} {:>9} | {:>9}",
+        "{:>6} | {:>10} {:>10} | {:>10} {:>10} | {:>10} {:>10} | {:>9} {:>9} | {:>9} {:>9} {:>9}",
         "t [h]",
         "dpN clsd",
         "dpE clsd",
+        "dpN nonlin",
+        "dpE nonlin",
         "dpN lin",
         "dpE lin",
         "1σ N",
         "1σ E",
         "φD [mrad]",
-        "1σ φD",
-        "nonlinear"
+        "φD nonlin",
+        "1σ φD"
     );
     for e in &r.epochs {
-        let nl = e
-            .nonlinear
-            .map(|n| format!("{:.0},{:.0}", n.dp_n_m[0], n.dp_n_m[1]))
-            .unwrap_or_else(|| "—".to_string());
+        let nl = |f: &dyn Fn(&NonlinearPoint) -> String| {
+            e.nonlinear
+                .as_ref()
+                .map(f)
+                .unwrap_or_else(|| "—".to_string())
+        };
         println!(
-            "{:>6.2} | {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>9.1} {:>9.1} | {:>9.4} {:>9.4} | {:>9}",
+            "{:>6.2} | {:>10.1} {:>10.1} | {:>10} {:>10} | {:>10.1} {:>10.1} | {:>9.1} {:>9.1} | {:>9.4} {:>9} {:>9.4}",
             e.t_h,
             e.closed_form.dp_n[0],
             e.closed_form.dp_n[1],
+            nl(&|n| format!("{:.1}", n.dp_n_m[0])),
+            nl(&|n| format!("{:.1}", n.dp_n_m[1])),
             e.linear.dp_n_m[0],
             e.linear.dp_n_m[1],
             e.linear.sigma_p_m[0],
             e.linear.sigma_p_m[1],
             e.closed_form.phi[2] * 1e3,
-            e.linear.sigma_phi[2] * 1e3,
-            nl
+            nl(&|n| format!("{:.4}", n.phi[2] * 1e3)),
+            e.linear.sigma_phi[2] * 1e3
         );
     }
 }
@@ -324,6 +363,7 @@ mod tests {
             hours: 2.0,
             lat: 37.5,
             schuler_share: false,
+            no_nonlinear: false,
             json: true,
         }
     }
@@ -349,8 +389,40 @@ mod tests {
         assert_eq!(CliError::bad("x").exit_code(), 2);
     }
 
+    /// The nonlinear column follows the closed form (east gyro 0.01 °/h, 2 h: spec §6 T9
+    /// INS −2011 m, closed form −2013 m; tolerance 1 % of the peak + 50 m).
     #[test]
-    fn nonlinear_hook_is_empty_until_implemented() {
-        assert!(nonlinear_column(0.6, &StationaryErrors::default(), 1.0).is_none());
+    #[allow(clippy::unwrap_used)]
+    fn nonlinear_column_matches_closed_form() {
+        let lat = 37.5_f64.to_radians();
+        let p = SchulerParams::T9;
+        let col = nonlinear_column(
+            lat,
+            &p,
+            &Vec3::new(0.0, 0.01, 0.0),
+            &Vec3::zeros(),
+            &[1.0, 2.0],
+        )
+        .unwrap();
+        let closed = StationaryClosedForm::new(
+            lat,
+            &StationaryErrors {
+                eps_n: Vec3::new(0.0, 0.01, 0.0) * DEG_PER_HOUR,
+                ..Default::default()
+            },
+            p,
+        );
+        for (h, n) in [1.0, 2.0].iter().zip(&col) {
+            let n = n.unwrap();
+            let c = closed.eval(h * 3600.0);
+            assert!((n.dp_n_m[0] - c.dp_n[0]).abs() < 0.01 * 2013.0 + 50.0);
+            assert!(
+                (n.phi[2] - c.phi[2]).abs() < 2e-5,
+                "{} vs {}",
+                n.phi[2],
+                c.phi[2]
+            );
+        }
+        assert!((col[1].unwrap().dp_n_m[0] + 2011.0).abs() < 5.0);
     }
 }

@@ -5,6 +5,8 @@ pub mod align_plot;
 pub mod allan;
 pub mod demo;
 pub mod errors;
+pub mod merge;
+pub mod montecarlo;
 pub mod nav;
 pub mod run;
 pub mod scenarios;

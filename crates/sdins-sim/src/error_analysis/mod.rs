@@ -14,11 +14,16 @@
 //! * [`linear_model`]: the 15-state phi-angle error model along any trajectory and the
 //!   covariance propagation `P = ΦPΦᵀ + Q`.
 //! * [`schuler_share`]: the reconstruction of the paper's Table 1 (spec §4.4).
+//! * [`nonlinear`]: stationary nonlinear free-inertial runs with injected biases (§6 T9).
+//! * [`reference`](mod@reference): reference trajectories and error statistics for the linear model from
+//!   scenarios and IMU error models.
 //! * [`grades`]: the sensor-grade bias/noise values of spec §4.5 used here.
 
 pub mod grades;
 pub mod linear_model;
+pub mod nonlinear;
 pub mod periods;
+pub mod reference;
 pub mod schuler_share;
 pub mod short_term;
 pub mod stationary;

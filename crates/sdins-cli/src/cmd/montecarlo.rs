@@ -1,0 +1,244 @@
+//! `sdins montecarlo`: N seeded realisations of a scenario with its IMU error model,
+//! per-epoch error statistics, and a lossless shard state for `sdins merge`.
+//!
+//! Writes into `--out DIR`:
+//! * `mc_stats.csv` — `t_s` and, per channel (position/velocity/attitude error N, E, D),
+//!   mean, σ, p05, p50, p95 (see `sdins_sim::montecarlo::stats`);
+//! * `mc_state.json` — the raw accumulator state (every f64 as its IEEE bit pattern), the
+//!   input of `sdins merge`.
+//!
+//! With `--shard i/n` only the blocks of shard i are computed (see `docs/montecarlo.md`);
+//! `mc_stats.csv` then covers that shard's runs only.
+
+use crate::error::CliError;
+use crate::output::write_string;
+use crate::progress::Progress;
+use sdins_core::nav::AlgorithmSpec;
+use sdins_sim::imu_error::ImuErrorModel;
+use sdins_sim::montecarlo::runner::shard_runs;
+use sdins_sim::montecarlo::{run_shard, McError, McOptions, McState, McStats, Shard};
+use sdins_sim::scenario::Scenario;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Arguments of `sdins montecarlo`.
+#[derive(clap::Args, Debug, Clone)]
+#[command(
+    after_help = "Examples:\n  sdins montecarlo mach1-east --grade aviation --runs 1000 --seed 1 --out mc\n  \
+    sdins montecarlo my.toml --runs 1000 --seed 1 --shard 0/4 --out mc/shard0 --quiet\n  \
+    sdins merge mc/shard0 mc/shard1 mc/shard2 mc/shard3 --out mc/all"
+)]
+pub struct Args {
+    /// built-in scenario name or scenario file (its [imu] grade/errors are the error model)
+    pub scenario: String,
+    /// number of runs N (all shards must use the same N)
+    #[arg(long)]
+    pub runs: u64,
+    /// seed of the sensor-error streams (replaces the scenario's [imu] seed)
+    #[arg(long)]
+    pub seed: u64,
+    /// algorithm: savage, songlee, songlee-complete, dualquat
+    #[arg(long, default_value = "songlee-complete")]
+    pub algo: String,
+    /// IMU samples per navigation update (default: the scenario's)
+    #[arg(long)]
+    pub samples: Option<usize>,
+    /// IMU grade preset replacing the scenario's error model (marine, aviation, intermediate, tactical, consumer)
+    #[arg(long)]
+    pub grade: Option<String>,
+    /// compute shard i of n (0-based, e.g. 2/8); shards are whole blocks of runs
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// output epoch spacing [s]
+    #[arg(long, default_value_t = 10.0)]
+    pub every_s: f64,
+    /// stop after this time [s] (default: whole scenario)
+    #[arg(long)]
+    pub until_s: Option<f64>,
+    /// vertical channel: hold (default for Monte Carlo) or free
+    #[arg(long, default_value = "hold")]
+    pub vertical: String,
+    /// runs per block K (all shards must use the same K)
+    #[arg(long, default_value_t = sdins_sim::montecarlo::DEFAULT_BLOCK)]
+    pub block: u64,
+    /// worker threads (default: all cores)
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// output folder (default ./sdins-out/mc-<scenario>)
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// print a JSON summary on stdout
+    #[arg(long)]
+    pub json: bool,
+    /// no progress bar
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Map a library error to the CLI's exit codes.
+pub fn mc_err(e: McError) -> CliError {
+    match e {
+        McError::Interrupted => CliError::Other("interrupted: no output written".into()),
+        McError::Config(_)
+        | McError::Model(_)
+        | McError::Mismatch(_)
+        | McError::DuplicateBlock(_)
+        | McError::BadState(_) => CliError::bad(e.to_string()),
+        other => CliError::Other(other.to_string()),
+    }
+}
+
+/// Write `mc_stats.csv` and `mc_state.json` into `dir`.
+pub fn write_outputs(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliError> {
+    let json = serde_json::to_string(state).map_err(|e| CliError::Other(e.to_string()))?;
+    write_string(&dir.join("mc_state.json"), &json)?;
+    write_string(&dir.join("mc_stats.csv"), &stats.to_csv())
+}
+
+/// Summary printed after a run or merge.
+pub fn summary_json(state: &McState, stats: &McStats, out: &Path) -> serde_json::Value {
+    let last = stats.cells.last();
+    serde_json::json!({
+        "job": state.job,
+        "runs_included": stats.runs,
+        "complete": stats.complete,
+        "missing_blocks": state.missing_blocks(),
+        "epochs": stats.times_s.len(),
+        "final_t_s": stats.times_s.last(),
+        "final": last.map(|row| {
+            sdins_sim::montecarlo::CHANNELS
+                .iter()
+                .zip(row.iter())
+                .map(|(c, s)| (c.to_string(), serde_json::json!(s)))
+                .collect::<serde_json::Map<_, _>>()
+        }),
+        "out": out.display().to_string(),
+    })
+}
+
+/// Print a short table of the final epoch.
+pub fn print_summary(state: &McState, stats: &McStats, out: &Path) {
+    println!(
+        "Monte Carlo {} / {}: {} of {} runs (seed {}, block {}), {} epochs{}",
+        state.job.scenario,
+        state.job.algo,
+        stats.runs,
+        state.job.runs,
+        state.job.seed,
+        state.job.block,
+        stats.times_s.len(),
+        if stats.complete {
+            ""
+        } else {
+            " — INCOMPLETE (missing blocks)"
+        }
+    );
+    if let (Some(t), Some(row)) = (stats.times_s.last(), stats.cells.last()) {
+        println!("final epoch t = {t} s");
+        println!(
+            "{:>10} {:>12} {:>12} {:>12} {:>12} {:>12}",
+            "channel", "mean", "sigma", "p05", "p50", "p95"
+        );
+        for (c, s) in sdins_sim::montecarlo::CHANNELS.iter().zip(row.iter()) {
+            println!(
+                "{c:>10} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e}",
+                s.mean, s.sigma, s.p05, s.p50, s.p95
+            );
+        }
+    }
+    println!("files in {}", out.display());
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let mut scn = Scenario::load(&args.scenario)?;
+    if let Some(g) = &args.grade {
+        scn.imu.model =
+            ImuErrorModel::preset(g).map_err(|e| CliError::bad(format!("--grade: {e}")))?;
+        scn.imu.grade = Some(g.clone());
+    }
+    if scn.imu.model == ImuErrorModel::ideal() && !args.quiet {
+        eprintln!(
+            "sdins: warning: scenario {} has ideal sensors (no [imu] grade/errors and no --grade): every run is the same",
+            scn.name
+        );
+    }
+    let n = args.samples.unwrap_or(scn.nav.samples);
+    let algo = AlgorithmSpec::from_name(&args.algo, n).ok_or_else(|| {
+        CliError::bad(format!(
+            "--algo {}: expected savage, songlee, songlee-complete or dualquat",
+            args.algo
+        ))
+    })?;
+    if !(1..=4).contains(&n) {
+        return Err(CliError::bad(format!("--samples {n}: expected 1..=4")));
+    }
+    let vertical_hold = match args.vertical.as_str() {
+        "hold" => true,
+        "free" => false,
+        o => {
+            return Err(CliError::bad(format!(
+                "--vertical {o}: expected hold or free"
+            )))
+        }
+    };
+    if let Some(u) = args.until_s {
+        if !(u.is_finite() && u > 0.0) {
+            return Err(CliError::bad(format!("--until-s {u}: expected > 0")));
+        }
+    }
+    let shard = match &args.shard {
+        None => Shard::ALL,
+        Some(s) => Shard::parse(s).map_err(|e| CliError::bad(format!("--shard: {e}")))?,
+    };
+    let opts = McOptions {
+        runs: args.runs,
+        seed: args.seed,
+        algo,
+        every_s: args.every_s,
+        until_s: args.until_s,
+        block: args.block,
+        vertical_hold,
+    };
+    let out = args.out.clone().unwrap_or_else(|| {
+        PathBuf::from(match args.shard {
+            None => format!("sdins-out/mc-{}", scn.name),
+            Some(_) => format!("sdins-out/mc-{}-shard{}", scn.name, shard.index),
+        })
+    });
+    let total = shard_runs(&opts, shard);
+    let bar = Mutex::new((Progress::new(total, "runs", args.quiet), 0_u64));
+    let on_run = || {
+        if let Ok(mut g) = bar.lock() {
+            g.1 += 1;
+            let done = g.1;
+            g.0.set(done);
+        }
+    };
+    let cancelled = crate::progress::interrupted;
+    let compute = || run_shard(&scn, &opts, shard, &on_run, &cancelled);
+    let result = match args.threads {
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t.max(1))
+            .build()
+            .map_err(|e| CliError::Other(e.to_string()))?
+            .install(compute),
+        None => compute(),
+    };
+    if let Ok(g) = bar.lock() {
+        g.0.finish();
+    }
+    let state = result.map_err(mc_err)?;
+    let stats = state.statistics();
+    write_outputs(&out, &state, &stats)?;
+    if args.json {
+        let v = summary_json(&state, &stats, &out);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?
+        );
+    } else {
+        print_summary(&state, &stats, &out);
+    }
+    Ok(())
+}
