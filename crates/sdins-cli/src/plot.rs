@@ -108,7 +108,14 @@ fn draw_panel<DB: DrawingBackend>(
                 .y_desc(p.y_label.as_str())
                 .label_style(("sans-serif", 13))
                 .axis_desc_style(("sans-serif", 15))
-                .y_label_formatter(&|v| format!("{:.0e}", v))
+                .y_label_formatter(&|v| {
+                    let big = y0.abs().max(y1.abs());
+                    if p.log_y || !(1e-2..1e4).contains(&big) {
+                        format!("{:.1e}", v)
+                    } else {
+                        format!("{:.3}", v)
+                    }
+                })
                 .draw()
                 .map_err(|e| e.to_string())?;
             for (k, s) in p.series.iter().enumerate() {

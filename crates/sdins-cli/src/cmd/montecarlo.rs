@@ -88,11 +88,118 @@ pub fn mc_err(e: McError) -> CliError {
     }
 }
 
-/// Write `mc_stats.csv` and `mc_state.json` into `dir`.
+/// Write `mc_stats.csv`, `mc_state.json`, the envelope plot (`envelopes.png`), the
+/// report (`report.html`) and `run.toml` into `dir`.
 pub fn write_outputs(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliError> {
     let json = serde_json::to_string(state).map_err(|e| CliError::Other(e.to_string()))?;
     write_string(&dir.join("mc_state.json"), &json)?;
-    write_string(&dir.join("mc_stats.csv"), &stats.to_csv())
+    write_string(&dir.join("mc_stats.csv"), &stats.to_csv())?;
+    write_report(dir, state, stats)
+}
+
+/// Envelopes per channel group: mean and mean ± σ of the N and E errors (the percentiles
+/// are in the table and the CSV).
+fn envelope_figure(stats: &McStats) -> crate::plot::Figure {
+    use crate::plot::{Figure, Panel, Series};
+    let names = sdins_sim::montecarlo::CHANNELS;
+    let panel = |title: &str, unit: &str, first: usize| {
+        let mut series = Vec::new();
+        for (k, axis) in ["N", "E"].iter().enumerate() {
+            let c = first + k;
+            let pick =
+                |f: &dyn Fn(&sdins_sim::montecarlo::ChannelStats) -> f64| -> Vec<(f64, f64)> {
+                    stats
+                        .times_s
+                        .iter()
+                        .zip(&stats.cells)
+                        .map(|(t, row)| (*t, f(&row[c])))
+                        .collect()
+                };
+            series.push(Series {
+                name: format!("{axis} mean"),
+                points: pick(&|x| x.mean),
+            });
+            series.push(Series {
+                name: format!("{axis} mean+σ"),
+                points: pick(&|x| x.mean + x.sigma),
+            });
+            series.push(Series {
+                name: format!("{axis} mean−σ"),
+                points: pick(&|x| x.mean - x.sigma),
+            });
+        }
+        let _ = names;
+        Panel {
+            title: title.to_string(),
+            x_label: "time [s]".into(),
+            y_label: unit.to_string(),
+            log_y: false,
+            series,
+        }
+    };
+    Figure {
+        panels: vec![
+            panel("position error envelope", "error [m]", 0),
+            panel("velocity error envelope", "error [m/s]", 3),
+            panel("attitude error envelope", "error [rad]", 6),
+        ],
+        cols: 3,
+        size: (1800, 520),
+    }
+}
+
+fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliError> {
+    let job = &state.job;
+    let mut r = crate::report::Report::new(&format!("sdins montecarlo: {}", job.scenario));
+    r.para(&format!(
+        "{} runs ({} included{}), algorithm {} with {} samples per update, seed {}, vertical channel {}.",
+        job.runs,
+        stats.runs,
+        if stats.complete { "" } else { ", partial" },
+        job.algo,
+        job.samples,
+        job.seed,
+        if job.vertical_hold { "held" } else { "free" }
+    ));
+    if let (Some(t), Some(row)) = (stats.times_s.last(), stats.cells.last()) {
+        let rows: Vec<Vec<String>> = sdins_sim::montecarlo::CHANNELS
+            .iter()
+            .zip(row.iter())
+            .map(|(n, c)| {
+                vec![
+                    n.to_string(),
+                    format!("{:.4e}", c.mean),
+                    format!("{:.4e}", c.sigma),
+                    format!("{:.4e}", c.p05),
+                    format!("{:.4e}", c.p50),
+                    format!("{:.4e}", c.p95),
+                ]
+            })
+            .collect();
+        r.para(&format!("Statistics at the last epoch, t = {t} s:"));
+        r.table(&["channel", "mean", "σ", "p05", "p50", "p95"], &rows);
+    }
+    let fig = envelope_figure(stats);
+    r.figure(&fig, "North and east error envelopes over the runs: mean and mean ± σ (percentiles in the table and mc_stats.csv).")?;
+    fig.png(&dir.join("envelopes.png"))?;
+    r.write(&dir.join("report.html"))?;
+    let mut t = toml::Table::new();
+    t.insert("sdins_version".into(), env!("CARGO_PKG_VERSION").into());
+    t.insert("git_commit".into(), crate::report::git_commit().into());
+    t.insert(
+        "command".into(),
+        std::env::args().collect::<Vec<_>>().join(" ").into(),
+    );
+    t.insert("scenario".into(), job.scenario.clone().into());
+    t.insert(
+        "scenario_fingerprint".into(),
+        job.fingerprint.clone().into(),
+    );
+    t.insert("algo".into(), job.algo.clone().into());
+    t.insert("runs".into(), (job.runs as i64).into());
+    t.insert("seed".into(), (job.seed as i64).into());
+    let text = toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?;
+    write_string(&dir.join("run.toml"), &text)
 }
 
 /// Summary printed after a run or merge.
