@@ -188,9 +188,11 @@ fn stationary_72h_vertical_hold_matches_closed_form() {
             s.algo, last[i][0], last[i][1], c.dp_n[0], c.dp_n[1], 100.0 * dev / amp, s.wall_s
         );
         assert!(ortho < 1e-14, "{}: ortho {ortho:e}", s.algo);
-        // the closed form's spherical earth (R0 = 6371 km vs √(R_M R_N)) and ignored
-        // Coriolis coupling in the slow response are O(r² ≈ 3.5e-3) and O(e²) effects
-        assert!(dev <= 0.02 * amp, "{}: {dev} m of {amp} m", s.algo);
+        // The closed form uses a spherical earth: the east drift scales with R0 = 6371 km
+        // where the mechanization has R_N + h = 6386 km at 37.5° (+0.24 %); the slow-gain and
+        // Coriolis approximations of the model are O(r² = (Ω/ω_s)² ≈ 3.5e-3) on the 24 h
+        // terms. Measured: 0.35 % (178.6 m of 50.4 km), SLC and DQ within 0.1 m.
+        assert!(dev <= 0.005 * amp, "{}: {dev} m of {amp} m", s.algo);
     }
 }
 
