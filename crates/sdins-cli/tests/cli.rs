@@ -314,3 +314,220 @@ fn nav_psins_trj10ms_through_the_cli() {
         "{row:?}"
     );
 }
+
+const IMU_H: &str = "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n";
+
+fn imu_rows(n: usize) -> String {
+    (0..n)
+        .map(|k| format!("{:.2},0,0,0,0,0,-0.098\n", 0.01 * (k + 1) as f64))
+        .collect()
+}
+
+/// Every IMU-file input class through `sdins nav`: exit 2, message naming the file, line,
+/// column and what was expected.
+#[test]
+fn nav_imu_file_classes_exit_2_with_file_line_column() {
+    let d = tmp("imuclasses");
+    let r3 = imu_rows(3);
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("empty.csv", String::new(), "empty.csv: empty file, expected an IMU record"),
+        ("header.csv", IMU_H.into(), "header.csv:1: header only, expected data rows after it"),
+        ("truncated.csv", format!("{IMU_H}{r3}0.04,0,0"), "truncated.csv:5: truncated last line: 3 of 7 fields and no final newline"),
+        ("columns.csv", format!("{IMU_H}0.01,0,0,0,0,-0.098\n{r3}"), "columns.csv:2: expected 7 fields, found 6"),
+        ("text.csv", format!("{IMU_H}{r3}0.04,0,x1,0,0,0,-0.098\n"), "text.csv:5: column 3 (dtheta_y_rad): expected a number, found `x1`"),
+        ("nan.csv", format!("{IMU_H}{r3}0.04,0,0,0,NaN,0,-0.098\n"), "nan.csv:5: column 5 (dv_x_mps): expected a finite number, found `NaN`"),
+        ("inf.csv", format!("{IMU_H}{r3}0.04,0,0,0,0,0,-inf\n"), "inf.csv:5: column 7 (dv_z_mps): expected a finite number, found `-inf`"),
+        ("back.csv", format!("{IMU_H}{r3}0.02,0,0,0,0,0,-0.098\n"), "back.csv:5: column 1 (time): expected a time after 0.03 s, found 0.02 s"),
+        ("repeat.csv", format!("{IMU_H}{r3}0.03,0,0,0,0,0,-0.098\n"), "repeat.csv:5: column 1 (time): expected a time after 0.03 s, found 0.03 s"),
+        ("irregular.csv", format!("{IMU_H}{r3}0.0403,0,0,0,0,0,-0.098\n"), "irregular.csv:5: column 1 (time): sample interval"),
+        ("spin.csv", format!("{IMU_H}{r3}0.04,3.2,0,0,0,0,-0.098\n"), "spin.csv:5: columns 2-4: |Δθ| per sample [rad] = 3.2e0, expected at most 3.141592653589793e0"),
+        ("force.csv", format!("{IMU_H}{r3}0.04,0,0,0,0,0,-98.1\n"), "force.csv:5: columns 5-7: |f| [m/s²] = 9.81e3, expected at most 9.80665e3"),
+        ("unknown.csv", "a,b,c\n1,2,3\n".into(), "unknown.csv:1: cannot detect the IMU format"),
+    ];
+    for (name, text, want) in cases {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        let (code, _, err) = sdins(&[
+            "nav",
+            "--imu",
+            p.to_str().unwrap(),
+            "--init",
+            "37.5,127,0,0,0,0,0,0,0",
+            "--out",
+            d.join("o").to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(err.contains(want), "{name}: want `{want}` in `{err}`");
+        assert!(!err.contains("panicked"), "{name}: {err}");
+    }
+    // nothing was written for any of them
+    assert!(!d.join("o").exists() || std::fs::read_dir(d.join("o")).unwrap().count() == 0);
+}
+
+/// Scenario ranges and names: heights, latitudes beyond the pole limit, zero/negative
+/// durations and rates, unknown algorithm names (with a hint), unknown keys.
+#[test]
+fn scenario_ranges_and_names_exit_2() {
+    let d = tmp("scnranges");
+    let with_nav = |nav: &str| GOOD.replace("[[segment]]", &format!("[nav]\n{nav}\n[[segment]]"));
+    for (name, text, want) in [
+        ("hlow.toml", GOOD.replace("lon_deg = 127.0", "lon_deg = 127.0\nh_m = -1500.0"), "hlow.toml:4: start.h_m: -1500 is out of range: expected height in [-1000, 100000] m"),
+        ("hhigh.toml", GOOD.replace("lon_deg = 127.0", "lon_deg = 127.0\nh_m = 100001.0"), "hhigh.toml:4: start.h_m: 100001 is out of range: expected height in [-1000, 100000] m"),
+        ("pole.toml", GOOD.replace("lat_deg = 37.5", "lat_deg = -89.995"), "pole.toml:2: start.lat_deg: -89.995 is too close to a pole"),
+        ("lat.toml", GOOD.replace("lat_deg = 37.5", "lat_deg = 90.5"), "lat.toml:2: start.lat_deg: 90.5 is out of range: expected latitude in [-90, 90] deg"),
+        ("latnan.toml", GOOD.replace("lat_deg = 37.5", "lat_deg = nan"), "latnan.toml:2: start.lat_deg: must be a finite number"),
+        ("dur0.toml", GOOD.replace("duration_s = 1.0", "duration_s = 0.0"), "dur0.toml:8: segment.duration_s: 0 must be > 0"),
+        ("durlong.toml", GOOD.replace("duration_s = 1.0", "duration_s = 1e9"), "durlong.toml:8: segment.duration_s: 1000000000 s is too long"),
+        ("rateneg.toml", GOOD.replace("rate_hz = 100.0", "rate_hz = -100.0"), "rateneg.toml:5: imu.rate_hz: -100 must be > 0"),
+        ("algo.toml", with_nav("algos = [\"songle\"]"), "algo.toml:7: nav.algos: unknown algorithm `songle` (did you mean `songlee`?): expected savage, songlee, songlee-complete, dualquat"),
+        ("coning.toml", with_nav("samples = 2\nconing = \"three_poly\""), "coning.toml:8: nav.coning: `three_poly` is the set for 3 samples per update, but nav.samples is 2"),
+        ("key.toml", with_nav("vertcal = \"hold\""), "key.toml:7: vertcal: unknown key (did you mean `vertical`?)"),
+    ] {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        let (code, _, err) = sdins(&["truth", p.to_str().unwrap(), "--out", d.join("o").to_str().unwrap()]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(err.contains(want), "{name}: want `{want}` in `{err}`");
+    }
+}
+
+fn truth_and_imu(d: &std::path::Path) {
+    let p = d.join("s.toml");
+    std::fs::write(&p, GOOD).unwrap();
+    let (code, _, err) = sdins(&[
+        "truth",
+        p.to_str().unwrap(),
+        "--out",
+        d.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+}
+
+/// `sdins nav --truth` with a reference on another time base is an error naming both
+/// files (it used to compare nothing), as is a reference whose first row is not at the
+/// start epoch when it provides the initial state. (No command takes both a rate and an
+/// IMU file: `nav` derives the rate from the file, so the time bases are what is checked.)
+#[test]
+fn nav_truth_time_base_mismatch_exit_2() {
+    let d = tmp("timebase");
+    truth_and_imu(&d);
+    let truth = std::fs::read_to_string(d.join("truth.csv")).unwrap();
+    // shift every reference time by 1000 s
+    let shifted: String = truth
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 0 {
+                format!("{l}\n")
+            } else {
+                let (t, rest) = l.split_once(',').unwrap();
+                format!("{},{rest}\n", t.parse::<f64>().unwrap() + 1000.0)
+            }
+        })
+        .collect();
+    let sh = d.join("shifted.csv");
+    std::fs::write(&sh, shifted).unwrap();
+    let imu = d.join("imu.csv");
+    let args = |t: &std::path::Path, init: bool| {
+        let mut v = vec![
+            "nav".to_string(),
+            "--imu".into(),
+            imu.to_str().unwrap().into(),
+            "--truth".into(),
+            t.to_str().unwrap().into(),
+            "--out".into(),
+            d.join("n").to_str().unwrap().into(),
+        ];
+        if init {
+            v.extend(["--init".into(), "37.5,127,0,0,0,0,0,0,0".into()]);
+        }
+        v
+    };
+    let run = |a: Vec<String>| sdins(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let (code, _, err) = run(args(&sh, true));
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("shifted.csv: no time matches an update epoch of")
+            && err.contains("imu.csv")
+            && err.contains("the reference covers 1000 s to 1001 s"),
+        "{err}"
+    );
+    let (code, _, err) = run(args(&sh, false));
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(
+            "shifted.csv: the first row (t = 1000 s) is not at the start of the first sample of"
+        ) && err.contains("give --init"),
+        "{err}"
+    );
+    assert!(!d.join("n").join("nav_songlee-complete.csv").exists());
+    // the matching pair still works
+    let (code, _, err) = run(args(&d.join("truth.csv"), false));
+    assert_eq!(code, 0, "{err}");
+}
+
+/// An output folder that cannot be created fails with exit 1, naming it, and leaves
+/// nothing behind.
+#[test]
+fn unwritable_output_leaves_no_file() {
+    let d = tmp("unwritable");
+    let blocker = d.join("file");
+    std::fs::write(&blocker, "x").unwrap();
+    let out = blocker.join("sub");
+    let (code, _, err) = sdins(&[
+        "truth",
+        "stationary",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("file/sub") || err.contains("file"), "{err}");
+    let names: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 1, "{names:?}");
+}
+
+/// Ctrl-C during `sdins truth`: the run stops with a message, a non-zero exit code and
+/// neither output file nor a temporary file.
+#[cfg(unix)]
+#[test]
+fn sigint_stops_cleanly_without_partial_files() {
+    use std::time::{Duration, Instant};
+    let d = tmp("sigint");
+    // 90 min at 500 Hz: 2.7 M samples, several seconds of work
+    let child = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args([
+            "truth",
+            "stationary",
+            "--quiet",
+            "--out",
+            d.to_str().unwrap(),
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // wait until the temporary files exist (the run is under way)
+    let start = Instant::now();
+    while std::fs::read_dir(&d).unwrap().count() < 2 && start.elapsed() < Duration::from_secs(20) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(200));
+    let st = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("interrupted"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}

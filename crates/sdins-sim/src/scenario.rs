@@ -13,6 +13,8 @@ use std::path::Path;
 use toml::Spanned;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
+/// Longest accepted segment [s] (keeps sample counts far from integer overflow).
+pub const MAX_SEGMENT_S: f64 = 1.0e7;
 
 /// A scenario error: where and what.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -153,7 +155,7 @@ struct ImuDoc {
 #[serde(deny_unknown_fields)]
 struct NavDoc {
     samples: Option<S<i64>>,
-    algos: Option<Vec<String>>,
+    algos: Option<S<Vec<String>>>,
     coning: Option<S<String>>,
     earth: Option<S<String>>,
     vertical: Option<S<String>>,
@@ -564,6 +566,13 @@ impl Scenario {
             let sd = s.get_ref();
             let kind = sd.kind.get_ref().as_str();
             let dur = cx.positive(&sd.duration_s, "segment.duration_s")?;
+            if dur > MAX_SEGMENT_S {
+                return cx.err(
+                    sd.duration_s.span(),
+                    "segment.duration_s",
+                    format!("{dur} s is too long: expected at most {MAX_SEGMENT_S:e} s (116 days)"),
+                );
+            }
             let n = dur / dt;
             if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
                 return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));
@@ -888,10 +897,51 @@ fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioEr
         cfg.substeps = v as usize;
     }
     if let Some(a) = &n.algos {
-        cfg.algos = a.clone();
+        for name in a.get_ref() {
+            if sdins_core::nav::AlgorithmKind::from_name(name).is_none() {
+                let names: Vec<&str> = sdins_core::nav::AlgorithmKind::ALL
+                    .iter()
+                    .map(|k| k.name())
+                    .collect();
+                let hint = suggest_from(name, &names)
+                    .map(|s| format!(" (did you mean `{s}`?)"))
+                    .unwrap_or_default();
+                return cx.err(
+                    a.span(),
+                    "nav.algos",
+                    format!(
+                        "unknown algorithm `{name}`{hint}: expected {}",
+                        names.join(", ")
+                    ),
+                );
+            }
+        }
+        cfg.algos = a.get_ref().clone();
     }
     if let Some(c) = &n.coning {
-        cfg.coning = Some(c.get_ref().clone());
+        let name = c.get_ref();
+        match sdins_core::coning::ConingSet::parse(name, cfg.samples) {
+            Some(set) if set.accepts(cfg.samples) => {}
+            Some(set) => {
+                return cx.err(
+                    c.span(),
+                    "nav.coning",
+                    format!(
+                        "`{name}` is the set for {} samples per update, but nav.samples is {}",
+                        set.samples(),
+                        cfg.samples
+                    ),
+                )
+            }
+            None => {
+                return cx.err(
+                    c.span(),
+                    "nav.coning",
+                    format!("unknown coning set `{name}`: expected none, 1prev, two, three_poly, three_opt, four_poly, four_opt, polynomial or optimal"),
+                )
+            }
+        }
+        cfg.coning = Some(name.clone());
     }
     if let Some(e) = &n.earth {
         cfg.earth = match e.get_ref().as_str() {

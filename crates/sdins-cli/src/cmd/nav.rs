@@ -93,6 +93,46 @@ fn parse_init(s: &str) -> Result<InitialState, CliError> {
     })
 }
 
+/// Fail unless at least one reference time falls on a navigation update epoch
+/// `t0 + k N δt` (k = 1..=updates) within 0.1 δt: otherwise `--truth` would silently
+/// compare nothing (different time bases, another trajectory, a decimated file that
+/// misses every epoch).
+pub fn check_time_bases(
+    truth: &[sdins_sim::truth::TruthSample],
+    truth_path: &std::path::Path,
+    imu_path: &std::path::Path,
+    t0: f64,
+    dt: f64,
+    samples: usize,
+    n_samples: usize,
+) -> Result<(), CliError> {
+    let upd = dt * samples.max(1) as f64;
+    let n_upd = n_samples / samples.max(1);
+    let tol = 0.1 * dt;
+    let matched = truth.iter().any(|r| {
+        let k = ((r.t_s - t0) / upd).round();
+        k >= 1.0 && k <= n_upd as f64 && (r.t_s - (t0 + k * upd)).abs() <= tol
+    });
+    if matched {
+        return Ok(());
+    }
+    let (first, last) = match (truth.first(), truth.last()) {
+        (Some(a), Some(b)) => (a.t_s, b.t_s),
+        _ => (f64::NAN, f64::NAN),
+    };
+    Err(CliError::bad(format!(
+        "{}: no time matches an update epoch of {}: the updates are at {} s + k·{} s up to {} s, the reference covers {} s to {} s (expected equal times within {} s; are the time bases the same?)",
+        truth_path.display(),
+        imu_path.display(),
+        t0,
+        upd,
+        t0 + n_upd as f64 * upd,
+        first,
+        last,
+        tol
+    )))
+}
+
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let format: ImuFormat = args.format.parse().map_err(CliError::BadInput)?;
@@ -115,8 +155,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let init = match (&args.init, &truth, &data.psins) {
         (Some(s), _, _) => parse_init(s)?,
         (None, Some(tr), _) if !tr.is_empty() => {
-            // the truth's first row is one sample after the start: use it only if it is at t0
+            // the state at the start of the first IMU sample: the truth's first row must be
+            // at that epoch, else the run would start from a wrong state
             let r = &tr[0];
+            let t_start = data.t0_s - data.dt_s;
+            if (r.t_s - t_start).abs() > 0.1 * data.dt_s {
+                return Err(CliError::bad(format!(
+                    "{}: the first row (t = {} s) is not at the start of the first sample of {} (t = {} s, its first time stamp {} s minus the interval {} s): give --init",
+                    args.truth.as_deref().unwrap_or(std::path::Path::new("")).display(),
+                    r.t_s,
+                    args.imu.display(),
+                    t_start,
+                    data.t0_s,
+                    data.dt_s
+                )));
+            }
             InitialState {
                 lat_rad: r.lat_rad,
                 lon_rad: r.lon_rad,
@@ -167,6 +220,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if specs.len() > 1 {
         return Err(CliError::bad("--algo: `nav` runs one algorithm"));
     }
+    let t0 = data.t0_s - data.dt_s; // state epoch before the first sample
+    if let (Some(tr), Some(tp)) = (&truth, &args.truth) {
+        check_time_bases(
+            tr,
+            tp,
+            &args.imu,
+            t0,
+            data.dt_s,
+            spec.samples,
+            data.increments.len(),
+        )?;
+    }
     let out = args
         .out
         .clone()
@@ -184,7 +249,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut errs: Vec<NavError> = Vec::new();
     let mut ti = 0usize;
     let mut write_err = None;
-    let t0 = data.t0_s - data.dt_s; // state epoch before the first sample
     let wall = navigate_recorded_timed(&spec, earth, data.dt_s, &init, &data.increments, |st| {
         let t = t0 + st.t_s;
         let e = st.euler();
