@@ -9,6 +9,7 @@ pub mod allan;
 pub mod error_analysis;
 pub mod imu_error;
 pub mod imu_file;
+pub mod initial;
 pub mod montecarlo;
 pub mod pipeline;
 pub mod scenario;

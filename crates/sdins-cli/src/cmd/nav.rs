@@ -4,7 +4,7 @@ use super::run::{algorithms, Args as RunArgs};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::earth::EarthModel;
-use sdins_core::math::{c_b_n_from_euler, Euler, Vec3};
+use sdins_core::math::Vec3;
 use sdins_core::nav::InitialState;
 use sdins_sim::imu_file::{read_imu_file, ImuFormat};
 use sdins_sim::pipeline::{nav_error, navigate_recorded_timed, NavError};
@@ -55,42 +55,7 @@ pub struct Args {
 }
 
 fn parse_init(s: &str) -> Result<InitialState, CliError> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| {
-            x.trim()
-                .parse::<f64>()
-                .map_err(|_| CliError::bad(format!("--init: `{x}` is not a number")))
-        })
-        .collect::<Result<_, _>>()?;
-    if v.len() != 9 {
-        return Err(CliError::bad(format!(
-            "--init: expected 9 values lat,lon,h,vn,ve,vd,roll,pitch,yaw, got {}",
-            v.len()
-        )));
-    }
-    if v.iter().any(|x| !x.is_finite()) {
-        return Err(CliError::bad("--init: values must be finite"));
-    }
-    if v[0].abs() > 89.99 {
-        return Err(CliError::bad(format!(
-            "--init: latitude {} is outside [-89.99, 89.99] deg",
-            v[0]
-        )));
-    }
-    if !(-1000.0..=100_000.0).contains(&v[2]) {
-        return Err(CliError::bad(format!(
-            "--init: height {} m is outside [-1000, 100000]",
-            v[2]
-        )));
-    }
-    Ok(InitialState {
-        lat_rad: v[0] * D2R,
-        lon_rad: v[1] * D2R,
-        h_m: v[2],
-        v_n_mps: Vec3::new(v[3], v[4], v[5]),
-        c_b_n: c_b_n_from_euler(&Euler::new(v[6] * D2R, v[7] * D2R, v[8] * D2R)),
-    })
+    sdins_sim::initial::parse_initial_state(s).map_err(CliError::BadInput)
 }
 
 /// Fail unless at least one reference time falls on a navigation update epoch
