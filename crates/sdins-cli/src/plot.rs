@@ -53,7 +53,8 @@ const COLORS: [RGBColor; 8] = [
     RGBColor(0x7f, 0x7f, 0x7f),
 ];
 
-fn register_font() -> Result<(), CliError> {
+/// Register the embedded DejaVu Sans as the plotters `sans-serif` font.
+pub fn register_font() -> Result<(), CliError> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
         .map_err(|_| CliError::Other("cannot load the embedded DejaVu Sans font".into()))
 }
@@ -189,32 +190,7 @@ impl Figure {
 
     /// Write the figure as a PNG file (temporary file, then rename).
     pub fn png(&self, dest: &Path) -> Result<(), CliError> {
-        register_font()?;
-        if let Some(dir) = dest.parent() {
-            if !dir.as_os_str().is_empty() {
-                std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
-                    path: dir.to_path_buf(),
-                    source,
-                })?;
-            }
-        }
-        let name = dest
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let tmp = dest.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
-        let result = {
-            let root = BitMapBackend::new(&tmp, self.size).into_drawing_area();
-            draw(root, self)
-        };
-        if let Err(e) = result {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(CliError::Other(format!("PNG plot {}: {e}", dest.display())));
-        }
-        std::fs::rename(&tmp, dest).map_err(|source| CliError::Io {
-            path: dest.to_path_buf(),
-            source,
-        })
+        write_png(dest, self.size, |root| draw(root, self))
     }
 }
 
@@ -291,4 +267,36 @@ impl Bars {
         }
         Ok(s)
     }
+}
+
+/// Draw a bitmap with `draw` into a temporary PNG next to `dest` and rename it into place
+/// (the output-file rule of `crate::output`: a complete file or none).
+pub fn write_png(
+    dest: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<(), String>,
+) -> Result<(), CliError> {
+    register_font()?;
+    if let Some(dir) = dest.parent() {
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+        }
+    }
+    let name = dest
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dest.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
+    let result = draw(BitMapBackend::new(&tmp, size).into_drawing_area());
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(CliError::Other(format!("PNG plot {}: {e}", dest.display())));
+    }
+    std::fs::rename(&tmp, dest).map_err(|source| CliError::Io {
+        path: dest.to_path_buf(),
+        source,
+    })
 }

@@ -257,31 +257,7 @@ fn svg(panels: &[Panel]) -> Result<String, CliError> {
 
 /// Draw to a temporary PNG next to `dest`, then rename into place.
 fn png(panels: &[Panel], dest: &Path) -> Result<(), CliError> {
-    if let Some(dir) = dest.parent() {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
-                path: dir.to_path_buf(),
-                source,
-            })?;
-        }
-    }
-    let name = dest
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dest.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
-    let result = {
-        let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
-        draw(root, panels)
-    };
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(CliError::Other(format!("PNG plot {}: {e}", dest.display())));
-    }
-    std::fs::rename(&tmp, dest).map_err(|source| CliError::Io {
-        path: dest.to_path_buf(),
-        source,
-    })
+    crate::plot::write_png(dest, SIZE, |root| draw(root, panels))
 }
 
 /// Write `align_attitude.svg/.png` and `align_bias.svg/.png` into `dir`. Fewer than two
@@ -293,7 +269,7 @@ pub fn write_plots(dir: &Path, rows: &[HistRow]) -> Result<(), CliError> {
             rows.len()
         )));
     }
-    crate::cmd::allan::register_font()?;
+    crate::plot::register_font()?;
     for (stem, panels) in [
         ("align_attitude", attitude_panels(rows)),
         ("align_bias", bias_panels(rows)),
@@ -329,7 +305,7 @@ mod tests {
 
     #[test]
     fn plots_have_labels_legends_and_dashed_bounds() {
-        crate::cmd::allan::register_font().unwrap();
+        crate::plot::register_font().unwrap();
         let r = rows(true, 300);
         let s = svg(&attitude_panels(&r)).unwrap();
         assert!(

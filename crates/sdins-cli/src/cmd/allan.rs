@@ -246,11 +246,7 @@ pub fn csv(r: &AllanReport) -> String {
 
 const SIZE: (u32, u32) = (1400, 560);
 
-/// Register the embedded DejaVu Sans as the plotters `sans-serif` font.
-pub(crate) fn register_font() -> Result<(), CliError> {
-    plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
-        .map_err(|_| CliError::Other("cannot load the embedded DejaVu Sans font".into()))
-}
+use crate::plot::register_font;
 
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
@@ -339,28 +335,7 @@ pub fn plot_svg(r: &AllanReport) -> Result<String, CliError> {
 
 /// The log-log plot as a PNG file (drawn to a temporary file, then renamed).
 pub fn plot_png(r: &AllanReport, dest: &Path) -> Result<(), CliError> {
-    register_font()?;
-    if let Some(dir) = dest.parent() {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
-                path: dir.to_path_buf(),
-                source,
-            })?;
-        }
-    }
-    let tmp = dest.with_file_name(format!(".allan.tmp-{}.png", std::process::id()));
-    let result = {
-        let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
-        draw(root, r)
-    };
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(CliError::Other(format!("PNG plot {}: {e}", dest.display())));
-    }
-    std::fs::rename(&tmp, dest).map_err(|source| CliError::Io {
-        path: dest.to_path_buf(),
-        source,
-    })
+    crate::plot::write_png(dest, SIZE, |root| draw(root, r))
 }
 
 #[cfg(test)]
