@@ -187,6 +187,27 @@ pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Co
             cone = prev.dtheta_b_rad.cross(&dth) / 12.0;
             scul = (prev.dtheta_b_rad.cross(&dv) + prev.dv_b_mps.cross(&dth)) / 12.0;
         }
+        ConingSet::ThreePoly | ConingSet::ThreeOpt if samples.len() == 3 => {
+            // k12 = k23 = a, k13 = b (table above), regrouped as in S1 eqs. 4 and 27:
+            // a Δθ2×(Δθ3−Δθ1) + b Δθ1×Δθ3 and
+            // a [(Δθ1−Δθ3)×Δv2 + (Δv1−Δv3)×Δθ2] + b [Δθ1×Δv3 + Δv1×Δθ3]
+            // (2 + 4 cross products instead of 3 + 6; equal up to rounding)
+            let c = set.coefficients();
+            let (a, b) = (c[0].2, c[2].2);
+            let (t1, t2, t3) = (
+                &samples[0].dtheta_b_rad,
+                &samples[1].dtheta_b_rad,
+                &samples[2].dtheta_b_rad,
+            );
+            let (v1, v2, v3) = (
+                &samples[0].dv_b_mps,
+                &samples[1].dv_b_mps,
+                &samples[2].dv_b_mps,
+            );
+            cone = a * t2.cross(&(t3 - t1)) + b * t1.cross(t3);
+            scul =
+                a * ((t1 - t3).cross(v2) + (v1 - v3).cross(t2)) + b * (t1.cross(v3) + v1.cross(t3));
+        }
         _ => {
             for &(i, j, k) in set.coefficients() {
                 if let (Some(a), Some(b)) = (samples.get(i), samples.get(j)) {
@@ -225,6 +246,37 @@ mod tests {
         let eq4 =
             t1 + t2 + t3 + (33.0 / 80.0) * t1.cross(&t3) + (57.0 / 80.0) * t2.cross(&(t3 - t1));
         assert!((c.dphi_b_rad - eq4).norm() < 1e-17);
+    }
+
+    #[test]
+    fn regrouped_three_sample_form_equals_the_pair_sum() {
+        // the specialised N = 3 branch against Σ k_ij over the table's pairs
+        let s = [
+            Increment::new(Vec3::new(3e-4, -2e-4, 1e-4), Vec3::new(0.05, 0.01, -0.098)),
+            Increment::new(Vec3::new(-1e-4, 4e-4, 2e-4), Vec3::new(0.04, 0.03, -0.099)),
+            Increment::new(Vec3::new(2e-4, 1e-4, -3e-4), Vec3::new(0.02, 0.05, -0.097)),
+        ];
+        for set in [ConingSet::ThreePoly, ConingSet::ThreeOpt] {
+            let (mut cone, mut scul) = (Vec3::zeros(), Vec3::zeros());
+            for &(i, j, k) in set.coefficients() {
+                let (a, b) = (&s[i], &s[j]);
+                cone += k * a.dtheta_b_rad.cross(&b.dtheta_b_rad);
+                scul += k * (a.dtheta_b_rad.cross(&b.dv_b_mps) + a.dv_b_mps.cross(&b.dtheta_b_rad));
+            }
+            let c = compensate(set, &s, &Increment::default());
+            let dth = s[0].dtheta_b_rad + s[1].dtheta_b_rad + s[2].dtheta_b_rad;
+            // the cone term (|Δθ|² ≈ 1e-7) differs by a few of its own roundings, but
+            // it is only seen through Δφ = Δθ + cone, rounded at ε|Δφ|; sculling terms
+            // (|Δθ||Δv| ≈ 4e-5) differ by a few roundings ε|Δθ||Δv|
+            let eps = f64::EPSILON;
+            assert!(
+                (c.dphi_b_rad - dth - cone).norm() <= 4.0 * eps * c.dphi_b_rad.norm(),
+                "{}",
+                set.name()
+            );
+            assert!((c.dv_scul_b_mps - scul).norm() <= 1e-20, "{}", set.name());
+            assert!(cone.norm() > 1e-8 && scul.norm() > 1e-6);
+        }
     }
 
     #[test]

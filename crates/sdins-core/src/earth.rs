@@ -120,7 +120,8 @@ impl EarthModel {
     /// [`LocalEarth`] at latitude `lat_rad` and height `h_m`.
     #[inline]
     pub fn local(&self, lat_rad: f64, h_m: f64) -> LocalEarth {
-        let (s, c) = (libm::sin(lat_rad), libm::cos(lat_rad));
+        // one shared argument reduction; same kernels, same values as sin and cos
+        let (s, c) = libm::sincos(lat_rad);
         self.local_sc(s, c, h_m)
     }
 

@@ -64,13 +64,14 @@ fn arr(v: &Vec3) -> [f64; 3] {
 /// results equal the textbook formulas to rounding (see the tests).
 #[inline]
 pub fn nav_error(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> NavError {
-    let r = earth.radii(truth.lat_rad);
+    let (sin_lat, cos_lat) = libm::sincos(truth.lat_rad);
+    let r = earth.radii_sin(sin_lat);
     let dlat = nav.lat_rad - truth.lat_rad;
     let dlon = lon_diff(nav.lon_rad, truth.lon_rad);
     let dh = nav.h_m - truth.h_m;
     let pos = [
         dlat * (r.r_m_m + truth.h_m),
-        dlon * (r.r_n_m + truth.h_m) * truth.lat_rad.cos(),
+        dlon * (r.r_n_m + truth.h_m) * cos_lat,
         -dh,
     ];
     let (a, t) = (&nav.c_b_n, &truth.c_b_n);
@@ -84,7 +85,7 @@ pub fn nav_error(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> Nav
     ];
     // angle difference of atan2(ya, xa) − atan2(yt, xt), wrapped to (−π, π]
     let diff =
-        |ya: f64, xa: f64, yt: f64, xt: f64| libm::atan2(ya * xt - xa * yt, xa * xt + ya * yt);
+        |ya: f64, xa: f64, yt: f64, xt: f64| atan2_small(ya * xt - xa * yt, xa * xt + ya * yt);
     // pitch = asin(s) with s = −C31 clamped: (sin, cos) = (s, √(1 − s²))
     let sc = |c: &sdins_core::math::Mat3| {
         let s = (-c[(2, 0)]).clamp(-1.0, 1.0);
@@ -103,6 +104,21 @@ pub fn nav_error(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> Nav
             diff(sa, ca, st, ct),
             diff(a[(1, 0)], a[(0, 0)], t[(1, 0)], t[(0, 0)]),
         ],
+    }
+}
+
+/// `atan2(y, x)` with a short path for the small angles that navigation errors are:
+/// for `x > 0` and `|y| ≤ 10⁻³ x`, `atan z = z − z³/3 + z⁵/5 − z⁷/7 + O(z⁹)` with
+/// `z = y/x`, whose truncation is below `z⁸/9 ≤ 1.2·10⁻²⁵` relative, far under one ulp;
+/// otherwise `libm::atan2`.
+#[inline]
+pub fn atan2_small(y: f64, x: f64) -> f64 {
+    if x > 0.0 && y.abs() <= 1e-3 * x {
+        let z = y / x;
+        let z2 = z * z;
+        z * (1.0 - z2 * (1.0 / 3.0 - z2 * (1.0 / 5.0 - z2 * (1.0 / 7.0))))
+    } else {
+        libm::atan2(y, x)
     }
 }
 
@@ -418,6 +434,25 @@ mod tests {
             assert_eq!(f.height_err_m, r.height_err_m);
             assert_eq!(f.t_s, r.t_s);
         }
+    }
+
+    #[test]
+    fn small_angle_atan2_equals_libm_to_rounding() {
+        // both sides of the 1e-3 switch, signs, x ≠ 1, and the libm fallback region
+        let mut worst = 0.0_f64;
+        for k in 0..4001 {
+            let z = (k as f64 - 2000.0) * 1.25e-6; // |z| ≤ 2.5e-3
+            for x in [1.0, 0.37, 3.0e3] {
+                let (a, b) = (atan2_small(z * x, x), libm::atan2(z * x, x));
+                let ulp = f64::EPSILON * b.abs().max(f64::MIN_POSITIVE);
+                worst = worst.max((a - b).abs() / ulp);
+            }
+        }
+        // a 4-term series with 3 roundings vs libm's own ≤ 1 ulp: a few ulp at most
+        assert!(worst <= 4.0, "worst {worst} ulp");
+        assert_eq!(atan2_small(1e-4, -1.0), libm::atan2(1e-4, -1.0));
+        assert_eq!(atan2_small(0.0, 0.0), 0.0);
+        assert!(atan2_small(f64::NAN, 1.0).is_nan());
     }
 
     #[test]

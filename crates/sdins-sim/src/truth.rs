@@ -263,11 +263,6 @@ pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
 /// Longitude difference wrapped to (−π, π] (for error computation across ±180°).
 #[inline]
 pub fn lon_diff(a: f64, b: f64) -> f64 {
-    let d = a - b;
-    // already in range (the usual case): skip the fmod, which would only add rounding
-    if d > -core::f64::consts::PI && d <= core::f64::consts::PI {
-        d
-    } else {
-        wrap_pi(d)
-    }
+    // wrap_pi returns values already in range unchanged (no fmod rounding)
+    wrap_pi(a - b)
 }

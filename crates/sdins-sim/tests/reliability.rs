@@ -129,6 +129,10 @@ fn antimeridian_east_and_west() {
     assert_eq!(wrap_pi(pi), pi);
     assert!((wrap_pi(-pi) - pi).abs() < 1e-15);
     assert!((wrap_pi(3.0 * pi + 0.1) - (-pi + 0.1)).abs() < 1e-14);
+    // in-range values come back bit for bit (no (a + π) − π rounding)
+    for a in [0.1, -3.0, 2.0_f64.sqrt(), -pi + 1e-15, 1e-300] {
+        assert_eq!(wrap_pi(a).to_bits(), a.to_bits());
+    }
     assert!((lon_diff(-pi + 1e-6, pi - 1e-6) - 2e-6).abs() < 1e-15);
     assert!((lon_diff(pi - 1e-6, -pi + 1e-6) + 2e-6).abs() < 1e-15);
 }

@@ -255,8 +255,14 @@ impl Mechanization for AnyMechanization {
 }
 
 /// Wrap a longitude to (−π, π].
+///
+/// Values already in range are returned unchanged (bit for bit): the `fmod` route would
+/// round `(a + π) − π` and cost a library call on every navigation state.
 #[inline]
 pub fn wrap_pi(a: f64) -> f64 {
+    if a > -core::f64::consts::PI && a <= core::f64::consts::PI {
+        return a;
+    }
     let two_pi = 2.0 * core::f64::consts::PI;
     let mut x = libm::fmod(a + core::f64::consts::PI, two_pi);
     if x <= 0.0 {
