@@ -39,11 +39,17 @@ fn main() {
         .map_or(scn.trajectory.duration_s, |s| s.parse().expect("seconds"));
     let n = (secs / cfg.dt_s).round() as u64;
     let gen = TruthGenerator::new(&scn.trajectory, cfg).without_closed_form();
+    let gen = match args.get(3).map(String::as_str) {
+        Some("rk4") => gen.reference_rk4(),
+        _ => gen,
+    };
+    let gen_scheme = gen.scheme();
     let t0 = Instant::now();
     let (k, sum) = truth_run(gen, n);
     let el = t0.elapsed().as_secs_f64();
     println!(
-        "{name}: {k} samples, substeps {}, checksum {sum:.17e}, {:.3} s, {:.0} ns/sample",
+        "{name}: {k} samples, {:?}, substeps {}, checksum {sum:.17e}, {:.3} s, {:.0} ns/sample",
+        gen_scheme,
         cfg.substeps,
         el,
         el / k as f64 * 1e9

@@ -371,7 +371,7 @@ fn gauss_matches_rk4_reference_turn_90dps() {
 }
 
 #[test]
-#[ignore = "release: whole dq-paper and turn-90dps with the RK4 reference (~30 s)"]
+#[ignore = "release: whole dq-paper and turn-90dps with the RK4 reference (~4 s)"]
 fn gauss_matches_rk4_reference_whole_runs() {
     for name in ["dq-paper", "turn-90dps"] {
         let scn = Scenario::load(name).unwrap();
