@@ -84,12 +84,14 @@ pub enum TruthScheme {
     /// `A·H·(ΩH)⁶/2 016 000`. [`auto_substeps`] gives `Ω·δt/substeps ≤ 2e-3`, hence
     /// `ΩH ≤ 0.032` and a relative remainder `≤ 5.3e-16` of `A·H` (below one rounding of the
     /// increment; RK4 at the same `substeps` is Simpson's rule with `(Ωh)⁴/2880 = 5.6e-15`).
-    /// `dq-paper` (1 Hz, 0.5° coning, `A = Ω sin α = 0.055 rad/s`, `H = 5 ms`): 1.5e-19 rad;
-    /// its specific-force oscillation (`g sin α = 0.086 m/s²`) 2.3e-19 m/s. `turn-90dps`
-    /// (`f_y = s ψ̇ ≤ 534 m/s²` at `Ω = π rad/s`, `H = 2 ms`): 3e-23 m/s. The position at
-    /// the nodes has the stage error `O(H⁴·v⁽³⁾/R)` (below 1e-15 m here), which enters the
-    /// increments through `∂g/∂h ≈ 3e-6 s⁻²` and `∂ω/∂L ≈ 1e-4 s⁻¹` only (< 1e-20); the
-    /// position at the panel end is the order-6 Gauss quadrature (superconvergent).
+    /// `dq-paper` (1 Hz, 0.5° coning, `A = Ω sin α = 0.055 rad/s`, `H = 5 ms`): 1.3e-19 rad;
+    /// its specific-force oscillation (`g sin α = 0.086 m/s²`) 2.1e-19 m/s. `turn-90dps`
+    /// (`f_y = s ψ̇`, a raised cosine of amplitude 267 m/s² at `Ω = π rad/s`, `H = 2 ms`):
+    /// 2e-20 m/s. The node positions carry the collocation stage error `O(H⁴·|v⁽³⁾|)`
+    /// (≲ 1e-10 m in the 90°/s turn, ~1e-14 m in `dq-paper`), which enters the increments
+    /// only through `∂g/∂h ≈ 3e-6 s⁻²` and `∂ω_ie/∂L ≈ 1e-4 s⁻¹` (< 1e-20 per sample); the
+    /// position at the panel end is the order-6 Gauss quadrature of the rates at the nodes,
+    /// where the node errors enter only through `∂L̇/∂L ≈ 1e-8 s⁻¹`.
     /// Equal to the RK4 reference at doubled substeps within 2e-17 rad / 2e-16 m/s per sample
     /// (tests/truth.rs, `gauss_matches_rk4_reference_*`), with 3 kinematics evaluations per
     /// panel instead of 3 per RK4 substep.
@@ -494,7 +496,8 @@ impl Iterator for TruthGenerator<'_> {
 /// the fastest periodic motion advances at most 2e-3 rad per substep. RK4 on a pure
 /// quadrature is Simpson's rule, whose error per sample is δt·h⁴·|ω⁗|/2880; for 1 Hz,
 /// 0.5° coning at 100 Hz this is 4.5e-17 rad with 16 substeps and 2.8e-18 rad with 32.
-/// Rounded up to a power of two.
+/// Rounded up to a power of two. The default Gauss scheme uses `substeps/16` panels, i.e.
+/// at most 0.032 rad of the fastest motion per panel ([`TruthScheme::Gauss3`]).
 pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
     let w_max = traj.max_frequency_rps();
     let need = (dt_s * w_max / 2e-3).ceil().clamp(16.0, 4096.0) as usize;
