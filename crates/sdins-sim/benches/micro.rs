@@ -1,5 +1,5 @@
 //! Micro-benchmarks (criterion): one navigation update of every algorithm for N = 1..4,
-//! the truth generator per sample (closed form and RK4), and the IMU error model per
+//! the truth generator per sample (closed form, Gauss, RK4 reference), and the IMU error model per
 //! sample. Throughput is in IMU samples, so criterion prints samples/s.
 //!
 //! `cargo bench -p sdins-sim --bench micro` (docs/performance.md has the numbers).
@@ -63,19 +63,22 @@ fn truth(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(300))
         .measurement_time(Duration::from_secs(1))
         .throughput(Throughput::Elements(1));
-    for (label, name, closed) in [
-        ("closed_form/mach1-east", "mach1-east", true),
-        ("rk4/mach1-east", "mach1-east", false),
-        ("rk4/dq-paper", "dq-paper", false),
+    // 0: closed form, 1: the general (Gauss) path, 2: the RK4 reference
+    for (label, name, path) in [
+        ("closed_form/mach1-east", "mach1-east", 0),
+        ("gauss/mach1-east", "mach1-east", 1),
+        ("gauss/dq-paper", "dq-paper", 1),
+        ("gauss/turn-90dps", "turn-90dps", 1),
+        ("rk4_reference/dq-paper", "dq-paper", 2),
     ] {
         let scn = scenario(name);
         let cfg = truth_config(&scn);
         let make = || {
             let t = TruthGenerator::new(&scn.trajectory, cfg);
-            if closed {
-                t
-            } else {
-                t.without_closed_form()
+            match path {
+                0 => t,
+                1 => t.without_closed_form(),
+                _ => t.reference_rk4(),
             }
         };
         g.bench_function(label, |b| {

@@ -272,7 +272,8 @@ pub struct NavConfig {
     pub earth: EarthChoice,
     /// vertical channel: `free` or `hold`
     pub vertical_hold: bool,
-    /// truth RK4 substeps per sample (default: [`crate::truth::auto_substeps`])
+    /// truth resolution: RK4 substeps per sample, `⌈substeps/16⌉` Gauss panels for the
+    /// default scheme (default: [`crate::truth::auto_substeps`])
     pub substeps: usize,
 }
 

@@ -6,7 +6,7 @@
 //! values (flat turns, as in the papers' scenarios). Overlays add body coning, sculling
 //! and vibration on top.
 
-use sdins_core::math::{c_b_n_from_euler, Euler, Mat3, Quat, Vec3};
+use sdins_core::math::{Euler, Mat3, Quat, Vec3};
 use std::f64::consts::PI;
 
 /// A motion segment (one of the `[[segment]]` tables of a scenario).
@@ -157,6 +157,42 @@ pub struct Trajectory {
     overlays: Vec<Overlay>,
     /// total duration [s]
     pub duration_s: f64,
+    /// per-trajectory constants of [`Trajectory::kinematics_split`]: sin/cos of roll and
+    /// pitch, and per overlay sin/cos of the coning half-angle α/2 and of α
+    consts: KinConsts,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct KinConsts {
+    /// sin φ0, cos φ0, sin θ0, cos θ0
+    roll_pitch: [f64; 4],
+    /// per overlay: sin(α/2), cos(α/2), sin α, cos α (zeros for non-coning overlays)
+    overlay: Vec<[f64; 4]>,
+}
+
+impl KinConsts {
+    fn new(roll: f64, pitch: f64, overlays: &[Overlay]) -> Self {
+        let overlay = overlays
+            .iter()
+            .map(|o| match o.kind {
+                OverlayKind::Coning { half_angle_rad, .. } => {
+                    let (sa2, ca2) = (0.5 * half_angle_rad).sin_cos();
+                    let (sa, ca) = half_angle_rad.sin_cos();
+                    [sa2, ca2, sa, ca]
+                }
+                _ => [0.0; 4],
+            })
+            .collect();
+        Self {
+            roll_pitch: [
+                libm::sin(roll),
+                libm::cos(roll),
+                libm::sin(pitch),
+                libm::cos(pitch),
+            ],
+            overlay,
+        }
+    }
 }
 
 struct Nominal {
@@ -197,8 +233,9 @@ impl Segment {
             }
             Motion::STurn { amplitude_rps } => {
                 let w = 2.0 * PI / big_t;
-                n.heading = self.heading0 + amplitude_rps / w * (1.0 - (w * tau).cos());
-                n.heading_dot = amplitude_rps * (w * tau).sin();
+                let (s, c) = (w * tau).sin_cos();
+                n.heading = self.heading0 + amplitude_rps / w * (1.0 - c);
+                n.heading_dot = amplitude_rps * s;
             }
             Motion::Climb { to_climb_rate_mps } => {
                 let rate = (-to_climb_rate_mps - self.v_d0) / big_t;
@@ -249,6 +286,7 @@ impl Trajectory {
         Self {
             roll0_rad: start_euler.roll_rad,
             pitch0_rad: start_euler.pitch_rad,
+            consts: KinConsts::new(start_euler.roll_rad, start_euler.pitch_rad, &overlays),
             segments,
             overlays,
             duration_s: t,
@@ -334,9 +372,20 @@ impl Trajectory {
             n.speed_dot * sh + n.speed * n.heading_dot * ch,
             n.v_d_dot,
         );
-        let c_nom = c_b_n_from_euler(&Euler::new(self.roll0_rad, self.pitch0_rad, n.heading));
-        let (sr, cr) = self.roll0_rad.sin_cos();
-        let (sp, cp) = self.pitch0_rad.sin_cos();
+        // c_b_n_from_euler(roll0, pitch0, heading) with the constant sin/cos of roll and
+        // pitch and the heading's sin/cos from above
+        let [sr, cr, sp, cp] = self.consts.roll_pitch;
+        let c_nom = Mat3::new(
+            ch * cp,
+            ch * sp * sr - sh * cr,
+            ch * sp * cr + sh * sr,
+            sh * cp,
+            sh * sp * sr + ch * cr,
+            sh * sp * cr - ch * sr,
+            -sp,
+            cp * sr,
+            cp * cr,
+        );
         // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (spec §1.2)
         let w_nom = Vec3::new(
             -n.heading_dot * sp,
@@ -347,7 +396,7 @@ impl Trajectory {
         // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (spec §7.0)
         let mut c_c = Mat3::identity();
         let mut w_c = Vec3::zeros();
-        for ov in &self.overlays {
+        for (ov, kc) in self.overlays.iter().zip(&self.consts.overlay) {
             // branch by t_sel: before the window the overlay is at rest, after it frozen
             let active = t_sel >= ov.start_s && t_sel < ov.end_s;
             let (tau_base, tau_off) = if active {
@@ -364,18 +413,15 @@ impl Trajectory {
             };
             let (c_k, w_k) = match ov.kind {
                 OverlayKind::Coning {
-                    axis,
-                    half_angle_rad,
-                    omega_rps,
+                    axis, omega_rps, ..
                 } => {
-                    let (sa2, ca2) = (0.5 * half_angle_rad).sin_cos();
+                    let [sa2, ca2, sa, ca] = *kc;
                     let (swt, cwt) = sincos(omega_rps);
                     let v0 = axis.place(sa2, 0.0, 0.0);
                     let vt = axis.place(sa2 * cwt, sa2 * swt, 0.0);
                     let q0 = Quat::from_parts(ca2, &v0);
                     let qt = Quat::from_parts(ca2, &vt);
                     let c = q0.conj().mul(&qt).to_dcm();
-                    let (sa, ca) = half_angle_rad.sin_cos();
                     let w = axis.place(
                         -omega_rps * sa * swt,
                         omega_rps * sa * cwt,
@@ -512,6 +558,24 @@ mod tests {
                 "t={t}: {}",
                 (w - k.omega_nb_b_rps).norm()
             );
+        }
+    }
+
+    #[test]
+    fn nominal_attitude_is_the_euler_dcm() {
+        // the cached roll/pitch sin/cos build the same DCM as c_b_n_from_euler
+        let tr = Trajectory::new(
+            10.0,
+            0.0,
+            Euler::new(0.02, -0.03, 0.4),
+            &[(Motion::STurn { amplitude_rps: 0.3 }, 10.0)],
+            vec![],
+        );
+        for &t in &[0.0, 1.7, 4.2, 9.9] {
+            let k = tr.kinematics(t, t);
+            let yaw = tr.segments()[0].eval(t).heading;
+            let want = sdins_core::math::c_b_n_from_euler(&Euler::new(0.02, -0.03, yaw));
+            assert!((k.c_b_n - want).abs().max() <= 4.0 * f64::EPSILON, "t={t}");
         }
     }
 

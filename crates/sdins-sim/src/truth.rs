@@ -4,14 +4,22 @@
 //! * Constant-state cases (static, or cruise along a parallel): closed form
 //!   `Δθ = C_n^b (ω_ie + ω_en) δt`, `Δv = C_n^b ((2ω_ie + ω_en) × v − g) δt`,
 //!   `l(t) = l0 + v_E t / ((R_N + h) cos L)`.
-//! * Everything else: classical RK4 on `[L − L0, l − l0, h, ∫ω_ib^b, ∫f^b]` with
-//!   `substeps` (default 16) per sample, the integrals reset at every sample boundary and
-//!   the analytic branch selected by the substep midpoint, using
-//!   `ω_ib^b = ω_nb^b + C_n^b (ω_ie + ω_en)` and `f^b = C_n^b (v̇ + (2ω_ie + ω_en) × v − g)`.
+//! * Everything else: the increments are quadratures of
+//!   `ω_ib^b = ω_nb^b + C_n^b (ω_ie + ω_en)` and `f^b = C_n^b (v̇ + (2ω_ie + ω_en) × v − g)`
+//!   over the sample, where attitude, rates, velocity and v̇ are analytic functions of time
+//!   ([`Trajectory::kinematics_split`]) and the position `(L, l, h)` enters only through
+//!   the slowly varying earth terms `ω_ie(L)`, `ω_en(L, h, v)`, `g(L, h)`. The default
+//!   scheme ([`TruthScheme::Gauss3`]) integrates the whole state
+//!   `[L, l, h, ∫ω_ib^b, ∫f^b]` with 3-node Gauss–Legendre collocation on
+//!   `⌈substeps/16⌉` panels per sample (split further at segment and overlay boundaries
+//!   inside a sample, so that no panel straddles a kink); see [`TruthScheme::Gauss3`] for
+//!   the error bound. The classical RK4 of the spec, with `substeps` steps per sample and
+//!   the analytic branch selected by the substep midpoint, is kept as the independent
+//!   reference ([`TruthGenerator::reference_rk4`], [`TruthScheme::Rk4`]).
 
 use crate::trajectory::Trajectory;
 use sdins_core::coning::Increment;
-use sdins_core::earth::EarthModel;
+use sdins_core::earth::{sin_cos_shift, EarthModel};
 use sdins_core::math::{Mat3, Vec3};
 use sdins_core::nav::{wrap_pi, InitialState};
 
@@ -47,8 +55,51 @@ pub struct TruthConfig {
     pub lon0_rad: f64,
     /// start height [m]
     pub h0_m: f64,
-    /// RK4 substeps per sample (16 in the spec; the refinement test compares with 32)
+    /// integration resolution: RK4 substeps per sample for [`TruthScheme::Rk4`] (16 in the
+    /// spec; the refinement test compares with 32); [`TruthScheme::Gauss3`] uses
+    /// `⌈substeps/16⌉` Gauss panels per sample
     pub substeps: usize,
+}
+
+/// How the general (non-closed-form) path integrates a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TruthScheme {
+    /// Default. 3-node Gauss–Legendre collocation (order 6, stage order 3) on
+    /// `P = ⌈substeps/16⌉` equal panels of length `H` per sample (per piece between
+    /// segment/overlay boundaries inside the sample, if any; each panel selects its
+    /// analytic branch by its midpoint). Per panel, with nodes `c = ½ ∓ √15/10, ½` and
+    /// weights `5/18, 4/9, 5/18`:
+    ///
+    /// * the kinematics are evaluated once per node (3 per panel);
+    /// * height at the nodes is the collocation (Butcher `A`) quadrature of `−v_D`;
+    ///   latitude at the nodes the same for `v_N/(R_M + h)`, with `R_M` first at the panel
+    ///   start latitude and then once corrected at the predicted node latitudes (one
+    ///   fixed-point step: the contraction factor is `H·|∂L̇/∂L| ≈ H·v_N·R_M'/R_M² ≈ 1e-10`);
+    ///   sin/cos of the node latitudes by [`sin_cos_shift`] from the panel start;
+    /// * the earth terms, `ω_ib^b`, `f^b`, `L̇`, `l̇` at the nodes, and the panel sums
+    ///   `H·Σ b_i y'_i`.
+    ///
+    /// Error: for the increments (pure quadratures given the position) the Gauss remainder
+    /// is `H⁷ f⁽⁶⁾(ξ)/2 016 000`; for an oscillation of amplitude `A` and frequency `Ω` that is
+    /// `A·H·(ΩH)⁶/2 016 000`. [`auto_substeps`] gives `Ω·δt/substeps ≤ 2e-3`, hence
+    /// `ΩH ≤ 0.032` and a relative remainder `≤ 5.3e-16` of `A·H` (below one rounding of the
+    /// increment; RK4 at the same `substeps` is Simpson's rule with `(Ωh)⁴/2880 = 5.6e-15`).
+    /// `dq-paper` (1 Hz, 0.5° coning, `A = Ω sin α = 0.055 rad/s`, `H = 5 ms`): 1.3e-19 rad;
+    /// its specific-force oscillation (`g sin α = 0.086 m/s²`) 2.1e-19 m/s. `turn-90dps`
+    /// (`f_y = s ψ̇`, a raised cosine of amplitude 267 m/s² at `Ω = π rad/s`, `H = 2 ms`):
+    /// 2e-20 m/s. The node positions carry the collocation stage error `O(H⁴·|v⁽³⁾|)`
+    /// (≲ 1e-10 m in the 90°/s turn, ~1e-14 m in `dq-paper`), which enters the increments
+    /// only through `∂g/∂h ≈ 3e-6 s⁻²` and `∂ω_ie/∂L ≈ 1e-4 s⁻¹` (< 1e-20 per sample); the
+    /// position at the panel end is the order-6 Gauss quadrature of the rates at the nodes,
+    /// where the node errors enter only through `∂L̇/∂L ≈ 1e-8 s⁻¹`.
+    /// Equal to the RK4 reference at doubled substeps within 2e-17 rad / 2e-16 m/s per sample
+    /// (tests/truth.rs, `gauss_matches_rk4_reference_*`), with 3 kinematics evaluations per
+    /// panel instead of 3 per RK4 substep.
+    Gauss3,
+    /// Classical RK4 on `[L − L0, l − l0, h, ∫ω_ib^b, ∫f^b]` with `substeps` steps per
+    /// sample, the integrals reset at every sample boundary and the analytic branch
+    /// selected by the substep midpoint (spec §7.0). The independent reference.
+    Rk4,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -71,6 +122,54 @@ pub struct TruthGenerator<'a> {
     dlon: f64,
     h: f64,
     closed: Option<ClosedForm>,
+    scheme: TruthScheme,
+    /// segment and overlay boundaries (sorted): the Gauss panels never straddle one
+    breaks: Vec<f64>,
+    /// index of the first boundary after the current sample start
+    bi: usize,
+}
+
+/// Gauss–Legendre 3-node nodes, Butcher `A` (collocation) matrix; weights 5/18, 4/9, 5/18
+/// are applied as `y₂ + (5/18)((y₁ − y₂) + (y₃ − y₂))` (exact for constant integrands).
+const GL3_C: [f64; 3] = [
+    0.5 - 0.387_298_334_620_741_7, // ½ − √15/10
+    0.5,
+    0.5 + 0.387_298_334_620_741_7,
+];
+const SQ15: f64 = 3.872_983_346_207_417;
+const GL3_A: [[f64; 3]; 3] = [
+    [
+        5.0 / 36.0,
+        2.0 / 9.0 - SQ15 / 15.0,
+        5.0 / 36.0 - SQ15 / 30.0,
+    ],
+    [
+        5.0 / 36.0 + SQ15 / 24.0,
+        2.0 / 9.0,
+        5.0 / 36.0 - SQ15 / 24.0,
+    ],
+    [
+        5.0 / 36.0 + SQ15 / 30.0,
+        2.0 / 9.0 + SQ15 / 15.0,
+        5.0 / 36.0,
+    ],
+];
+
+/// The Gauss 3-node weighted mean `Σ b_i y_i` in the form exact for constant `y`.
+#[inline]
+fn gl3_mean(y: [f64; 3]) -> f64 {
+    y[1] + (5.0 / 18.0) * ((y[0] - y[1]) + (y[2] - y[1]))
+}
+
+/// `Σ_j A_ij y_j` (collocation stage quadrature).
+#[inline]
+fn gl3_stage(y: [f64; 3]) -> [f64; 3] {
+    let a = &GL3_A;
+    [
+        a[0][0] * y[0] + a[0][1] * y[1] + a[0][2] * y[2],
+        a[1][0] * y[0] + a[1][1] * y[1] + a[1][2] * y[2],
+        a[2][0] * y[0] + a[2][1] * y[1] + a[2][2] * y[2],
+    ]
 }
 
 type State = [f64; 9];
@@ -88,6 +187,9 @@ impl<'a> TruthGenerator<'a> {
             dlon: 0.0,
             h: cfg.h0_m,
             closed: None,
+            scheme: TruthScheme::Gauss3,
+            breaks: Self::boundaries(traj),
+            bi: 0,
         };
         if traj.is_constant_parallel() {
             g.closed = Some(g.closed_form());
@@ -95,10 +197,54 @@ impl<'a> TruthGenerator<'a> {
         g
     }
 
-    /// Force the general RK4 path even where the closed form applies (for tests).
+    /// Force the general (integrated) path even where the closed form applies (for tests).
     pub fn without_closed_form(mut self) -> Self {
         self.closed = None;
         self
+    }
+
+    /// The classical RK4 of the spec with `substeps` steps per sample instead of the Gauss
+    /// scheme, and never the closed form: the independent reference for tests.
+    pub fn reference_rk4(mut self) -> Self {
+        self.closed = None;
+        self.scheme = TruthScheme::Rk4;
+        self
+    }
+
+    /// The scheme of the general path.
+    pub fn scheme(&self) -> TruthScheme {
+        self.scheme
+    }
+
+    /// Start at sample `k` (time `k·δt`) from the configured start position instead of at
+    /// t = 0, for comparing schemes on a window of a long scenario: the position is not
+    /// propagated to `t_k`, and the closed-form path is not used.
+    pub fn starting_at_sample(mut self, k: u64) -> Self {
+        self.closed = None;
+        self.k = k.min(self.n_samples);
+        let t0 = self.k as f64 * self.cfg.dt_s;
+        self.bi = self.breaks.partition_point(|&b| b <= t0);
+        self
+    }
+
+    /// Position after the last sample as offsets from the start, `(L − L0 [rad], l − l0
+    /// [rad], h [m])`: free of the rounding of the absolute coordinates of
+    /// [`TruthSample`] (one ulp of a longitude near 2.2 rad is 2e-9 m), for comparing schemes.
+    pub fn position_offsets(&self) -> (f64, f64, f64) {
+        (self.dlat, self.dlon, self.h)
+    }
+
+    /// Interior segment starts and overlay window ends, sorted.
+    fn boundaries(traj: &Trajectory) -> Vec<f64> {
+        let mut b: Vec<f64> = traj.segments().iter().skip(1).map(|s| s.t0_s).collect();
+        for o in traj.overlays() {
+            b.push(o.start_s);
+            b.push(o.end_s);
+        }
+        b.retain(|t| t.is_finite() && *t > 0.0 && *t < traj.duration_s);
+        b.sort_by(f64::total_cmp);
+        b.dedup();
+        b
     }
 
     /// Number of samples the generator will produce in total.
@@ -205,6 +351,100 @@ impl<'a> TruthGenerator<'a> {
     }
 }
 
+impl TruthGenerator<'_> {
+    /// One sample `[t0, t0 + δt]` with the Gauss scheme ([`TruthScheme::Gauss3`]).
+    fn sample_gauss(&mut self, t0: f64) -> Increment {
+        let dt = self.cfg.dt_s;
+        let t1 = t0 + dt;
+        // boundaries within a few ulp of the sample ends are at the ends (the sample grid
+        // k·δt and the boundaries are both rounded): the panel midpoints select the branch
+        let eps = 64.0 * f64::EPSILON * t1.abs().max(dt);
+        while self.bi < self.breaks.len() && self.breaks[self.bi] <= t0 + eps {
+            self.bi += 1;
+        }
+        let panels = self.cfg.substeps.div_ceil(16).max(1);
+        let mut dth = Vec3::zeros();
+        let mut dv = Vec3::zeros();
+        // pieces [a, b] between the boundaries strictly inside the sample, P panels each
+        let (mut a, mut j) = (0.0, self.bi);
+        loop {
+            let last = !(j < self.breaks.len() && self.breaks[j] < t1 - eps);
+            let b = if last { dt } else { self.breaks[j] - t0 };
+            let hp = (b - a) / panels as f64;
+            for p in 0..panels {
+                let (th, v) = self.panel_gauss(t0, a + p as f64 * hp, hp);
+                dth += th;
+                dv += v;
+            }
+            if last {
+                break;
+            }
+            a = b;
+            j += 1;
+        }
+        Increment::new(dth, dv)
+    }
+
+    /// One Gauss panel `[t0 + oa, t0 + oa + hp]`: advances the position, returns the
+    /// increments over the panel.
+    fn panel_gauss(&mut self, t0: f64, oa: f64, hp: f64) -> (Vec3, Vec3) {
+        let e = self.cfg.earth;
+        let t_sel = t0 + (oa + 0.5 * hp);
+        let kin = GL3_C.map(|c| self.traj.kinematics_split(t0, oa + c * hp, t_sel));
+        let lat_a = self.cfg.lat0_rad + self.dlat;
+        let (s_a, c_a) = (libm::sin(lat_a), libm::cos(lat_a));
+        // height at the nodes: collocation quadrature of −v_D
+        let hs = gl3_stage(kin.map(|k| -k.v_n_mps.z));
+        let h_n = [0, 1, 2].map(|i| self.h + hp * hs[i]);
+        let h_b = self.h + hp * gl3_mean(kin.map(|k| -k.v_n_mps.z));
+        // latitude and longitude rates; the flat model moves over the ellipsoid at the
+        // start latitude (as the RK4 reference does)
+        let flat = !e.transport;
+        let (r0, cos0) = if flat {
+            let l0 = self.cfg.lat0_rad;
+            (e.radii(l0), libm::cos(l0))
+        } else {
+            (e.radii_sin(s_a), c_a)
+        };
+        // predictor: R_M at the panel start latitude
+        let pred = gl3_stage([0, 1, 2].map(|i| kin[i].v_n_mps.x / (r0.r_m_m + h_n[i])));
+        let mut th = [Vec3::zeros(); 3];
+        let mut f = [Vec3::zeros(); 3];
+        let mut lat_dot = [0.0; 3];
+        let mut lon_dot = [0.0; 3];
+        for i in 0..3 {
+            let (k, h) = (&kin[i], h_n[i]);
+            let (s, c) = sin_cos_shift(s_a, c_a, hp * pred[i]);
+            let le = e.local_sc(s, c, h);
+            let v = k.v_n_mps;
+            let w_ie = e.omega_ie_n_local(&le);
+            let w_en = e.omega_en_n_local(&le, h, &v);
+            let c_n_b = k.c_b_n.transpose();
+            th[i] = k.omega_nb_b_rps + c_n_b * (w_ie + w_en);
+            f[i] = c_n_b
+                * (k.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - Vec3::new(0.0, 0.0, le.g_mps2));
+            if flat {
+                lat_dot[i] = v.x / (r0.r_m_m + h);
+                lon_dot[i] = v.y / ((r0.r_n_m + h) * cos0);
+            } else {
+                lat_dot[i] = v.x / (le.r_m_m + h);
+                lon_dot[i] = v.y / ((le.r_n_m + h) * c);
+            }
+        }
+        self.dlat += hp * gl3_mean(lat_dot);
+        self.dlon += hp * gl3_mean(lon_dot);
+        self.h = h_b;
+        let mean3 = |y: &[Vec3; 3]| {
+            Vec3::new(
+                gl3_mean([y[0].x, y[1].x, y[2].x]),
+                gl3_mean([y[0].y, y[1].y, y[2].y]),
+                gl3_mean([y[0].z, y[1].z, y[2].z]),
+            )
+        };
+        (mean3(&th) * hp, mean3(&f) * hp)
+    }
+}
+
 impl Iterator for TruthGenerator<'_> {
     type Item = TruthSample;
 
@@ -223,7 +463,10 @@ impl Iterator for TruthGenerator<'_> {
                 (cf.inc, cf.v_n_mps, cf.c_b_n)
             }
             None => {
-                let inc = self.sample_rk4(t0);
+                let inc = match self.scheme {
+                    TruthScheme::Gauss3 => self.sample_gauss(t0),
+                    TruthScheme::Rk4 => self.sample_rk4(t0),
+                };
                 // attitude and velocity at the sample end are analytic (branch of the
                 // last substep)
                 let kin = self
@@ -253,7 +496,8 @@ impl Iterator for TruthGenerator<'_> {
 /// the fastest periodic motion advances at most 2e-3 rad per substep. RK4 on a pure
 /// quadrature is Simpson's rule, whose error per sample is δt·h⁴·|ω⁗|/2880; for 1 Hz,
 /// 0.5° coning at 100 Hz this is 4.5e-17 rad with 16 substeps and 2.8e-18 rad with 32.
-/// Rounded up to a power of two.
+/// Rounded up to a power of two. The default Gauss scheme uses `substeps/16` panels, i.e.
+/// at most 0.032 rad of the fastest motion per panel ([`TruthScheme::Gauss3`]).
 pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
     let w_max = traj.max_frequency_rps();
     let need = (dt_s * w_max / 2e-3).ceil().clamp(16.0, 4096.0) as usize;
@@ -265,4 +509,32 @@ pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
 pub fn lon_diff(a: f64, b: f64) -> f64 {
     // wrap_pi returns values already in range unchanged (no fmod rounding)
     wrap_pi(a - b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss3_weights_and_stages_are_exact_for_polynomials() {
+        // Σ b_i p(c_i) = ∫₀¹ p for degree ≤ 5; Σ_j A_ij p(c_j) = ∫₀^{c_i} p for degree ≤ 2
+        for d in 0..=5 {
+            let y = GL3_C.map(|c| (d + 1) as f64 * c.powi(d));
+            assert!((gl3_mean(y) - 1.0).abs() < 4.0 * f64::EPSILON, "degree {d}");
+            if d <= 2 {
+                let st = gl3_stage(y);
+                for i in 0..3 {
+                    let want = GL3_C[i].powi(d + 1);
+                    assert!(
+                        (st[i] - want).abs() < 4.0 * f64::EPSILON,
+                        "degree {d} stage {i}"
+                    );
+                }
+            }
+        }
+        // degree 6 is not exact: the remainder is 1/2 016 000 of the 6th derivative
+        let y = GL3_C.map(|c| 7.0 * c.powi(6));
+        let err = 1.0 - gl3_mean(y);
+        assert!((err - 5040.0 / 2_016_000.0).abs() < 1e-14, "{err:e}");
+    }
 }

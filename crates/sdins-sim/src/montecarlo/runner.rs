@@ -326,7 +326,7 @@ duration_s = 60.0
         ));
     }
 
-    /// The cached truth replays the streaming pipeline bit for bit (dq-paper: RK4 truth,
+    /// The cached truth replays the streaming pipeline bit for bit (dq-paper: integrated truth,
     /// coning overlay; aviation-grade errors; 41 s with a partial last epoch).
     #[test]
     fn cached_truth_run_equals_pipeline_run() {
