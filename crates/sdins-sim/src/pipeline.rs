@@ -31,21 +31,27 @@ pub struct NavError {
 }
 
 impl NavError {
-    /// Element-wise maximum of absolute values (`t_s` is the later time).
+    /// Element-wise maximum of absolute values (`t_s` is the later time). A NaN in
+    /// either operand propagates (and stays): a diverged solution must not be hidden
+    /// behind the maximum of its finite epochs, as `f64::max` would do.
+    #[inline]
     pub fn max_abs(&self, o: &NavError) -> NavError {
-        let m3 = |a: [f64; 3], b: [f64; 3]| {
-            [
-                a[0].abs().max(b[0].abs()),
-                a[1].abs().max(b[1].abs()),
-                a[2].abs().max(b[2].abs()),
-            ]
-        };
+        #[inline(always)]
+        fn m(a: f64, b: f64) -> f64 {
+            let (a, b) = (a.abs(), b.abs());
+            if b > a || b.is_nan() {
+                b
+            } else {
+                a
+            }
+        }
+        let m3 = |a: [f64; 3], b: [f64; 3]| [m(a[0], b[0]), m(a[1], b[1]), m(a[2], b[2])];
         NavError {
             t_s: self.t_s.max(o.t_s),
             pos_err_ned_m: m3(self.pos_err_ned_m, o.pos_err_ned_m),
             vel_err_ned_mps: m3(self.vel_err_ned_mps, o.vel_err_ned_mps),
             att_err_rad: m3(self.att_err_rad, o.att_err_rad),
-            height_err_m: self.height_err_m.abs().max(o.height_err_m.abs()),
+            height_err_m: m(self.height_err_m, o.height_err_m),
             euler_err_rad: m3(self.euler_err_rad, o.euler_err_rad),
         }
     }
@@ -64,7 +70,11 @@ fn arr(v: &Vec3) -> [f64; 3] {
 /// results equal the textbook formulas to rounding (see the tests).
 #[inline]
 pub fn nav_error(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> NavError {
-    let (sin_lat, cos_lat) = libm::sincos(truth.lat_rad);
+    let (sin_lat, cos_lat) = truth.sin_cos_lat;
+    debug_assert!(
+        (sin_lat - libm::sin(truth.lat_rad)).abs() <= 1e-15,
+        "stale sin_cos_lat"
+    );
     let r = earth.radii_sin(sin_lat);
     let dlat = nav.lat_rad - truth.lat_rad;
     let dlon = lon_diff(nav.lon_rad, truth.lon_rad);
@@ -402,15 +412,15 @@ mod tests {
                 (e[1] + de[1]) * d,
                 (e[2] + de[2]) * d,
             ));
-            let truth = TruthSample {
-                t_s: 12.5,
-                inc: Increment::default(),
-                lat_rad: lat * d,
-                lon_rad: lon_t * d,
-                h_m: 1200.0,
-                v_n_mps: Vec3::new(100.0, -50.0, 2.0),
-                c_b_n: ct,
-            };
+            let truth = TruthSample::new(
+                12.5,
+                Increment::default(),
+                lat * d,
+                lon_t * d,
+                1200.0,
+                Vec3::new(100.0, -50.0, 2.0),
+                ct,
+            );
             let nav = NavState {
                 t_s: 12.5,
                 lat_rad: (lat + 1e-5) * d,
@@ -434,6 +444,23 @@ mod tests {
             assert_eq!(f.height_err_m, r.height_err_m);
             assert_eq!(f.t_s, r.t_s);
         }
+    }
+
+    #[test]
+    fn max_abs_keeps_a_nan() {
+        let e = |x: f64| NavError {
+            pos_err_ned_m: [x, -2.0 * x, 0.5],
+            height_err_m: -x,
+            ..NavError::default()
+        };
+        let m = e(1.0).max_abs(&e(-3.0));
+        assert_eq!(m.pos_err_ned_m, [3.0, 6.0, 0.5]);
+        assert_eq!(m.height_err_m, 3.0);
+        let m = m.max_abs(&e(f64::NAN)).max_abs(&e(10.0));
+        assert!(m.pos_err_ned_m[0].is_nan() && m.height_err_m.is_nan());
+        assert_eq!(m.pos_err_ned_m[2], 0.5);
+        let m = e(f64::NAN).max_abs(&e(1.0));
+        assert!(m.pos_err_ned_m[1].is_nan());
     }
 
     #[test]

@@ -40,6 +40,33 @@ pub struct TruthSample {
     pub v_n_mps: Vec3,
     /// attitude body→NED
     pub c_b_n: Mat3,
+    /// `(sin L, cos L)` of `lat_rad`, so that every algorithm's error evaluation against
+    /// this sample shares one `sincos` (build samples with [`TruthSample::new`])
+    pub sin_cos_lat: (f64, f64),
+}
+
+impl TruthSample {
+    /// A sample, with `sin_cos_lat` computed from `lat_rad`.
+    pub fn new(
+        t_s: f64,
+        inc: Increment,
+        lat_rad: f64,
+        lon_rad: f64,
+        h_m: f64,
+        v_n_mps: Vec3,
+        c_b_n: Mat3,
+    ) -> Self {
+        Self {
+            t_s,
+            inc,
+            lat_rad,
+            lon_rad,
+            h_m,
+            v_n_mps,
+            c_b_n,
+            sin_cos_lat: libm::sincos(lat_rad),
+        }
+    }
 }
 
 /// Where the truth generator starts and how finely it integrates.
@@ -109,6 +136,8 @@ struct ClosedForm {
     /// the (constant) velocity and attitude, so that no sample re-evaluates them
     v_n_mps: Vec3,
     c_b_n: Mat3,
+    /// sin/cos of the (constant) latitude
+    sin_cos_lat: (f64, f64),
 }
 
 /// Streaming truth generator (constant memory): an iterator of [`TruthSample`].
@@ -281,6 +310,7 @@ impl<'a> TruthGenerator<'a> {
             lon_rate_rps,
             v_n_mps: k.v_n_mps,
             c_b_n: k.c_b_n,
+            sin_cos_lat: libm::sincos(lat),
         }
     }
 
@@ -456,11 +486,11 @@ impl Iterator for TruthGenerator<'_> {
         let t0 = self.k as f64 * dt;
         self.k += 1;
         let t1 = self.k as f64 * dt;
-        let (inc, v_n_mps, c_b_n) = match &self.closed {
+        let (inc, v_n_mps, c_b_n, sin_cos_lat) = match &self.closed {
             Some(cf) => {
                 self.dlon = cf.lon_rate_rps * t1;
-                // constant state: velocity and attitude are those of t = 0
-                (cf.inc, cf.v_n_mps, cf.c_b_n)
+                // constant state: velocity, attitude and latitude are those of t = 0
+                (cf.inc, cf.v_n_mps, cf.c_b_n, cf.sin_cos_lat)
             }
             None => {
                 let inc = match self.scheme {
@@ -472,17 +502,20 @@ impl Iterator for TruthGenerator<'_> {
                 let kin = self
                     .traj
                     .kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
-                (inc, kin.v_n_mps, kin.c_b_n)
+                let lat_rad = self.cfg.lat0_rad + self.dlat;
+                (inc, kin.v_n_mps, kin.c_b_n, libm::sincos(lat_rad))
             }
         };
         Some(TruthSample {
             t_s: t1,
             inc,
+            // after the integration of this sample (the closed form keeps dlat = 0)
             lat_rad: self.cfg.lat0_rad + self.dlat,
             lon_rad: wrap_pi(self.cfg.lon0_rad + self.dlon),
             h_m: self.h,
             v_n_mps,
             c_b_n,
+            sin_cos_lat,
         })
     }
 

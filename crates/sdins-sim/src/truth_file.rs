@@ -194,15 +194,7 @@ fn data_line(text: &str, k: usize) -> usize {
 }
 
 fn sample(t_s: f64, lat: f64, lon: f64, h: f64, v: Vec3, c: Mat3) -> TruthSample {
-    TruthSample {
-        t_s,
-        inc: Increment::default(),
-        lat_rad: lat,
-        lon_rad: lon,
-        h_m: h,
-        v_n_mps: v,
-        c_b_n: c,
-    }
+    TruthSample::new(t_s, Increment::default(), lat, lon, h, v, c)
 }
 
 /// Column names of an sdins `truth.csv` (further columns, e.g. the quaternion, are ignored).

@@ -294,6 +294,29 @@ fn closed_form_state_equals_the_trajectory_kinematics() {
     }
 }
 
+#[test]
+fn samples_carry_the_sin_cos_of_their_own_latitude() {
+    // nav_error uses TruthSample::sin_cos_lat instead of recomputing it: it must be the
+    // sincos of the sample's final latitude on the closed-form and integrated paths
+    // (dq-paper accelerates north-east, so a stale value would differ)
+    for name in ["mach1-east", "dq-paper"] {
+        let scn = Scenario::load(name).unwrap();
+        let c = cfg(&scn, 16);
+        let gen = TruthGenerator::new(&scn.trajectory, c);
+        let mut moved = false;
+        for s in gen.step_by(997).take(60) {
+            assert_eq!(
+                s.sin_cos_lat,
+                libm::sincos(s.lat_rad),
+                "{name} at {} s",
+                s.t_s
+            );
+            moved |= s.lat_rad != scn.start.lat_rad;
+        }
+        assert_eq!(moved, name == "dq-paper", "{name}");
+    }
+}
+
 /// Largest differences between the default (Gauss) truth at the scenario's substeps and
 /// the RK4 reference at twice as many, over `windows` of `(start_s, duration_s)`, each
 /// started from the scenario's start position: increments [rad], [m/s], and position [m]

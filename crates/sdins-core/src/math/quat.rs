@@ -193,14 +193,16 @@ impl Quat {
     #[inline]
     pub fn from_rotvec(phi: &Vec3) -> Self {
         let a2 = phi.norm_squared();
-        let a = libm::sqrt(a2);
-        let (c, s_over) = if a < 1e-6 {
+        // |φ| < 1e-6 ⇔ |φ|² < 1e-12: the square root is only taken where it is used
+        let (c, s_over) = if a2 < 1e-12 {
             (
                 1.0 - a2 / 8.0 + a2 * a2 / 384.0,
                 0.5 - a2 / 48.0 + a2 * a2 / 3840.0,
             )
         } else {
-            (libm::cos(0.5 * a), libm::sin(0.5 * a) / a)
+            let a = libm::sqrt(a2);
+            let (s, c) = libm::sincos(0.5 * a);
+            (c, s / a)
         };
         Quat::from_parts(c, &(phi * s_over))
     }

@@ -123,15 +123,15 @@ impl NonlinearRun {
         })?;
         let every = ((self.every_s / (dt * n as f64)).round() as u64).max(1);
         let mut out = Vec::new();
-        let t0 = crate::truth::TruthSample {
-            t_s: 0.0,
-            inc: Increment::default(),
-            lat_rad: init.lat_rad,
-            lon_rad: init.lon_rad,
-            h_m: init.h_m,
-            v_n_mps: init.v_n_mps,
-            c_b_n: c_true0,
-        };
+        let t0 = crate::truth::TruthSample::new(
+            0.0,
+            Increment::default(),
+            init.lat_rad,
+            init.lon_rad,
+            init.h_m,
+            init.v_n_mps,
+            c_true0,
+        );
         out.push(nav_error(&self.earth, &mech.state(), &t0));
         let mut buf = Vec::with_capacity(n);
         let mut k: u64 = 0;
