@@ -17,7 +17,7 @@
 //!   the analytic branch selected by the substep midpoint, is kept as the independent
 //!   reference ([`TruthGenerator::reference_rk4`], [`TruthScheme::Rk4`]).
 
-use crate::trajectory::Trajectory;
+use crate::trajectory::{Kinematics, OverlayPhases, Trajectory};
 use sdins_core::coning::Increment;
 use sdins_core::earth::{sin_cos_shift, EarthModel};
 use sdins_core::math::{Mat3, Vec3};
@@ -156,6 +156,22 @@ pub struct TruthGenerator<'a> {
     breaks: Vec<f64>,
     /// index of the first boundary after the current sample start
     bi: usize,
+    /// overlay phases at `ph_base_t` (the current sample start; carried over from the
+    /// previous sample's end evaluation)
+    ph_base: OverlayPhases,
+    ph_base_t: f64,
+    /// scratch: the phases at the sample end
+    ph_end: OverlayPhases,
+    /// overlay phases of the node offsets of a sample without inner boundaries (panel `p`,
+    /// node `i` at `3p + i`), the same for every such sample
+    ph_nodes: Vec<OverlayPhases>,
+    /// scratch for the node offsets of panels between inner boundaries
+    ph_tmp: [OverlayPhases; 3],
+    /// phases of offset 0
+    ph_zero: OverlayPhases,
+    /// `(L, sin L, cos L)` of the last latitude whose sin/cos was taken (the sample-end
+    /// latitude is the next panel's start latitude)
+    lat_sc: (f64, f64, f64),
 }
 
 /// Gauss–Legendre 3-node nodes, Butcher `A` (collocation) matrix; weights 5/18, 4/9, 5/18
@@ -219,7 +235,26 @@ impl<'a> TruthGenerator<'a> {
             scheme: TruthScheme::Gauss3,
             breaks: Self::boundaries(traj),
             bi: 0,
+            ph_base: OverlayPhases::default(),
+            ph_base_t: f64::NAN,
+            ph_end: OverlayPhases::default(),
+            ph_nodes: Vec::new(),
+            ph_tmp: Default::default(),
+            ph_zero: OverlayPhases::default(),
+            lat_sc: (f64::NAN, 0.0, 1.0),
         };
+        traj.phases_offset(0.0, &mut g.ph_zero);
+        // node offsets of the regular panel layout, formed as in `sample_gauss`
+        let panels = cfg.substeps.div_ceil(16).max(1);
+        let hp = cfg.dt_s / panels as f64;
+        for p in 0..panels {
+            let oa = 0.0 + p as f64 * hp;
+            for c in GL3_C {
+                let mut ph = OverlayPhases::default();
+                traj.phases_offset(oa + c * hp, &mut ph);
+                g.ph_nodes.push(ph);
+            }
+        }
         if traj.is_constant_parallel() {
             g.closed = Some(g.closed_form());
         }
@@ -393,6 +428,10 @@ impl TruthGenerator<'_> {
             self.bi += 1;
         }
         let panels = self.cfg.substeps.div_ceil(16).max(1);
+        if self.ph_base_t.to_bits() != t0.to_bits() {
+            self.traj.phases_at(t0, &mut self.ph_base);
+            self.ph_base_t = t0;
+        }
         let mut dth = Vec3::zeros();
         let mut dv = Vec3::zeros();
         // pieces [a, b] between the boundaries strictly inside the sample, P panels each
@@ -401,8 +440,10 @@ impl TruthGenerator<'_> {
             let last = !(j < self.breaks.len() && self.breaks[j] < t1 - eps);
             let b = if last { dt } else { self.breaks[j] - t0 };
             let hp = (b - a) / panels as f64;
+            // the whole sample in one piece: the node offsets of `ph_nodes`
+            let regular = last && j == self.bi;
             for p in 0..panels {
-                let (th, v) = self.panel_gauss(t0, a + p as f64 * hp, hp);
+                let (th, v) = self.panel_gauss(t0, a + p as f64 * hp, hp, regular.then_some(p));
                 dth += th;
                 dv += v;
             }
@@ -415,18 +456,49 @@ impl TruthGenerator<'_> {
         Increment::new(dth, dv)
     }
 
+    /// `(sin L, cos L)`, reusing the last result for the same `L`.
+    #[inline]
+    fn sin_cos_lat(&mut self, lat: f64) -> (f64, f64) {
+        if self.lat_sc.0.to_bits() != lat.to_bits() {
+            let (s, c) = libm::sincos(lat);
+            self.lat_sc = (lat, s, c);
+        }
+        (self.lat_sc.1, self.lat_sc.2)
+    }
+
     /// One Gauss panel `[t0 + oa, t0 + oa + hp]`: advances the position, returns the
-    /// increments over the panel.
-    fn panel_gauss(&mut self, t0: f64, oa: f64, hp: f64) -> (Vec3, Vec3) {
+    /// increments over the panel. `regular`: the panel index in a sample without inner
+    /// boundaries, whose node phases are precomputed.
+    fn panel_gauss(&mut self, t0: f64, oa: f64, hp: f64, regular: Option<usize>) -> (Vec3, Vec3) {
         let e = self.cfg.earth;
+        let traj = self.traj;
         let t_sel = t0 + (oa + 0.5 * hp);
-        let kin = GL3_C.map(|c| self.traj.kinematics_split(t0, oa + c * hp, t_sel));
+        let nodes: &[OverlayPhases] = match regular {
+            Some(p) => &self.ph_nodes[3 * p..3 * p + 3],
+            None => {
+                for (ph, c) in self.ph_tmp.iter_mut().zip(GL3_C) {
+                    traj.phases_offset(oa + c * hp, ph);
+                }
+                &self.ph_tmp
+            }
+        };
+        let b = &self.ph_base;
+        let kin: [Kinematics; 3] = [
+            traj.kinematics_phased(t0, oa + GL3_C[0] * hp, t_sel, b, &nodes[0]),
+            traj.kinematics_phased(t0, oa + GL3_C[1] * hp, t_sel, b, &nodes[1]),
+            traj.kinematics_phased(t0, oa + GL3_C[2] * hp, t_sel, b, &nodes[2]),
+        ];
         let lat_a = self.cfg.lat0_rad + self.dlat;
-        let (s_a, c_a) = (libm::sin(lat_a), libm::cos(lat_a));
+        let (s_a, c_a) = self.sin_cos_lat(lat_a);
         // height at the nodes: collocation quadrature of −v_D
-        let hs = gl3_stage(kin.map(|k| -k.v_n_mps.z));
-        let h_n = [0, 1, 2].map(|i| self.h + hp * hs[i]);
-        let h_b = self.h + hp * gl3_mean(kin.map(|k| -k.v_n_mps.z));
+        let vd = [-kin[0].v_n_mps.z, -kin[1].v_n_mps.z, -kin[2].v_n_mps.z];
+        let hs = gl3_stage(vd);
+        let h_n = [
+            self.h + hp * hs[0],
+            self.h + hp * hs[1],
+            self.h + hp * hs[2],
+        ];
+        let h_b = self.h + hp * gl3_mean(vd);
         // latitude and longitude rates; the flat model moves over the ellipsoid at the
         // start latitude (as the RK4 reference does)
         let flat = !e.transport;
@@ -437,7 +509,11 @@ impl TruthGenerator<'_> {
             (e.radii_sin(s_a), c_a)
         };
         // predictor: R_M at the panel start latitude
-        let pred = gl3_stage([0, 1, 2].map(|i| kin[i].v_n_mps.x / (r0.r_m_m + h_n[i])));
+        let pred = gl3_stage([
+            kin[0].v_n_mps.x / (r0.r_m_m + h_n[0]),
+            kin[1].v_n_mps.x / (r0.r_m_m + h_n[1]),
+            kin[2].v_n_mps.x / (r0.r_m_m + h_n[2]),
+        ]);
         let mut th = [Vec3::zeros(); 3];
         let mut f = [Vec3::zeros(); 3];
         let mut lat_dot = [0.0; 3];
@@ -498,12 +574,16 @@ impl Iterator for TruthGenerator<'_> {
                     TruthScheme::Rk4 => self.sample_rk4(t0),
                 };
                 // attitude and velocity at the sample end are analytic (branch of the
-                // last substep)
+                // last substep); its overlay phases are the next sample's base phases
+                let t_sel = t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64;
+                self.traj.phases_at(t1, &mut self.ph_end);
                 let kin = self
                     .traj
-                    .kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
+                    .kinematics_phased(t1, 0.0, t_sel, &self.ph_end, &self.ph_zero);
+                std::mem::swap(&mut self.ph_base, &mut self.ph_end);
+                self.ph_base_t = t1;
                 let lat_rad = self.cfg.lat0_rad + self.dlat;
-                (inc, kin.v_n_mps, kin.c_b_n, libm::sincos(lat_rad))
+                (inc, kin.v_n_mps, kin.c_b_n, self.sin_cos_lat(lat_rad))
             }
         };
         Some(TruthSample {
