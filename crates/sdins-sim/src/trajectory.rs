@@ -141,6 +141,9 @@ impl OverlayKind {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct OverlayPhases(Vec<(f64, f64)>);
 
+/// `(base, offset)` phases of [`Trajectory::kinematics_phased`]
+type PhasePair<'a> = (&'a [(f64, f64)], &'a [(f64, f64)]);
+
 /// An overlay active over `[start_s, end_s]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Overlay {
@@ -442,7 +445,7 @@ impl Trajectory {
         t_base: f64,
         off: f64,
         t_sel: f64,
-        phases: Option<(&[(f64, f64)], &[(f64, f64)])>,
+        phases: Option<PhasePair<'_>>,
     ) -> Kinematics {
         let t = t_base + off;
         let seg = self.segment_at(t_sel);
