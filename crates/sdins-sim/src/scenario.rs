@@ -272,8 +272,9 @@ pub struct NavConfig {
     pub earth: EarthChoice,
     /// vertical channel: `free` or `hold`
     pub vertical_hold: bool,
-    /// truth resolution: RK4 substeps per sample, `⌈substeps/16⌉` Gauss panels for the
-    /// default scheme (default: [`crate::truth::auto_substeps`])
+    /// truth resolution: RK4 substeps per sample; the default Gauss scheme uses one 3-node
+    /// panel up to 16 and `⌈substeps/32⌉` 4-node panels above (default:
+    /// [`crate::truth::auto_substeps`])
     pub substeps: usize,
 }
 

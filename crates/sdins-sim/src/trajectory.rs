@@ -124,6 +124,26 @@ pub enum OverlayKind {
     },
 }
 
+impl OverlayKind {
+    /// The angular frequency Ω of the overlay [rad/s].
+    pub fn omega_rps(&self) -> f64 {
+        match *self {
+            OverlayKind::Coning { omega_rps, .. }
+            | OverlayKind::Sculling { omega_rps, .. }
+            | OverlayKind::Vibration { omega_rps, .. } => omega_rps,
+        }
+    }
+}
+
+/// `(sin, cos)` of one phase per overlay of a trajectory, for
+/// [`Trajectory::kinematics_phased`] (fill with [`Trajectory::phases_at`] or
+/// [`Trajectory::phases_offset`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OverlayPhases(Vec<(f64, f64)>);
+
+/// `(base, offset)` phases of [`Trajectory::kinematics_phased`]
+type PhasePair<'a> = (&'a [(f64, f64)], &'a [(f64, f64)]);
+
 /// An overlay active over `[start_s, end_s]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Overlay {
@@ -168,10 +188,13 @@ struct KinConsts {
     roll_pitch: [f64; 4],
     /// per overlay: sin(α/2), cos(α/2), sin α, cos α (zeros for non-coning overlays)
     overlay: Vec<[f64; 4]>,
+    /// per segment: sin/cos of the start heading where the motion keeps it constant
+    /// (static, cruise, accelerate, climb), so that those segments need no trigonometry
+    heading: Vec<Option<(f64, f64)>>,
 }
 
 impl KinConsts {
-    fn new(roll: f64, pitch: f64, overlays: &[Overlay]) -> Self {
+    fn new(roll: f64, pitch: f64, overlays: &[Overlay], segments: &[Segment]) -> Self {
         let overlay = overlays
             .iter()
             .map(|o| match o.kind {
@@ -183,7 +206,18 @@ impl KinConsts {
                 _ => [0.0; 4],
             })
             .collect();
+        let heading = segments
+            .iter()
+            .map(|s| match s.motion {
+                Motion::Static
+                | Motion::Cruise
+                | Motion::Accelerate { .. }
+                | Motion::Climb { .. } => Some(s.heading0.sin_cos()),
+                Motion::TurnRate { .. } | Motion::TurnSmooth { .. } | Motion::STurn { .. } => None,
+            })
+            .collect();
         Self {
+            heading,
             roll_pitch: [
                 libm::sin(roll),
                 libm::cos(roll),
@@ -286,7 +320,12 @@ impl Trajectory {
         Self {
             roll0_rad: start_euler.roll_rad,
             pitch0_rad: start_euler.pitch_rad,
-            consts: KinConsts::new(start_euler.roll_rad, start_euler.pitch_rad, &overlays),
+            consts: KinConsts::new(
+                start_euler.roll_rad,
+                start_euler.pitch_rad,
+                &overlays,
+                &segments,
+            ),
             segments,
             overlays,
             duration_s: t,
@@ -332,13 +371,39 @@ impl Trajectory {
             })
     }
 
-    fn segment_at(&self, t_sel: f64) -> Option<&Segment> {
+    /// Index of the segment whose branch `t_sel` selects.
+    fn segment_at(&self, t_sel: f64) -> Option<usize> {
         // Segments are few; linear search from the end finds the last one starting ≤ t_sel.
         self.segments
             .iter()
-            .rev()
-            .find(|s| s.t0_s <= t_sel)
-            .or(self.segments.first())
+            .rposition(|s| s.t0_s <= t_sel)
+            .or(if self.segments.is_empty() {
+                None
+            } else {
+                Some(0)
+            })
+    }
+
+    /// `(sin, cos)` of `Ω_k (t_base − start_k)` for every overlay `k` into `out`: the
+    /// per-sample part of the overlay phases for [`Trajectory::kinematics_phased`].
+    pub fn phases_at(&self, t_base: f64, out: &mut OverlayPhases) {
+        out.0.clear();
+        out.0.extend(
+            self.overlays
+                .iter()
+                .map(|o| (o.kind.omega_rps() * (t_base - o.start_s)).sin_cos()),
+        );
+    }
+
+    /// `(sin, cos)` of `Ω_k·off` for every overlay `k` into `out`: the per-node part of
+    /// the overlay phases for [`Trajectory::kinematics_phased`].
+    pub fn phases_offset(&self, off: f64, out: &mut OverlayPhases) {
+        out.0.clear();
+        out.0.extend(
+            self.overlays
+                .iter()
+                .map(|o| (o.kind.omega_rps() * off).sin_cos()),
+        );
     }
 
     /// Exact kinematics at time `t`, with the analytic branch selected by `t_sel`
@@ -353,9 +418,39 @@ impl Trajectory {
     /// sample (at t = 400 s one ulp of t is 5.7e-14 s, which would otherwise put ~1e-16 rad
     /// of time-quantisation noise on each increment).
     pub fn kinematics_split(&self, t_base: f64, off: f64, t_sel: f64) -> Kinematics {
+        self.kinematics_impl(t_base, off, t_sel, None)
+    }
+
+    /// [`Trajectory::kinematics_split`] with the sin/cos of the overlay phases supplied:
+    /// `base` from [`Trajectory::phases_at`]`(t_base)` and `offset` from
+    /// [`Trajectory::phases_offset`]`(off)`. Bit-for-bit the same result, without the two
+    /// `sin_cos` per periodic overlay: a sample's base phase is shared by all its nodes and
+    /// the node offsets repeat from sample to sample.
+    pub fn kinematics_phased(
+        &self,
+        t_base: f64,
+        off: f64,
+        t_sel: f64,
+        base: &OverlayPhases,
+        offset: &OverlayPhases,
+    ) -> Kinematics {
+        debug_assert_eq!(base.0.len(), self.overlays.len());
+        debug_assert_eq!(offset.0.len(), self.overlays.len());
+        self.kinematics_impl(t_base, off, t_sel, Some((&base.0, &offset.0)))
+    }
+
+    #[inline(always)]
+    fn kinematics_impl(
+        &self,
+        t_base: f64,
+        off: f64,
+        t_sel: f64,
+        phases: Option<PhasePair<'_>>,
+    ) -> Kinematics {
         let t = t_base + off;
-        let n = match self.segment_at(t_sel) {
-            Some(seg) => seg.eval(t),
+        let seg = self.segment_at(t_sel);
+        let n = match seg {
+            Some(i) => self.segments[i].eval(t),
             None => Nominal {
                 speed: 0.0,
                 speed_dot: 0.0,
@@ -365,7 +460,11 @@ impl Trajectory {
                 v_d_dot: 0.0,
             },
         };
-        let (sh, ch) = n.heading.sin_cos();
+        // constant-heading segments: n.heading is their start heading, whose sin/cos is cached
+        let (sh, ch) = match seg.and_then(|i| self.consts.heading[i]) {
+            Some(sc) => sc,
+            None => n.heading.sin_cos(),
+        };
         let mut v = Vec3::new(n.speed * ch, n.speed * sh, n.v_d);
         let mut v_dot = Vec3::new(
             n.speed_dot * ch - n.speed * n.heading_dot * sh,
@@ -396,7 +495,7 @@ impl Trajectory {
         // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (spec §7.0)
         let mut c_c = Mat3::identity();
         let mut w_c = Vec3::zeros();
-        for (ov, kc) in self.overlays.iter().zip(&self.consts.overlay) {
+        for (j, (ov, kc)) in self.overlays.iter().zip(&self.consts.overlay).enumerate() {
             // branch by t_sel: before the window the overlay is at rest, after it frozen
             let active = t_sel >= ov.start_s && t_sel < ov.end_s;
             let (tau_base, tau_off) = if active {
@@ -407,8 +506,11 @@ impl Trajectory {
                 (ov.end_s - ov.start_s, 0.0)
             };
             let sincos = |w: f64| -> (f64, f64) {
-                let (sa, ca) = (w * tau_base).sin_cos();
-                let (sb, cb) = (w * tau_off).sin_cos();
+                let ((sa, ca), (sb, cb)) = match phases {
+                    // the supplied phases are those of the active branch
+                    Some((b, o)) if active => (b[j], o[j]),
+                    _ => ((w * tau_base).sin_cos(), (w * tau_off).sin_cos()),
+                };
                 (sa * cb + ca * sb, ca * cb - sa * sb)
             };
             let (c_k, w_k) = match ov.kind {
@@ -467,9 +569,22 @@ impl Trajectory {
                     (Mat3::identity(), Vec3::zeros())
                 }
             };
-            // compose: C_c ← C_c C_k, ω_c ← C_kᵀ ω_c + ω_k
-            w_c = c_k.transpose() * w_c + w_k;
-            c_c *= c_k;
+            // compose: C_c ← C_c C_k, ω_c ← C_kᵀ ω_c + ω_k (the first directly: the
+            // products with the identity and zero would return it unchanged)
+            if j == 0 {
+                (c_c, w_c) = (c_k, w_k);
+            } else {
+                w_c = c_k.transpose() * w_c + w_k;
+                c_c *= c_k;
+            }
+        }
+        if self.overlays.is_empty() {
+            return Kinematics {
+                v_n_mps: v,
+                v_dot_n_mps2: v_dot,
+                c_b_n: c_nom,
+                omega_nb_b_rps: w_nom,
+            };
         }
         Kinematics {
             v_n_mps: v,

@@ -10,14 +10,14 @@
 //!   ([`Trajectory::kinematics_split`]) and the position `(L, l, h)` enters only through
 //!   the slowly varying earth terms `ω_ie(L)`, `ω_en(L, h, v)`, `g(L, h)`. The default
 //!   scheme ([`TruthScheme::Gauss3`]) integrates the whole state
-//!   `[L, l, h, ∫ω_ib^b, ∫f^b]` with 3-node Gauss–Legendre collocation on
-//!   `⌈substeps/16⌉` panels per sample (split further at segment and overlay boundaries
-//!   inside a sample, so that no panel straddles a kink); see [`TruthScheme::Gauss3`] for
-//!   the error bound. The classical RK4 of the spec, with `substeps` steps per sample and
+//!   `[L, l, h, ∫ω_ib^b, ∫f^b]` with Gauss–Legendre collocation: one 3-node panel per
+//!   sample up to 16 substeps, else 4-node panels, `⌈substeps/32⌉` per sample (split
+//!   further at segment and overlay boundaries inside a sample, so that no panel straddles
+//!   a kink); see [`TruthScheme::Gauss3`] for the error bound. The classical RK4 of the spec, with `substeps` steps per sample and
 //!   the analytic branch selected by the substep midpoint, is kept as the independent
 //!   reference ([`TruthGenerator::reference_rk4`], [`TruthScheme::Rk4`]).
 
-use crate::trajectory::Trajectory;
+use crate::trajectory::{Kinematics, OverlayPhases, Trajectory};
 use sdins_core::coning::Increment;
 use sdins_core::earth::{sin_cos_shift, EarthModel};
 use sdins_core::math::{Mat3, Vec3};
@@ -83,21 +83,26 @@ pub struct TruthConfig {
     /// start height [m]
     pub h0_m: f64,
     /// integration resolution: RK4 substeps per sample for [`TruthScheme::Rk4`] (16 in the
-    /// spec; the refinement test compares with 32); [`TruthScheme::Gauss3`] uses
-    /// `⌈substeps/16⌉` Gauss panels per sample
+    /// spec; the refinement test compares with 32); [`TruthScheme::Gauss3`] uses one
+    /// 3-node panel per sample up to 16, else `⌈substeps/32⌉` 4-node panels
     pub substeps: usize,
 }
 
 /// How the general (non-closed-form) path integrates a sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TruthScheme {
-    /// Default. 3-node Gauss–Legendre collocation (order 6, stage order 3) on
-    /// `P = ⌈substeps/16⌉` equal panels of length `H` per sample (per piece between
-    /// segment/overlay boundaries inside the sample, if any; each panel selects its
-    /// analytic branch by its midpoint). Per panel, with nodes `c = ½ ∓ √15/10, ½` and
-    /// weights `5/18, 4/9, 5/18`:
+    /// Default: Gauss–Legendre collocation (named for its original 3-node rule). Up to 16
+    /// substeps, one 3-node panel per sample (order 6, stage order 3; nodes
+    /// `c = ½ ∓ √15/10, ½`, weights `5/18, 4/9, 5/18`); above, `P = ⌈substeps/32⌉` 4-node
+    /// panels (order 8, stage order 4; nodes `½ ∓ ½√(3/7 ± (2/7)√(6/5))`, weights
+    /// `(18 ∓ √30)/72`), which replace `2P` 3-node panels with `4P` instead of `6P` nodes
+    /// and a smaller remainder (below). The panels are equal, of length `H`, per piece
+    /// between segment/overlay boundaries inside the sample, if any; each panel selects its
+    /// analytic branch by its midpoint. Per panel:
     ///
-    /// * the kinematics are evaluated once per node (3 per panel);
+    /// * the kinematics are evaluated once per node, with the overlay phases'
+    ///   sin/cos shared ([`Trajectory::kinematics_phased`]: once per sample for the sample
+    ///   start, once per generator for the node offsets);
     /// * height at the nodes is the collocation (Butcher `A`) quadrature of `−v_D`;
     ///   latitude at the nodes the same for `v_N/(R_M + h)`, with `R_M` first at the panel
     ///   start latitude and then once corrected at the predicted node latitudes (one
@@ -107,21 +112,25 @@ pub enum TruthScheme {
     ///   `H·Σ b_i y'_i`.
     ///
     /// Error: for the increments (pure quadratures given the position) the Gauss remainder
-    /// is `H⁷ f⁽⁶⁾(ξ)/2 016 000`; for an oscillation of amplitude `A` and frequency `Ω` that is
-    /// `A·H·(ΩH)⁶/2 016 000`. [`auto_substeps`] gives `Ω·δt/substeps ≤ 2e-3`, hence
-    /// `ΩH ≤ 0.032` and a relative remainder `≤ 5.3e-16` of `A·H` (below one rounding of the
-    /// increment; RK4 at the same `substeps` is Simpson's rule with `(Ωh)⁴/2880 = 5.6e-15`).
-    /// `dq-paper` (1 Hz, 0.5° coning, `A = Ω sin α = 0.055 rad/s`, `H = 5 ms`): 1.3e-19 rad;
-    /// its specific-force oscillation (`g sin α = 0.086 m/s²`) 2.1e-19 m/s. `turn-90dps`
+    /// is `H⁷ f⁽⁶⁾(ξ)/2 016 000` (3 nodes) and `H⁹ f⁽⁸⁾(ξ)/1 778 112 000` (4 nodes); for an
+    /// oscillation of amplitude `A` and frequency `Ω` that is `A·H·(ΩH)⁶/2 016 000` and
+    /// `A·H·(ΩH)⁸/1 778 112 000`. [`auto_substeps`] gives `Ω·δt/substeps ≤ 2e-3`, hence
+    /// `ΩH ≤ 0.032` on 3-node panels and `ΩH ≤ 0.064` on 4-node panels, relative remainders
+    /// `≤ 5.3e-16` and `≤ 1.6e-19` of `A·H` (below one rounding of the increment; RK4 at the
+    /// same `substeps` is Simpson's rule with `(Ωh)⁴/2880 = 5.6e-15`). `dq-paper` (1 Hz,
+    /// 0.5° coning, `A = Ω sin α = 0.055 rad/s`, 32 substeps: one 4-node panel, `H = 10 ms`):
+    /// 7e-23 rad per sample (3-node panels of 5 ms: 2.6e-19); its specific-force
+    /// oscillation (`g sin α = 0.086 m/s²`) 1e-22 m/s. `turn-90dps`
     /// (`f_y = s ψ̇`, a raised cosine of amplitude 267 m/s² at `Ω = π rad/s`, `H = 2 ms`):
     /// 2e-20 m/s. The node positions carry the collocation stage error `O(H⁴·|v⁽³⁾|)`
-    /// (≲ 1e-10 m in the 90°/s turn, ~1e-14 m in `dq-paper`), which enters the increments
-    /// only through `∂g/∂h ≈ 3e-6 s⁻²` and `∂ω_ie/∂L ≈ 1e-4 s⁻¹` (< 1e-20 per sample); the
-    /// position at the panel end is the order-6 Gauss quadrature of the rates at the nodes,
+    /// with 3 nodes, `O(H⁵·|v⁽⁴⁾|)` with 4 (≲ 1e-10 m in the 90°/s turn, ≲ 1e-14 m in
+    /// `dq-paper`), which enters the increments only through `∂g/∂h ≈ 3e-6 s⁻²` and
+    /// `∂ω_ie/∂L ≈ 1e-4 s⁻¹` (< 1e-20 per sample); the position at the panel end is the
+    /// order-6 (order-8) Gauss quadrature of the rates at the nodes,
     /// where the node errors enter only through `∂L̇/∂L ≈ 1e-8 s⁻¹`.
     /// Equal to the RK4 reference at doubled substeps within 2e-17 rad / 2e-16 m/s per sample
-    /// (tests/truth.rs, `gauss_matches_rk4_reference_*`), with 3 kinematics evaluations per
-    /// panel instead of 3 per RK4 substep.
+    /// (tests/truth.rs, `gauss_matches_rk4_reference_*`), with 3 or 4 kinematics evaluations
+    /// per panel instead of 3 per RK4 substep.
     Gauss3,
     /// Classical RK4 on `[L − L0, l − l0, h, ∫ω_ib^b, ∫f^b]` with `substeps` steps per
     /// sample, the integrals reset at every sample boundary and the analytic branch
@@ -156,6 +165,22 @@ pub struct TruthGenerator<'a> {
     breaks: Vec<f64>,
     /// index of the first boundary after the current sample start
     bi: usize,
+    /// overlay phases at `ph_base_t` (the current sample start; carried over from the
+    /// previous sample's end evaluation)
+    ph_base: OverlayPhases,
+    ph_base_t: f64,
+    /// scratch: the phases at the sample end
+    ph_end: OverlayPhases,
+    /// overlay phases of the node offsets of a sample without inner boundaries (panel `p`,
+    /// node `i` at `3p + i`), the same for every such sample
+    ph_nodes: Vec<OverlayPhases>,
+    /// scratch for the node offsets of panels between inner boundaries
+    ph_tmp: [OverlayPhases; 4],
+    /// phases of offset 0
+    ph_zero: OverlayPhases,
+    /// `(L, sin L, cos L)` of the last latitude whose sin/cos was taken (the sample-end
+    /// latitude is the next panel's start latitude)
+    lat_sc: (f64, f64, f64),
 }
 
 /// Gauss–Legendre 3-node nodes, Butcher `A` (collocation) matrix; weights 5/18, 4/9, 5/18
@@ -201,6 +226,89 @@ fn gl3_stage(y: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+/// Gauss–Legendre 4-node nodes `½ ∓ ½√(3/7 ± (2/7)√(6/5))` and Butcher `A` matrix
+/// (collocation, `A_ij = ∫₀^{c_i} ℓ_j`); weights `(18 ∓ √30)/72` (outer, inner) are applied
+/// as `½(y₁ + y₂) + b_o((y₀ − y₁) + (y₃ − y₂))` (exact for constant integrands).
+#[allow(clippy::excessive_precision)] // 20-digit values (mpmath)
+const GL4_C: [f64; 4] = [
+    0.069_431_844_202_973_712,
+    0.330_009_478_207_571_87,
+    0.669_990_521_792_428_13,
+    0.930_568_155_797_026_29,
+];
+/// outer weight `(18 − √30)/72`
+#[allow(clippy::excessive_precision)] // 20-digit values (mpmath)
+const GL4_BO: f64 = 0.173_927_422_568_726_93;
+#[allow(clippy::excessive_precision)] // 20-digit values (mpmath)
+const GL4_A: [[f64; 4]; 4] = [
+    [
+        0.086_963_711_284_363_464,
+        -0.026_604_180_084_998_793,
+        0.012_627_462_689_404_725,
+        -0.003_555_149_685_795_683_2,
+    ],
+    [
+        0.188_118_117_499_868_07,
+        0.163_036_288_715_636_54,
+        -0.027_880_428_602_470_895,
+        0.006_735_500_594_538_155_5,
+    ],
+    [
+        0.167_191_921_974_188_77,
+        0.353_953_006_033_743_97,
+        0.163_036_288_715_636_54,
+        -0.014_190_694_931_141_143,
+    ],
+    [
+        0.177_482_572_254_522_61,
+        0.313_445_114_741_868_35,
+        0.352_676_757_516_271_86,
+        0.086_963_711_284_363_464,
+    ],
+];
+
+/// The Gauss 4-node weighted mean `Σ b_i y_i` in the form exact for constant `y`.
+#[inline]
+fn gl4_mean(y: [f64; 4]) -> f64 {
+    0.5 * (y[1] + y[2]) + GL4_BO * ((y[0] - y[1]) + (y[3] - y[2]))
+}
+
+/// `Σ_j A_ij y_j` for the 4-node rule.
+#[inline]
+fn gl4_stage(y: [f64; 4]) -> [f64; 4] {
+    let a = &GL4_A;
+    std::array::from_fn(|i| a[i][0] * y[0] + a[i][1] * y[1] + a[i][2] * y[2] + a[i][3] * y[3])
+}
+
+/// One Gauss–Legendre rule: nodes, weighted mean, stage quadrature.
+struct Rule<const N: usize> {
+    c: [f64; N],
+    mean: fn([f64; N]) -> f64,
+    stage: fn([f64; N]) -> [f64; N],
+}
+
+const GL3: Rule<3> = Rule {
+    c: GL3_C,
+    mean: gl3_mean,
+    stage: gl3_stage,
+};
+const GL4: Rule<4> = Rule {
+    c: GL4_C,
+    mean: gl4_mean,
+    stage: gl4_stage,
+};
+
+/// The Gauss layout for `substeps`: `(nodes, panels per sample)`. Up to 16 substeps one
+/// 3-node panel; above, 4-node panels of twice the length, `⌈substeps/32⌉` (more accurate
+/// than 3-node panels of `⌈substeps/16⌉`, with fewer nodes: see [`TruthScheme::Gauss3`]).
+fn gauss_layout(substeps: usize) -> (usize, usize) {
+    if substeps <= 16 {
+        (3, 1)
+    } else {
+        (4, substeps.div_ceil(32))
+    }
+}
+
 type State = [f64; 9];
 
 impl<'a> TruthGenerator<'a> {
@@ -219,7 +327,27 @@ impl<'a> TruthGenerator<'a> {
             scheme: TruthScheme::Gauss3,
             breaks: Self::boundaries(traj),
             bi: 0,
+            ph_base: OverlayPhases::default(),
+            ph_base_t: f64::NAN,
+            ph_end: OverlayPhases::default(),
+            ph_nodes: Vec::new(),
+            ph_tmp: Default::default(),
+            ph_zero: OverlayPhases::default(),
+            lat_sc: (f64::NAN, 0.0, 1.0),
         };
+        traj.phases_offset(0.0, &mut g.ph_zero);
+        // node offsets of the regular panel layout, formed as in `sample_gauss`
+        let (nodes, panels) = gauss_layout(cfg.substeps);
+        let hp = cfg.dt_s / panels as f64;
+        for p in 0..panels {
+            let oa = 0.0 + p as f64 * hp;
+            let c: &[f64] = if nodes == 3 { &GL3_C } else { &GL4_C };
+            for &c in c {
+                let mut ph = OverlayPhases::default();
+                traj.phases_offset(oa + c * hp, &mut ph);
+                g.ph_nodes.push(ph);
+            }
+        }
         if traj.is_constant_parallel() {
             g.closed = Some(g.closed_form());
         }
@@ -392,7 +520,11 @@ impl TruthGenerator<'_> {
         while self.bi < self.breaks.len() && self.breaks[self.bi] <= t0 + eps {
             self.bi += 1;
         }
-        let panels = self.cfg.substeps.div_ceil(16).max(1);
+        let (nodes, panels) = gauss_layout(self.cfg.substeps);
+        if self.ph_base_t.to_bits() != t0.to_bits() {
+            self.traj.phases_at(t0, &mut self.ph_base);
+            self.ph_base_t = t0;
+        }
         let mut dth = Vec3::zeros();
         let mut dv = Vec3::zeros();
         // pieces [a, b] between the boundaries strictly inside the sample, P panels each
@@ -401,8 +533,16 @@ impl TruthGenerator<'_> {
             let last = !(j < self.breaks.len() && self.breaks[j] < t1 - eps);
             let b = if last { dt } else { self.breaks[j] - t0 };
             let hp = (b - a) / panels as f64;
+            // the whole sample in one piece: the node offsets of `ph_nodes`
+            let regular = last && j == self.bi;
             for p in 0..panels {
-                let (th, v) = self.panel_gauss(t0, a + p as f64 * hp, hp);
+                let reg = regular.then_some(p);
+                let oa = a + p as f64 * hp;
+                let (th, v) = if nodes == 3 {
+                    self.panel_gauss(&GL3, t0, oa, hp, reg)
+                } else {
+                    self.panel_gauss(&GL4, t0, oa, hp, reg)
+                };
                 dth += th;
                 dv += v;
             }
@@ -415,18 +555,58 @@ impl TruthGenerator<'_> {
         Increment::new(dth, dv)
     }
 
+    /// `(sin L, cos L)`, reusing the last result for the same `L`.
+    #[inline]
+    fn sin_cos_lat(&mut self, lat: f64) -> (f64, f64) {
+        if self.lat_sc.0.to_bits() != lat.to_bits() {
+            let (s, c) = libm::sincos(lat);
+            self.lat_sc = (lat, s, c);
+        }
+        (self.lat_sc.1, self.lat_sc.2)
+    }
+
     /// One Gauss panel `[t0 + oa, t0 + oa + hp]`: advances the position, returns the
-    /// increments over the panel.
-    fn panel_gauss(&mut self, t0: f64, oa: f64, hp: f64) -> (Vec3, Vec3) {
+    /// increments over the panel. `regular`: the panel index in a sample without inner
+    /// boundaries, whose node phases are precomputed.
+    fn panel_gauss<const N: usize>(
+        &mut self,
+        rule: &Rule<N>,
+        t0: f64,
+        oa: f64,
+        hp: f64,
+        regular: Option<usize>,
+    ) -> (Vec3, Vec3) {
         let e = self.cfg.earth;
+        let traj = self.traj;
         let t_sel = t0 + (oa + 0.5 * hp);
-        let kin = GL3_C.map(|c| self.traj.kinematics_split(t0, oa + c * hp, t_sel));
+        let nodes: &[OverlayPhases] = match regular {
+            Some(p) => &self.ph_nodes[N * p..N * p + N],
+            None => {
+                for (ph, c) in self.ph_tmp.iter_mut().zip(rule.c) {
+                    traj.phases_offset(oa + c * hp, ph);
+                }
+                &self.ph_tmp[..N]
+            }
+        };
+        let b = &self.ph_base;
+        // filled in place (array::from_fn would copy each 144-byte value twice)
+        let z = Vec3::zeros();
+        let mut kin = [Kinematics {
+            v_n_mps: z,
+            v_dot_n_mps2: z,
+            c_b_n: Mat3::zeros(),
+            omega_nb_b_rps: z,
+        }; N];
+        for (i, k) in kin.iter_mut().enumerate() {
+            *k = traj.kinematics_phased(t0, oa + rule.c[i] * hp, t_sel, b, &nodes[i]);
+        }
         let lat_a = self.cfg.lat0_rad + self.dlat;
-        let (s_a, c_a) = (libm::sin(lat_a), libm::cos(lat_a));
+        let (s_a, c_a) = self.sin_cos_lat(lat_a);
         // height at the nodes: collocation quadrature of −v_D
-        let hs = gl3_stage(kin.map(|k| -k.v_n_mps.z));
-        let h_n = [0, 1, 2].map(|i| self.h + hp * hs[i]);
-        let h_b = self.h + hp * gl3_mean(kin.map(|k| -k.v_n_mps.z));
+        let vd: [f64; N] = std::array::from_fn(|i| -kin[i].v_n_mps.z);
+        let hs = (rule.stage)(vd);
+        let h_n: [f64; N] = std::array::from_fn(|i| self.h + hp * hs[i]);
+        let h_b = self.h + hp * (rule.mean)(vd);
         // latitude and longitude rates; the flat model moves over the ellipsoid at the
         // start latitude (as the RK4 reference does)
         let flat = !e.transport;
@@ -437,12 +617,14 @@ impl TruthGenerator<'_> {
             (e.radii_sin(s_a), c_a)
         };
         // predictor: R_M at the panel start latitude
-        let pred = gl3_stage([0, 1, 2].map(|i| kin[i].v_n_mps.x / (r0.r_m_m + h_n[i])));
-        let mut th = [Vec3::zeros(); 3];
-        let mut f = [Vec3::zeros(); 3];
-        let mut lat_dot = [0.0; 3];
-        let mut lon_dot = [0.0; 3];
-        for i in 0..3 {
+        let pred = (rule.stage)(std::array::from_fn(|i| {
+            kin[i].v_n_mps.x / (r0.r_m_m + h_n[i])
+        }));
+        let mut th = [[0.0; N]; 3];
+        let mut f = [[0.0; N]; 3];
+        let mut lat_dot = [0.0; N];
+        let mut lon_dot = [0.0; N];
+        for i in 0..N {
             let (k, h) = (&kin[i], h_n[i]);
             let (s, c) = sin_cos_shift(s_a, c_a, hp * pred[i]);
             let le = e.local_sc(s, c, h);
@@ -450,9 +632,13 @@ impl TruthGenerator<'_> {
             let w_ie = e.omega_ie_n_local(&le);
             let w_en = e.omega_en_n_local(&le, h, &v);
             let c_n_b = k.c_b_n.transpose();
-            th[i] = k.omega_nb_b_rps + c_n_b * (w_ie + w_en);
-            f[i] = c_n_b
+            let th_i = k.omega_nb_b_rps + c_n_b * (w_ie + w_en);
+            let f_i = c_n_b
                 * (k.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - Vec3::new(0.0, 0.0, le.g_mps2));
+            for a in 0..3 {
+                th[a][i] = th_i[a];
+                f[a][i] = f_i[a];
+            }
             if flat {
                 lat_dot[i] = v.x / (r0.r_m_m + h);
                 lon_dot[i] = v.y / ((r0.r_n_m + h) * cos0);
@@ -461,17 +647,12 @@ impl TruthGenerator<'_> {
                 lon_dot[i] = v.y / ((le.r_n_m + h) * c);
             }
         }
-        self.dlat += hp * gl3_mean(lat_dot);
-        self.dlon += hp * gl3_mean(lon_dot);
+        self.dlat += hp * (rule.mean)(lat_dot);
+        self.dlon += hp * (rule.mean)(lon_dot);
         self.h = h_b;
-        let mean3 = |y: &[Vec3; 3]| {
-            Vec3::new(
-                gl3_mean([y[0].x, y[1].x, y[2].x]),
-                gl3_mean([y[0].y, y[1].y, y[2].y]),
-                gl3_mean([y[0].z, y[1].z, y[2].z]),
-            )
-        };
-        (mean3(&th) * hp, mean3(&f) * hp)
+        let mean3 =
+            |y: [[f64; N]; 3]| Vec3::new((rule.mean)(y[0]), (rule.mean)(y[1]), (rule.mean)(y[2]));
+        (mean3(th) * hp, mean3(f) * hp)
     }
 }
 
@@ -498,12 +679,16 @@ impl Iterator for TruthGenerator<'_> {
                     TruthScheme::Rk4 => self.sample_rk4(t0),
                 };
                 // attitude and velocity at the sample end are analytic (branch of the
-                // last substep)
+                // last substep); its overlay phases are the next sample's base phases
+                let t_sel = t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64;
+                self.traj.phases_at(t1, &mut self.ph_end);
                 let kin = self
                     .traj
-                    .kinematics(t1, t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64);
+                    .kinematics_phased(t1, 0.0, t_sel, &self.ph_end, &self.ph_zero);
+                std::mem::swap(&mut self.ph_base, &mut self.ph_end);
+                self.ph_base_t = t1;
                 let lat_rad = self.cfg.lat0_rad + self.dlat;
-                (inc, kin.v_n_mps, kin.c_b_n, libm::sincos(lat_rad))
+                (inc, kin.v_n_mps, kin.c_b_n, self.sin_cos_lat(lat_rad))
             }
         };
         Some(TruthSample {
@@ -529,8 +714,9 @@ impl Iterator for TruthGenerator<'_> {
 /// the fastest periodic motion advances at most 2e-3 rad per substep. RK4 on a pure
 /// quadrature is Simpson's rule, whose error per sample is δt·h⁴·|ω⁗|/2880; for 1 Hz,
 /// 0.5° coning at 100 Hz this is 4.5e-17 rad with 16 substeps and 2.8e-18 rad with 32.
-/// Rounded up to a power of two. The default Gauss scheme uses `substeps/16` panels, i.e.
-/// at most 0.032 rad of the fastest motion per panel ([`TruthScheme::Gauss3`]).
+/// Rounded up to a power of two. The default Gauss scheme uses one 3-node panel for 16 and
+/// `substeps/32` 4-node panels above, i.e. at most 0.032 rad (3 nodes) or 0.064 rad (4 nodes)
+/// of the fastest motion per panel ([`TruthScheme::Gauss3`]).
 pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
     let w_max = traj.max_frequency_rps();
     let need = (dt_s * w_max / 2e-3).ceil().clamp(16.0, 4096.0) as usize;
@@ -569,5 +755,32 @@ mod tests {
         let y = GL3_C.map(|c| 7.0 * c.powi(6));
         let err = 1.0 - gl3_mean(y);
         assert!((err - 5040.0 / 2_016_000.0).abs() < 1e-14, "{err:e}");
+    }
+
+    #[test]
+    fn gauss4_weights_and_stages_are_exact_for_polynomials() {
+        // Σ b_i p(c_i) = ∫₀¹ p for degree ≤ 7; Σ_j A_ij p(c_j) = ∫₀^{c_i} p for degree ≤ 3
+        for d in 0..=7 {
+            let y = GL4_C.map(|c| (d + 1) as f64 * c.powi(d));
+            assert!((gl4_mean(y) - 1.0).abs() < 4.0 * f64::EPSILON, "degree {d}");
+            if d <= 3 {
+                let st = gl4_stage(y);
+                for i in 0..4 {
+                    let want = GL4_C[i].powi(d + 1);
+                    assert!(
+                        (st[i] - want).abs() < 4.0 * f64::EPSILON,
+                        "degree {d} stage {i}"
+                    );
+                }
+            }
+        }
+        // degree 8 is not exact: the remainder is 1/1 778 112 000 of the 8th derivative
+        let y = GL4_C.map(|c| 9.0 * c.powi(8));
+        let err = 1.0 - gl4_mean(y);
+        assert!((err - 362_880.0 / 1_778_112_000.0).abs() < 1e-14, "{err:e}");
+        // the layout: 4-node panels only where they replace at least two 3-node panels
+        assert_eq!(gauss_layout(16), (3, 1));
+        assert_eq!(gauss_layout(32), (4, 1));
+        assert_eq!(gauss_layout(64), (4, 2));
     }
 }
