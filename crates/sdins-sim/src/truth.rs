@@ -9,11 +9,11 @@
 //!   over the sample, where attitude, rates, velocity and v̇ are analytic functions of time
 //!   ([`Trajectory::kinematics_split`]) and the position `(L, l, h)` enters only through
 //!   the slowly varying earth terms `ω_ie(L)`, `ω_en(L, h, v)`, `g(L, h)`. The default
-//!   scheme ([`TruthScheme::Gauss3`]) integrates the whole state
+//!   scheme ([`TruthScheme::Gauss`]) integrates the whole state
 //!   `[L, l, h, ∫ω_ib^b, ∫f^b]` with Gauss–Legendre collocation: one 3-node panel per
 //!   sample up to 16 substeps, else 4-node panels, `⌈substeps/32⌉` per sample (split
 //!   further at segment and overlay boundaries inside a sample, so that no panel straddles
-//!   a kink); see [`TruthScheme::Gauss3`] for the error bound. The classical RK4 of the spec, with `substeps` steps per sample and
+//!   a kink); see [`TruthScheme::Gauss`] for the error bound. The classical RK4 of the spec, with `substeps` steps per sample and
 //!   the analytic branch selected by the substep midpoint, is kept as the independent
 //!   reference ([`TruthGenerator::reference_rk4`], [`TruthScheme::Rk4`]).
 
@@ -83,7 +83,7 @@ pub struct TruthConfig {
     /// start height [m]
     pub h0_m: f64,
     /// integration resolution: RK4 substeps per sample for [`TruthScheme::Rk4`] (16 in the
-    /// spec; the refinement test compares with 32); [`TruthScheme::Gauss3`] uses one
+    /// spec; the refinement test compares with 32); [`TruthScheme::Gauss`] uses one
     /// 3-node panel per sample up to 16, else `⌈substeps/32⌉` 4-node panels
     pub substeps: usize,
 }
@@ -91,7 +91,7 @@ pub struct TruthConfig {
 /// How the general (non-closed-form) path integrates a sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TruthScheme {
-    /// Default: Gauss–Legendre collocation (named for its original 3-node rule). Up to 16
+    /// Default: Gauss–Legendre collocation. Up to 16
     /// substeps, one 3-node panel per sample (order 6, stage order 3; nodes
     /// `c = ½ ∓ √15/10, ½`, weights `5/18, 4/9, 5/18`); above, `P = ⌈substeps/32⌉` 4-node
     /// panels (order 8, stage order 4; nodes `½ ∓ ½√(3/7 ± (2/7)√(6/5))`, weights
@@ -131,7 +131,7 @@ pub enum TruthScheme {
     /// Equal to the RK4 reference at doubled substeps within 2e-17 rad / 2e-16 m/s per sample
     /// (tests/truth.rs, `gauss_matches_rk4_reference_*`), with 3 or 4 kinematics evaluations
     /// per panel instead of 3 per RK4 substep.
-    Gauss3,
+    Gauss,
     /// Classical RK4 on `[L − L0, l − l0, h, ∫ω_ib^b, ∫f^b]` with `substeps` steps per
     /// sample, the integrals reset at every sample boundary and the analytic branch
     /// selected by the substep midpoint (spec §7.0). The independent reference.
@@ -300,7 +300,7 @@ const GL4: Rule<4> = Rule {
 
 /// The Gauss layout for `substeps`: `(nodes, panels per sample)`. Up to 16 substeps one
 /// 3-node panel; above, 4-node panels of twice the length, `⌈substeps/32⌉` (more accurate
-/// than 3-node panels of `⌈substeps/16⌉`, with fewer nodes: see [`TruthScheme::Gauss3`]).
+/// than 3-node panels of `⌈substeps/16⌉`, with fewer nodes: see [`TruthScheme::Gauss`]).
 fn gauss_layout(substeps: usize) -> (usize, usize) {
     if substeps <= 16 {
         (3, 1)
@@ -324,7 +324,7 @@ impl<'a> TruthGenerator<'a> {
             dlon: 0.0,
             h: cfg.h0_m,
             closed: None,
-            scheme: TruthScheme::Gauss3,
+            scheme: TruthScheme::Gauss,
             breaks: Self::boundaries(traj),
             bi: 0,
             ph_base: OverlayPhases::default(),
@@ -510,7 +510,7 @@ impl<'a> TruthGenerator<'a> {
 }
 
 impl TruthGenerator<'_> {
-    /// One sample `[t0, t0 + δt]` with the Gauss scheme ([`TruthScheme::Gauss3`]).
+    /// One sample `[t0, t0 + δt]` with the Gauss scheme ([`TruthScheme::Gauss`]).
     fn sample_gauss(&mut self, t0: f64) -> Increment {
         let dt = self.cfg.dt_s;
         let t1 = t0 + dt;
@@ -675,7 +675,7 @@ impl Iterator for TruthGenerator<'_> {
             }
             None => {
                 let inc = match self.scheme {
-                    TruthScheme::Gauss3 => self.sample_gauss(t0),
+                    TruthScheme::Gauss => self.sample_gauss(t0),
                     TruthScheme::Rk4 => self.sample_rk4(t0),
                 };
                 // attitude and velocity at the sample end are analytic (branch of the
@@ -716,7 +716,7 @@ impl Iterator for TruthGenerator<'_> {
 /// 0.5° coning at 100 Hz this is 4.5e-17 rad with 16 substeps and 2.8e-18 rad with 32.
 /// Rounded up to a power of two. The default Gauss scheme uses one 3-node panel for 16 and
 /// `substeps/32` 4-node panels above, i.e. at most 0.032 rad (3 nodes) or 0.064 rad (4 nodes)
-/// of the fastest motion per panel ([`TruthScheme::Gauss3`]).
+/// of the fastest motion per panel ([`TruthScheme::Gauss`]).
 pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
     let w_max = traj.max_frequency_rps();
     let need = (dt_s * w_max / 2e-3).ceil().clamp(16.0, 4096.0) as usize;

@@ -334,7 +334,7 @@ fn gauss_vs_rk4(name: &str, windows: &[(f64, f64)]) -> (f64, f64, f64) {
         let mut a = TruthGenerator::new(&scn.trajectory, c1)
             .without_closed_form()
             .starting_at_sample(k);
-        assert_eq!(a.scheme(), sdins_sim::truth::TruthScheme::Gauss3);
+        assert_eq!(a.scheme(), sdins_sim::truth::TruthScheme::Gauss);
         let mut b = TruthGenerator::new(&scn.trajectory, c2)
             .reference_rk4()
             .starting_at_sample(k);
