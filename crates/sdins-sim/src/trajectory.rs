@@ -474,17 +474,7 @@ impl Trajectory {
         // c_b_n_from_euler(roll0, pitch0, heading) with the constant sin/cos of roll and
         // pitch and the heading's sin/cos from above
         let [sr, cr, sp, cp] = self.consts.roll_pitch;
-        let c_nom = Mat3::new(
-            ch * cp,
-            ch * sp * sr - sh * cr,
-            ch * sp * cr + sh * sr,
-            sh * cp,
-            sh * sp * sr + ch * cr,
-            sh * sp * cr - ch * sr,
-            -sp,
-            cp * sr,
-            cp * cr,
-        );
+        let c_nom = sdins_core::math::c_b_n_from_sin_cos((sr, cr), (sp, cp), (sh, ch));
         // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (spec §1.2)
         let w_nom = Vec3::new(
             -n.heading_dot * sp,

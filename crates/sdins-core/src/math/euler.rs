@@ -27,9 +27,18 @@ impl Euler {
 
 /// `c_b_n = Rz(yaw) Ry(pitch) Rx(roll)`.
 pub fn c_b_n_from_euler(e: &Euler) -> Mat3 {
-    let (sf, cf) = (libm::sin(e.roll_rad), libm::cos(e.roll_rad));
-    let (st, ct) = (libm::sin(e.pitch_rad), libm::cos(e.pitch_rad));
-    let (sp, cp) = (libm::sin(e.yaw_rad), libm::cos(e.yaw_rad));
+    c_b_n_from_sin_cos(
+        libm::sincos(e.roll_rad),
+        libm::sincos(e.pitch_rad),
+        libm::sincos(e.yaw_rad),
+    )
+}
+
+/// `c_b_n = Rz(yaw) Ry(pitch) Rx(roll)` from the `(sin, cos)` pairs of roll, pitch and
+/// yaw (for callers that already hold them, e.g. constant angles).
+#[inline]
+pub fn c_b_n_from_sin_cos(roll: (f64, f64), pitch: (f64, f64), yaw: (f64, f64)) -> Mat3 {
+    let ((sf, cf), (st, ct), (sp, cp)) = (roll, pitch, yaw);
     Mat3::new(
         cp * ct,
         cp * st * sf - sp * cf,

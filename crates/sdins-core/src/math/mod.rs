@@ -7,7 +7,7 @@ mod euler;
 mod quat;
 mod rotvec;
 
-pub use euler::{c_b_n_from_euler, euler_from_c_b_n, Euler};
+pub use euler::{c_b_n_from_euler, c_b_n_from_sin_cos, euler_from_c_b_n, Euler};
 pub use quat::Quat;
 pub use rotvec::{dcm_from_rotvec, rotvec_from_dcm};
 
