@@ -734,50 +734,41 @@ pub fn lon_diff(a: f64, b: f64) -> f64 {
 mod tests {
     use super::*;
 
-    #[test]
-    fn gauss3_weights_and_stages_are_exact_for_polynomials() {
-        // Σ b_i p(c_i) = ∫₀¹ p for degree ≤ 5; Σ_j A_ij p(c_j) = ∫₀^{c_i} p for degree ≤ 2
-        for d in 0..=5 {
-            let y = GL3_C.map(|c| (d + 1) as f64 * c.powi(d));
-            assert!((gl3_mean(y) - 1.0).abs() < 4.0 * f64::EPSILON, "degree {d}");
-            if d <= 2 {
-                let st = gl3_stage(y);
-                for i in 0..3 {
-                    let want = GL3_C[i].powi(d + 1);
+    /// An N-node Gauss rule: the weights integrate degree ≤ 2N − 1 exactly, the
+    /// collocation stages degree ≤ N − 1, and degree 2N leaves the remainder
+    /// `1/denominator` of its 2N-th derivative.
+    fn check_rule<const N: usize>(rule: &Rule<N>, remainder_denominator: f64) {
+        for d in 0..2 * N as i32 {
+            let y = rule.c.map(|c| (d + 1) as f64 * c.powi(d));
+            assert!(
+                ((rule.mean)(y) - 1.0).abs() < 4.0 * f64::EPSILON,
+                "N={N} degree {d}"
+            );
+            if d < N as i32 {
+                for (i, (st, c)) in (rule.stage)(y).iter().zip(rule.c).enumerate() {
                     assert!(
-                        (st[i] - want).abs() < 4.0 * f64::EPSILON,
-                        "degree {d} stage {i}"
+                        (st - c.powi(d + 1)).abs() < 4.0 * f64::EPSILON,
+                        "N={N} degree {d} stage {i}"
                     );
                 }
             }
         }
-        // degree 6 is not exact: the remainder is 1/2 016 000 of the 6th derivative
-        let y = GL3_C.map(|c| 7.0 * c.powi(6));
-        let err = 1.0 - gl3_mean(y);
-        assert!((err - 5040.0 / 2_016_000.0).abs() < 1e-14, "{err:e}");
+        let d = 2 * N as i32;
+        let y = rule.c.map(|c| (d + 1) as f64 * c.powi(d));
+        let err = 1.0 - (rule.mean)(y);
+        // the 2N-th derivative of (2N + 1) c^(2N) is (2N + 1)!
+        let fact: f64 = (1..=d + 1).map(f64::from).product();
+        assert!(
+            (err - fact / remainder_denominator).abs() < 1e-14,
+            "N={N}: {err:e}"
+        );
     }
 
     #[test]
-    fn gauss4_weights_and_stages_are_exact_for_polynomials() {
-        // Σ b_i p(c_i) = ∫₀¹ p for degree ≤ 7; Σ_j A_ij p(c_j) = ∫₀^{c_i} p for degree ≤ 3
-        for d in 0..=7 {
-            let y = GL4_C.map(|c| (d + 1) as f64 * c.powi(d));
-            assert!((gl4_mean(y) - 1.0).abs() < 4.0 * f64::EPSILON, "degree {d}");
-            if d <= 3 {
-                let st = gl4_stage(y);
-                for i in 0..4 {
-                    let want = GL4_C[i].powi(d + 1);
-                    assert!(
-                        (st[i] - want).abs() < 4.0 * f64::EPSILON,
-                        "degree {d} stage {i}"
-                    );
-                }
-            }
-        }
-        // degree 8 is not exact: the remainder is 1/1 778 112 000 of the 8th derivative
-        let y = GL4_C.map(|c| 9.0 * c.powi(8));
-        let err = 1.0 - gl4_mean(y);
-        assert!((err - 362_880.0 / 1_778_112_000.0).abs() < 1e-14, "{err:e}");
+    fn gauss_weights_and_stages_are_exact_for_polynomials() {
+        // remainders 1/2 016 000 (3 nodes) and 1/1 778 112 000 (4 nodes) of f^(2N)
+        check_rule(&GL3, 2_016_000.0);
+        check_rule(&GL4, 1_778_112_000.0);
         // the layout: 4-node panels only where they replace at least two 3-node panels
         assert_eq!(gauss_layout(16), (3, 1));
         assert_eq!(gauss_layout(32), (4, 1));
