@@ -173,6 +173,9 @@ pub struct Compensated {
 /// `prev` is the previous update's summed increment (used by `1prev` only).
 #[inline]
 pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Compensated {
+    if let (ConingSet::ThreePoly | ConingSet::ThreeOpt, [s1, s2, s3]) = (set, samples) {
+        return compensate_three(set, s1, s2, s3);
+    }
     let mut dth = Vec3::zeros();
     let mut dv = Vec3::zeros();
     for s in samples {
@@ -186,27 +189,6 @@ pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Co
         ConingSet::OnePrev => {
             cone = prev.dtheta_b_rad.cross(&dth) / 12.0;
             scul = (prev.dtheta_b_rad.cross(&dv) + prev.dv_b_mps.cross(&dth)) / 12.0;
-        }
-        ConingSet::ThreePoly | ConingSet::ThreeOpt if samples.len() == 3 => {
-            // k12 = k23 = a, k13 = b (table above), regrouped as in S1 eqs. 4 and 27:
-            // a Δθ2×(Δθ3−Δθ1) + b Δθ1×Δθ3 and
-            // a [(Δθ1−Δθ3)×Δv2 + (Δv1−Δv3)×Δθ2] + b [Δθ1×Δv3 + Δv1×Δθ3]
-            // (2 + 4 cross products instead of 3 + 6; equal up to rounding)
-            let c = set.coefficients();
-            let (a, b) = (c[0].2, c[2].2);
-            let (t1, t2, t3) = (
-                &samples[0].dtheta_b_rad,
-                &samples[1].dtheta_b_rad,
-                &samples[2].dtheta_b_rad,
-            );
-            let (v1, v2, v3) = (
-                &samples[0].dv_b_mps,
-                &samples[1].dv_b_mps,
-                &samples[2].dv_b_mps,
-            );
-            cone = a * t2.cross(&(t3 - t1)) + b * t1.cross(t3);
-            scul =
-                a * ((t1 - t3).cross(v2) + (v1 - v3).cross(t2)) + b * (t1.cross(v3) + v1.cross(t3));
         }
         _ => {
             for &(i, j, k) in set.coefficients() {
@@ -223,6 +205,27 @@ pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Co
         dv_b_mps: dv,
         dphi_b_rad: dth + cone,
         dv_scul_b_mps: scul,
+    }
+}
+
+/// The three-sample sets (k12 = k23 = a, k13 = b in the table above) regrouped as in S1
+/// eqs. 4 and 27: cone `a Δθ2×(Δθ3−Δθ1) + b Δθ1×Δθ3`, sculling
+/// `a [(Δθ1−Δθ3)×Δv2 + (Δv1−Δv3)×Δθ2] + b [Δθ1×Δv3 + Δv1×Δθ3]` (2 + 4 cross products
+/// instead of 3 + 6, no loops; equal to the pair sum up to rounding, the sums bit for bit).
+#[inline(always)]
+fn compensate_three(set: ConingSet, s1: &Increment, s2: &Increment, s3: &Increment) -> Compensated {
+    let c = set.coefficients();
+    let (a, b) = (c[0].2, c[2].2);
+    let (t1, t2, t3) = (&s1.dtheta_b_rad, &s2.dtheta_b_rad, &s3.dtheta_b_rad);
+    let (v1, v2, v3) = (&s1.dv_b_mps, &s2.dv_b_mps, &s3.dv_b_mps);
+    let dth = t1 + t2 + t3;
+    let cone = a * t2.cross(&(t3 - t1)) + b * t1.cross(t3);
+    Compensated {
+        dtheta_b_rad: dth,
+        dv_b_mps: v1 + v2 + v3,
+        dphi_b_rad: dth + cone,
+        dv_scul_b_mps: a * ((t1 - t3).cross(v2) + (v1 - v3).cross(t2))
+            + b * (t1.cross(v3) + v1.cross(t3)),
     }
 }
 
