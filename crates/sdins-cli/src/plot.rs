@@ -7,6 +7,26 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::Path;
 
+/// Y-axis scale of time-series plots (`--plot-scale`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum PlotScale {
+    /// logarithmic: the absolute value |y| is drawn
+    #[default]
+    Log,
+    /// linear: signed values
+    Linear,
+}
+
+impl PlotScale {
+    /// The option value (`log`, `linear`).
+    pub fn name(self) -> &'static str {
+        match self {
+            PlotScale::Log => "log",
+            PlotScale::Linear => "linear",
+        }
+    }
+}
+
 /// One line of a panel.
 #[derive(Clone, Debug)]
 pub struct Series {
@@ -266,6 +286,11 @@ impl Bars {
             draw_bars(root, self).map_err(|e| CliError::Other(format!("SVG plot: {e}")))?;
         }
         Ok(s)
+    }
+
+    /// Write the chart as a PNG file (temporary file, then rename).
+    pub fn png(&self, dest: &Path) -> Result<(), CliError> {
+        write_png(dest, self.size, |root| draw_bars(root, self))
     }
 }
 

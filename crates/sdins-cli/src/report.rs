@@ -64,27 +64,25 @@ impl Report {
 
     /// An inline SVG figure with a caption.
     pub fn figure(&mut self, fig: &Figure, caption: &str) -> Result<(), CliError> {
-        let svg = fig.svg()?;
-        // drop the XML prolog if any: the SVG is embedded in HTML
-        let svg = svg.find("<svg").map_or(svg.as_str(), |i| &svg[i..]);
-        let _ = writeln!(
-            self.body,
-            "<figure>{svg}<figcaption>{}</figcaption></figure>",
-            esc(caption)
-        );
+        self.svg(&fig.svg()?, caption);
         Ok(())
     }
 
     /// An inline SVG bar chart with a caption.
     pub fn bars(&mut self, b: &crate::plot::Bars, caption: &str) -> Result<(), CliError> {
-        let svg = b.svg()?;
-        let svg = svg.find("<svg").map_or(svg.as_str(), |i| &svg[i..]);
+        self.svg(&b.svg()?, caption);
+        Ok(())
+    }
+
+    /// An SVG document (e.g. from plotters) inline with a caption.
+    pub fn svg(&mut self, svg: &str, caption: &str) {
+        // drop the XML prolog if any: the SVG is embedded in HTML
+        let svg = svg.find("<svg").map_or(svg, |i| &svg[i..]);
         let _ = writeln!(
             self.body,
             "<figure>{svg}<figcaption>{}</figcaption></figure>",
             esc(caption)
         );
-        Ok(())
     }
 
     /// The whole HTML document.
@@ -112,4 +110,31 @@ C_alg C_true<sup>T</sup> = I + [ε×]; position error δN = δL(R<sub>M</sub>+h)
 /// The git commit sdins was built from, if known at build time.
 pub fn git_commit() -> &'static str {
     option_env!("SDINS_GIT_COMMIT").unwrap_or("unknown")
+}
+
+/// The command line of this process, space-separated.
+pub fn command_line() -> String {
+    std::env::args().collect::<Vec<_>>().join(" ")
+}
+
+/// The text of a scenario as given on the command line: a built-in scenario's TOML, or
+/// the file's content (empty if it cannot be read any more).
+pub fn scenario_text(name_or_file: &str) -> String {
+    match sdins_sim::scenario::builtin(name_or_file) {
+        Some(b) => b.toml.to_string(),
+        None => std::fs::read_to_string(name_or_file).unwrap_or_default(),
+    }
+}
+
+/// Write `dir/run.toml` atomically: `sdins_version`, `git_commit` and `command` first,
+/// then the command's own `fields` (scenario, seed, method, ...), everything needed to
+/// reproduce the outputs of the folder.
+pub fn write_run_toml(dir: &Path, fields: toml::Table) -> Result<(), CliError> {
+    let mut t = toml::Table::new();
+    t.insert("sdins_version".into(), env!("CARGO_PKG_VERSION").into());
+    t.insert("git_commit".into(), git_commit().into());
+    t.insert("command".into(), command_line().into());
+    t.extend(fields);
+    let text = toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?;
+    crate::output::write_string(&dir.join("run.toml"), &text)
 }

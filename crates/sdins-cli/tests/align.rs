@@ -85,6 +85,24 @@ fn align_fine_writes_plots() {
     assert!(svg.contains("accelerometer bias [μg]") && svg.contains("gyro bias [°/h]"));
     let png = std::fs::read(d.join("align_bias.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    // the folder's report and reproduction record
+    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    assert!(
+        html.contains("<svg") && html.contains("roll"),
+        "report.html"
+    );
+    let t: toml::Table = std::fs::read_to_string(d.join("run.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    for k in ["sdins_version", "git_commit", "command"] {
+        assert!(t.contains_key(k), "run.toml lacks {k}: {t:?}");
+    }
+    let text = toml::to_string(&t).unwrap();
+    assert!(
+        text.contains("fine") && text.contains("alignment"),
+        "{text}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 

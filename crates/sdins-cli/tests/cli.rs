@@ -146,6 +146,29 @@ fn truth_writes_both_files_and_run_json_shape() {
     }
     assert!(r["final"]["height_err_m"].is_number() && r["wall_s"].is_number());
     assert!(d.join("nav_songlee.csv").exists() && d.join("err_dualquat.csv").exists());
+    // per-axis error figure, log (default) and linear; reproduction record
+    for f in ["report.html", "errors.png", "errors_ned.png", "run.toml"] {
+        assert!(d.join(f).is_file(), "{f}");
+    }
+    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    assert!(html.contains("|ε_N| [arcsec]"), "log-scale per-axis labels");
+    let (code, _, err) = sdins(&[
+        "run",
+        p.to_str().unwrap(),
+        "--algo",
+        "songlee",
+        "--plot-scale",
+        "linear",
+        "--quiet",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    assert!(html.contains("ε_N [arcsec]") && !html.contains("|ε_N|"));
+    let (code, _, err) = sdins(&["run", p.to_str().unwrap(), "--plot-scale", "cubic"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("plot-scale"), "{err}");
 }
 
 #[test]

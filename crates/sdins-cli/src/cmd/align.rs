@@ -137,6 +137,13 @@ struct Input {
     phases: Vec<(f64, f64)>,
     vrw: f64,
     arw: f64,
+    /// error-model seed (scenarios)
+    seed: Option<u64>,
+    /// the format actually read (IMU files)
+    format: Option<ImuFormat>,
+    /// latitude [deg] and height [m] used
+    lat_deg: f64,
+    h_m: f64,
 }
 
 fn load(args: &Args) -> Result<Input, CliError> {
@@ -183,6 +190,10 @@ fn load(args: &Args) -> Result<Input, CliError> {
                 phases,
                 vrw,
                 arw,
+                seed: Some(scn.imu.seed),
+                format: None,
+                lat_deg: lat.to_degrees(),
+                h_m: scn.start.h_m,
             })
         }
         (None, Some(path)) => {
@@ -213,6 +224,10 @@ fn load(args: &Args) -> Result<Input, CliError> {
                 phases: Vec::new(),
                 vrw: 20.0 * UG,
                 arw: 0.002 * DPSH,
+                seed: None,
+                format: Some(data.format),
+                lat_deg: lat,
+                h_m: h,
             })
         }
     }
@@ -383,12 +398,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let e = euler_from_c_b_n(&res.c_b_n);
     if let Some(dir) = &args.out {
         write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi))?;
+        let mut svgs = None;
         if matches!(args.method, Method::Fine | Method::Multiheading) && args.alg == Alg::A
             || args.method == Method::Fine
         {
             write_string(&dir.join("align_history.csv"), &hist)?;
             if rows.len() >= 2 {
-                write_plots(dir, &rows)?;
+                svgs = Some(write_plots(dir, &rows)?);
             } else {
                 eprintln!(
                     "note: {} Kalman cycle(s): too short for the alignment plots",
@@ -396,6 +412,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 );
             }
         }
+        write_report(dir, &args, &inp, &res, &e, phi, svgs.as_ref())?;
+        write_align_toml(dir, &args, &inp, &cfg)?;
     }
     if args.json {
         println!("{}", result_json(&res, &e, phi, inp.true_bias));
@@ -456,15 +474,158 @@ pub fn run(args: Args) -> Result<(), CliError> {
         if let Some(d) = &args.out {
             if rows.len() >= 2 {
                 println!(
-                    "wrote {0}/align_result.csv, {0}/align_history.csv, plots {0}/align_attitude.svg/.png, {0}/align_bias.svg/.png",
+                    "wrote {0}/align_result.csv, {0}/align_history.csv, plots {0}/align_attitude.svg/.png, {0}/align_bias.svg/.png, {0}/report.html, {0}/run.toml",
                     d.display()
                 );
             } else {
-                println!("wrote {}/align_result.csv", d.display());
+                println!(
+                    "wrote {0}/align_result.csv, {0}/report.html, {0}/run.toml",
+                    d.display()
+                );
             }
         }
     }
     Ok(())
+}
+
+/// `report.html` of an alignment: input, result tables and (filters) the ±3σ plots.
+fn write_report(
+    dir: &std::path::Path,
+    args: &Args,
+    inp: &Input,
+    res: &Result1,
+    e: &Euler,
+    phi: Option<Vec3>,
+    svgs: Option<&[String; 2]>,
+) -> Result<(), CliError> {
+    let mut r = crate::report::Report::new(&format!("sdins align: {}", inp.name));
+    r.para(&format!(
+        "Input {}: {} samples, dt {} s ({:.1} s), latitude {:.6}°, height {} m, g {:.6} m/s². \
+         Method {}, coarse window {} s. Attitude errors in convention G (Ĉ = (I + [φ×]) C, NED); \
+         biases in body axes (FRD).",
+        inp.name,
+        inp.incs.len(),
+        inp.dt_s,
+        inp.incs.len() as f64 * inp.dt_s,
+        inp.lat_deg,
+        inp.h_m,
+        inp.site.g_mps2,
+        res.method,
+        args.window_s
+    ));
+    r.heading("Result");
+    r.table(
+        &["method", "roll [°]", "pitch [°]", "yaw [°]"],
+        &[vec![
+            res.method.clone(),
+            format!("{:.6}", e.roll_rad.to_degrees()),
+            format!("{:.6}", e.pitch_rad.to_degrees()),
+            format!("{:.6}", e.yaw_rad.to_degrees()),
+        ]],
+    );
+    let pm = |v: Vec3, s: Vec3, unit: f64, prec: usize| -> Vec<String> {
+        (0..3)
+            .map(|i| format!("{:.prec$} ± {:.prec$}", v[i] / unit, s[i] / unit))
+            .collect()
+    };
+    let plain = |v: Vec3, unit: f64, prec: usize| -> Vec<String> {
+        (0..3).map(|i| format!("{:.prec$}", v[i] / unit)).collect()
+    };
+    let mut rows: Vec<Vec<String>> = Vec::new();
+    let mut row = |name: &str, cells: Vec<String>| {
+        let mut x = vec![name.to_string()];
+        x.extend(cells);
+        rows.push(x);
+    };
+    if let Some((b, s)) = res.accel_bias {
+        row("accelerometer bias estimate ± 1σ [μg]", pm(b, s, UG, 2));
+    }
+    if let Some((b, s)) = res.gyro_bias {
+        row("gyro bias estimate ± 1σ [°/h]", pm(b, s, DPH, 5));
+    }
+    if let Some((ba, bg)) = inp.true_bias {
+        row("true accelerometer bias [μg]", plain(ba, UG, 2));
+        row("true gyro bias [°/h]", plain(bg, DPH, 5));
+    }
+    if let Some(s) = res.att_sigma {
+        row("attitude 1σ φ N/E/D [μrad]", plain(s, 1e-6, 1));
+    }
+    if let Some(p) = phi {
+        row("attitude error φ N/E/D vs truth [μrad]", plain(p, 1e-6, 2));
+    }
+    if rows.is_empty() {
+        r.para("The coarse methods estimate the attitude only (no biases, no covariance).");
+    } else {
+        r.table(&["quantity", "x / N", "y / E", "z / D"], &rows);
+    }
+    if let Some([att, bias]) = svgs {
+        r.heading("Convergence");
+        r.svg(
+            att,
+            "Attitude error φ against the truth (solid, scenarios) with the filter's ±3σ bounds (dashed), μrad; also align_attitude.png.",
+        );
+        r.svg(
+            bias,
+            "Bias estimates (solid) with ±3σ (dashed), body axes; also align_bias.png.",
+        );
+    }
+    r.write(&dir.join("report.html"))
+}
+
+/// `run.toml` of an alignment: the input (scenario text and error-model run, or the IMU
+/// file, format and latitude) and every option of the method.
+fn write_align_toml(
+    dir: &std::path::Path,
+    args: &Args,
+    inp: &Input,
+    cfg: &FineConfig,
+) -> Result<(), CliError> {
+    let mut t = toml::Table::new();
+    if let Some(name) = &args.scenario {
+        t.insert("scenario_name".into(), inp.name.clone().into());
+        t.insert("scenario".into(), crate::report::scenario_text(name).into());
+        t.insert("run".into(), (args.run as i64).into());
+    }
+    if let Some(seed) = inp.seed {
+        t.insert("seed".into(), (seed as i64).into());
+    }
+    if let Some(p) = &args.imu {
+        let abs = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
+        t.insert("imu_file".into(), abs.display().to_string().into());
+        t.insert("imu_format".into(), args.format.name().into());
+    }
+    if let Some(f) = inp.format {
+        t.insert("imu_format_read".into(), f.name().into());
+    }
+    t.insert("lat_deg".into(), inp.lat_deg.into());
+    t.insert("h_m".into(), inp.h_m.into());
+    let method = match args.method {
+        Method::Coarse1 => "coarse1",
+        Method::Coarse2 => "coarse2",
+        Method::Fine => "fine",
+        Method::Multiheading => "multiheading",
+    };
+    t.insert("method".into(), method.into());
+    if args.method == Method::Multiheading {
+        t.insert(
+            "alg".into(),
+            (if args.alg == Alg::A { "a" } else { "b" }).into(),
+        );
+    }
+    t.insert("window_s".into(), args.window_s.into());
+    if let Some(d) = args.duration_s {
+        t.insert("duration_s".into(), d.into());
+    }
+    t.insert("sigma_z_mps".into(), cfg.sigma_z_mps.into());
+    t.insert(
+        "vrw_ug_per_sqrt_hz".into(),
+        (args.vrw.unwrap_or(inp.vrw / UG)).into(),
+    );
+    t.insert(
+        "arw_deg_per_sqrt_h".into(),
+        (args.arw.unwrap_or(inp.arw / DPSH)).into(),
+    );
+    crate::report::write_run_toml(dir, t)
 }
 
 fn v3(v: &Vec3, unit: f64) -> String {

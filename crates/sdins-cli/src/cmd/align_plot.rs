@@ -260,9 +260,10 @@ fn png(panels: &[Panel], dest: &Path) -> Result<(), CliError> {
     crate::plot::write_png(dest, SIZE, |root| draw(root, panels))
 }
 
-/// Write `align_attitude.svg/.png` and `align_bias.svg/.png` into `dir`. Fewer than two
-/// rows (nothing to draw) is a bad-input error.
-pub fn write_plots(dir: &Path, rows: &[HistRow]) -> Result<(), CliError> {
+/// Write `align_attitude.svg/.png` and `align_bias.svg/.png` into `dir` and return the
+/// two SVG documents (attitude, bias) for the report. Fewer than two rows (nothing to
+/// draw) is a bad-input error.
+pub fn write_plots(dir: &Path, rows: &[HistRow]) -> Result<[String; 2], CliError> {
     if rows.len() < 2 {
         return Err(CliError::bad(format!(
             "alignment plots need at least two Kalman cycles, the history has {}",
@@ -270,14 +271,20 @@ pub fn write_plots(dir: &Path, rows: &[HistRow]) -> Result<(), CliError> {
         )));
     }
     crate::plot::register_font()?;
-    for (stem, panels) in [
+    let mut out: [String; 2] = Default::default();
+    for (k, (stem, panels)) in [
         ("align_attitude", attitude_panels(rows)),
         ("align_bias", bias_panels(rows)),
-    ] {
-        write_string(&dir.join(format!("{stem}.svg")), &svg(&panels)?)?;
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let s = svg(&panels)?;
+        write_string(&dir.join(format!("{stem}.svg")), &s)?;
         png(&panels, &dir.join(format!("{stem}.png")))?;
+        out[k] = s;
     }
-    Ok(())
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -38,6 +38,7 @@ pub fn run_args(scenario: &str, algo: &str, out: PathBuf, quiet: bool) -> RunArg
         every_s: 1.0,
         ideal: false,
         run: 0,
+        plot_scale: crate::plot::PlotScale::Log,
         json: false,
         quiet,
     }

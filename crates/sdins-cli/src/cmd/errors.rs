@@ -60,6 +60,10 @@ pub struct Args {
     /// JSON output on stdout
     #[arg(long)]
     pub json: bool,
+    /// output folder: errors.csv, report.html (tables, error and budget plots), errors.png,
+    /// budget.png, run.toml [default: sdins-out/errors]
+    #[arg(long)]
+    pub out: Option<std::path::PathBuf>,
 }
 
 /// Linear-model step [s] (see `linear_model` docs: Taylor-3 is accurate to < 1e-4 rad of
@@ -265,7 +269,226 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         print_table(&report);
     }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| std::path::PathBuf::from("sdins-out/errors"));
+    let budget = error_budget(lat, params, &gyro_dph, &accel_ug, duration);
+    write_folder(&out, &args, &report, &closed, &env, &budget)?;
+    eprintln!(
+        "wrote {0}/errors.csv, {0}/errors.png, {0}/budget.png, {0}/report.html, {0}/run.toml",
+        out.display()
+    );
     Ok(())
+}
+
+/// One error source's share of the final position error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BudgetRow {
+    /// source name, e.g. `gyro bias E`
+    pub source: String,
+    /// the source's value with unit
+    pub value: String,
+    /// its position error N, E at the final time \[m\]
+    pub dp_ne_m: [f64; 2],
+}
+
+/// Error budget at `t_s`: the closed form (spec §4.3) with one nonzero bias component at a
+/// time. The closed form is linear in the errors, so the rows add up (as vectors) to the
+/// all-sources error.
+pub fn error_budget(
+    lat_rad: f64,
+    params: SchulerParams,
+    gyro_dph: &Vec3,
+    accel_ug: &Vec3,
+    t_s: f64,
+) -> Vec<BudgetRow> {
+    let axes = ["N", "E", "D"];
+    let mut rows = Vec::new();
+    for k in 0..3 {
+        for (gyro, v) in [(true, gyro_dph[k]), (false, accel_ug[k])] {
+            if v == 0.0 {
+                continue;
+            }
+            let mut e = StationaryErrors::default();
+            let (source, value) = if gyro {
+                e.eps_n[k] = v * DEG_PER_HOUR;
+                (format!("gyro bias {}", axes[k]), format!("{v} °/h"))
+            } else {
+                e.da_n[k] = v * MICRO_G;
+                (format!("accel bias {}", axes[k]), format!("{v} μg"))
+            };
+            let dp = StationaryClosedForm::new(lat_rad, &e, params)
+                .eval(t_s)
+                .dp_n;
+            rows.push(BudgetRow {
+                source,
+                value,
+                dp_ne_m: [dp[0], dp[1]],
+            });
+        }
+    }
+    rows
+}
+
+/// errors.csv, the figures, report.html and run.toml of `sdins errors`.
+fn write_folder(
+    out: &std::path::Path,
+    args: &Args,
+    r: &Report<'_>,
+    closed: &StationaryClosedForm,
+    env: &[EnvelopePoint],
+    budget: &[BudgetRow],
+) -> Result<(), CliError> {
+    use crate::plot::{Bars, Figure, Panel, Series};
+    // time histories: closed form and linear model on the linear model's grid (≤ 400 points)
+    let stride = (env.len() / 400).max(1);
+    let pts: Vec<(f64, StationarySolution, &EnvelopePoint)> = env
+        .iter()
+        .step_by(stride)
+        .map(|e| (e.t_s, closed.eval(e.t_s), e))
+        .collect();
+    let mut csv = String::from(
+        "t_s,dp_n_closed_m,dp_e_closed_m,dp_n_linear_m,dp_e_linear_m,sigma_p_n_m,sigma_p_e_m,phi_d_closed_rad,sigma_phi_d_rad\n",
+    );
+    for (t, c, e) in &pts {
+        csv.push_str(&format!(
+            "{t},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}\n",
+            c.dp_n[0],
+            c.dp_n[1],
+            e.dp_n_m[0],
+            e.dp_n_m[1],
+            e.sigma_p_m[0],
+            e.sigma_p_m[1],
+            c.phi[2],
+            e.sigma_phi[2]
+        ));
+    }
+    crate::output::write_string(&out.join("errors.csv"), &csv)?;
+    let h = |t: f64| t / 3600.0;
+    let line = |name: &str, f: &dyn Fn(&(f64, StationarySolution, &EnvelopePoint)) -> f64| Series {
+        name: name.to_string(),
+        points: pts.iter().map(|p| (h(p.0), f(p))).collect(),
+    };
+    let panel = |axis: usize, title: &str| Panel {
+        title: title.to_string(),
+        x_label: "time [h]".into(),
+        y_label: "position error [m]".into(),
+        log_y: false,
+        series: vec![
+            line("closed form", &|p| p.1.dp_n[axis]),
+            line("linear model", &|p| p.2.dp_n_m[axis]),
+            line("+1σ", &|p| p.2.sigma_p_m[axis]),
+            line("−1σ", &|p| -p.2.sigma_p_m[axis]),
+        ],
+    };
+    let fig = Figure {
+        panels: vec![
+            panel(0, "north position error"),
+            panel(1, "east position error"),
+        ],
+        cols: 2,
+        size: (1200, 450),
+    };
+    fig.png(&out.join("errors.png"))?;
+    let bars = Bars {
+        title: format!(
+            "error budget: horizontal position error at {:.3} h",
+            r.hours
+        ),
+        y_label: "|δp_horizontal| [m]".into(),
+        bars: budget
+            .iter()
+            .map(|b| (b.source.clone(), b.dp_ne_m[0].hypot(b.dp_ne_m[1])))
+            .collect(),
+        size: (900, 420),
+    };
+    bars.png(&out.join("budget.png"))?;
+
+    let mut rep = crate::report::Report::new("sdins errors");
+    rep.para(&format!(
+        "Stationary free-inertial error propagation at L = {:.3}°, vertical channel held, {} h; NED gyro bias {:?} °/h, accelerometer bias {:?} μg{}.",
+        r.lat_deg,
+        r.hours,
+        r.gyro_bias_dph_ned,
+        r.accel_bias_ug_ned,
+        r.grade.map(|g| format!(" (grade {g})")).unwrap_or_default()
+    ));
+    let rows: Vec<Vec<String>> = r
+        .epochs
+        .iter()
+        .map(|e| {
+            let nl = |k: usize| {
+                e.nonlinear
+                    .map_or("—".to_string(), |n| format!("{:.1}", n.dp_n_m[k]))
+            };
+            vec![
+                format!("{:.2}", e.t_h),
+                format!("{:.1}", e.closed_form.dp_n[0]),
+                format!("{:.1}", e.closed_form.dp_n[1]),
+                nl(0),
+                nl(1),
+                format!("{:.1}", e.linear.dp_n_m[0]),
+                format!("{:.1}", e.linear.dp_n_m[1]),
+                format!("{:.1}", e.linear.sigma_p_m[0]),
+                format!("{:.1}", e.linear.sigma_p_m[1]),
+            ]
+        })
+        .collect();
+    rep.table(
+        &[
+            "t [h]",
+            "δN closed [m]",
+            "δE closed [m]",
+            "δN nonlinear [m]",
+            "δE nonlinear [m]",
+            "δN linear [m]",
+            "δE linear [m]",
+            "1σ N [m]",
+            "1σ E [m]",
+        ],
+        &rows,
+    );
+    rep.figure(
+        &fig,
+        "Position error vs time: closed form (spec §4.3), 15-state linear model, and its 1σ envelope (biases as 1σ uncertainty plus the grade's noise). Also errors.png.",
+    )?;
+    let brows: Vec<Vec<String>> = budget
+        .iter()
+        .map(|b| {
+            vec![
+                b.source.clone(),
+                b.value.clone(),
+                format!("{:.1}", b.dp_ne_m[0]),
+                format!("{:.1}", b.dp_ne_m[1]),
+                format!("{:.1}", b.dp_ne_m[0].hypot(b.dp_ne_m[1])),
+            ]
+        })
+        .collect();
+    rep.heading("Error budget");
+    rep.table(&["source", "value", "δN [m]", "δE [m]", "|δp| [m]"], &brows);
+    rep.bars(
+        &bars,
+        "Each source alone through the closed form at the final time (the closed form is linear: the rows add up as vectors to the all-sources error). Also budget.png.",
+    )?;
+    rep.write(&out.join("report.html"))?;
+
+    let mut t = toml::Table::new();
+    t.insert("lat_deg".into(), args.lat.into());
+    t.insert("hours".into(), args.hours.into());
+    if let Some(g) = &args.grade {
+        t.insert("grade".into(), g.clone().into());
+    }
+    t.insert(
+        "gyro_bias_dph_ned".into(),
+        r.gyro_bias_dph_ned.to_vec().into(),
+    );
+    t.insert(
+        "accel_bias_ug_ned".into(),
+        r.accel_bias_ug_ned.to_vec().into(),
+    );
+    t.insert("nonlinear".into(), (!args.no_nonlinear).into());
+    crate::report::write_run_toml(out, t)
 }
 
 fn print_table(r: &Report<'_>) {
@@ -365,7 +588,87 @@ mod tests {
             schuler_share: false,
             no_nonlinear: false,
             json: true,
+            out: Some(
+                std::env::temp_dir().join(format!("sdins-errors-unit-{}", std::process::id())),
+            ),
         }
+    }
+
+    /// The budget rows add up (as vectors) to the all-sources closed form: the closed form
+    /// is linear in the biases, so only rounding separates them (|δp| ~ 1e4 m: 1e-7 m).
+    /// Dropping any one row would miss by at least that source's share (≥ 100 m here).
+    #[test]
+    fn error_budget_adds_up_to_the_total() {
+        let lat = 37.5_f64.to_radians();
+        let params =
+            SchulerParams::with_local_gravity(&sdins_core::earth::EarthModel::WGS84, lat, 0.0);
+        let g = Vec3::new(0.01, -0.02, 0.015);
+        let a = Vec3::new(50.0, -80.0, 30.0);
+        let t = 6.0 * 3600.0;
+        let rows = error_budget(lat, params, &g, &a, t);
+        assert_eq!(rows.len(), 6);
+        let all = StationaryClosedForm::new(
+            lat,
+            &StationaryErrors {
+                eps_n: g * DEG_PER_HOUR,
+                da_n: a * MICRO_G,
+                ..Default::default()
+            },
+            params,
+        )
+        .eval(t)
+        .dp_n;
+        for (k, total) in all.iter().take(2).enumerate() {
+            let sum: f64 = rows.iter().map(|r| r.dp_ne_m[k]).sum();
+            assert!((sum - total).abs() <= 1e-7, "axis {k}: {sum} vs {total}");
+        }
+        // every horizontal source matters; the down accelerometer bias has no effect
+        // (vertical channel held)
+        for r in &rows {
+            let m = r.dp_ne_m[0].hypot(r.dp_ne_m[1]);
+            if r.source == "accel bias D" {
+                assert_eq!(m, 0.0);
+            } else {
+                assert!(m >= 100.0, "{}: {m}", r.source);
+            }
+        }
+    }
+
+    #[test]
+    #[allow(clippy::unwrap_used)]
+    fn output_folder_has_report_and_run_toml() {
+        let mut a = args();
+        a.no_nonlinear = true;
+        let dir = a.out.clone().unwrap();
+        run(a).unwrap();
+        for f in [
+            "errors.csv",
+            "errors.png",
+            "budget.png",
+            "report.html",
+            "run.toml",
+        ] {
+            assert!(dir.join(f).is_file(), "{f}");
+        }
+        let t: toml::Table = std::fs::read_to_string(dir.join("run.toml"))
+            .unwrap()
+            .parse()
+            .unwrap();
+        for k in [
+            "sdins_version",
+            "git_commit",
+            "command",
+            "lat_deg",
+            "hours",
+            "gyro_bias_dph_ned",
+        ] {
+            assert!(t.contains_key(k), "{k}");
+        }
+        let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+        assert!(html.contains("Error budget") && html.matches("<svg").count() >= 2);
+        let csv = std::fs::read_to_string(dir.join("errors.csv")).unwrap();
+        assert!(csv.lines().count() > 100);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

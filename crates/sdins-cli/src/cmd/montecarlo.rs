@@ -184,12 +184,6 @@ fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliE
     fig.png(&dir.join("envelopes.png"))?;
     r.write(&dir.join("report.html"))?;
     let mut t = toml::Table::new();
-    t.insert("sdins_version".into(), env!("CARGO_PKG_VERSION").into());
-    t.insert("git_commit".into(), crate::report::git_commit().into());
-    t.insert(
-        "command".into(),
-        std::env::args().collect::<Vec<_>>().join(" ").into(),
-    );
     t.insert("scenario".into(), job.scenario.clone().into());
     t.insert(
         "scenario_fingerprint".into(),
@@ -198,8 +192,7 @@ fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliE
     t.insert("algo".into(), job.algo.clone().into());
     t.insert("runs".into(), (job.runs as i64).into());
     t.insert("seed".into(), (job.seed as i64).into());
-    let text = toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?;
-    write_string(&dir.join("run.toml"), &text)
+    crate::report::write_run_toml(dir, t)
 }
 
 /// Summary printed after a run or merge.

@@ -174,6 +174,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         every_s: 1.0,
         ideal: true,
         run: 0,
+        plot_scale: crate::plot::PlotScale::Log,
         json: false,
         quiet: true,
     };

@@ -2,6 +2,7 @@
 
 use crate::error::CliError;
 use crate::output::AtomicFile;
+use crate::plot::PlotScale;
 use crate::progress::Progress;
 use sdins_core::coning::ConingSet;
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AttitudeMode, RotVector};
@@ -51,6 +52,9 @@ pub struct Args {
     /// run index of the sensor-error random stream (seed from the scenario)
     #[arg(long, default_value_t = 0)]
     pub run: u64,
+    /// y scale of the per-axis error plot errors_ned.png: log (|error|) or linear (signed)
+    #[arg(long, value_enum, default_value_t = PlotScale::Log)]
+    pub plot_scale: PlotScale,
     /// print the JSON summary on stdout
     #[arg(long)]
     pub json: bool,
@@ -138,6 +142,10 @@ pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, Cli
 /// (t, horizontal position, |down position|, velocity norm, attitude norm).
 pub type ErrSeries = Vec<(f64, f64, f64, f64, f64)>;
 
+/// Per-axis errors of one algorithm at the output epochs: (t, [attitude N, E, D \[rad\],
+/// velocity N, E, D \[m/s\], position N, E, D \[m\]]).
+pub type NedSeries = Vec<(f64, [f64; 9])>;
+
 /// Everything a run produced.
 pub struct Outcome {
     /// the scenario
@@ -148,6 +156,10 @@ pub struct Outcome {
     pub out: PathBuf,
     /// per-algorithm error time series
     pub series: Vec<ErrSeries>,
+    /// per-algorithm per-axis error time series
+    pub ned: Vec<NedSeries>,
+    /// y scale of the per-axis figure
+    pub plot_scale: PlotScale,
 }
 
 /// Run and return the summaries (used by `demo` too).
@@ -212,6 +224,7 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let mut bar = Progress::new(total, "navigate", args.quiet);
     let mut io_error = None;
     let mut series: Vec<ErrSeries> = vec![Vec::new(); algos.len()];
+    let mut ned: Vec<NedSeries> = vec![Vec::new(); algos.len()];
     let d = 180.0 / std::f64::consts::PI;
     let opts = RunOptions {
         algos: algos.clone(),
@@ -247,6 +260,10 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
             );
             let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
             series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
+            ned[i].push((
+                e.t_s,
+                [a[0], a[1], a[2], v[0], v[1], v[2], p[0], p[1], p[2]],
+            ));
             let r2 = writeln!(
                 err_files[i].writer(),
                 "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
@@ -287,6 +304,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         sums: summaries,
         out,
         series,
+        ned,
+        plot_scale: args.plot_scale,
     };
     write_report(&outcome)?;
     Ok(outcome)
@@ -295,26 +314,19 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
 /// `run.toml`: everything needed to reproduce the run (scenario text, options, seed,
 /// sdins version, git commit).
 fn write_run_toml(out: &std::path::Path, scn: &Scenario, args: &Args) -> Result<(), CliError> {
-    let scenario_text = match sdins_sim::scenario::builtin(&args.scenario) {
-        Some(b) => b.toml.to_string(),
-        None => std::fs::read_to_string(&args.scenario).unwrap_or_default(),
-    };
     let mut t = toml::Table::new();
-    t.insert("sdins_version".into(), env!("CARGO_PKG_VERSION").into());
-    t.insert("git_commit".into(), crate::report::git_commit().into());
-    t.insert(
-        "command".into(),
-        std::env::args().collect::<Vec<_>>().join(" ").into(),
-    );
     t.insert("scenario_name".into(), scn.name.clone().into());
     t.insert("seed".into(), (scn.imu.seed as i64).into());
     t.insert(
         "sensor_run".into(),
         (if args.ideal { -1 } else { args.run as i64 }).into(),
     );
-    t.insert("scenario".into(), scenario_text.into());
-    let text = toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?;
-    crate::output::write_string(&out.join("run.toml"), &text)
+    t.insert("plot_scale".into(), args.plot_scale.name().into());
+    t.insert(
+        "scenario".into(),
+        crate::report::scenario_text(&args.scenario).into(),
+    );
+    crate::report::write_run_toml(out, t)
 }
 
 /// The error figure of a run: log-scale error norms per algorithm.
@@ -344,6 +356,58 @@ pub fn error_figure(o: &Outcome) -> crate::plot::Figure {
         ],
         cols: 2,
         size: (1400, 900),
+    }
+}
+
+/// Arc seconds per radian.
+const ARCSEC_PER_RAD: f64 = 180.0 * 3600.0 / std::f64::consts::PI;
+
+/// The per-axis error figure of a run (`errors_ned.png`): attitude (arcsec), velocity
+/// (m/s) and position (m) error, N/E/D, one line per algorithm. On a log scale the
+/// absolute value is drawn.
+pub fn ned_figure(o: &Outcome) -> crate::plot::Figure {
+    use crate::plot::{Figure, Panel, Series};
+    let log = o.plot_scale == PlotScale::Log;
+    let groups = [
+        ("attitude error", "ε", "arcsec", ARCSEC_PER_RAD, 0),
+        ("velocity error", "δv", "m/s", 1.0, 3),
+        ("position error", "δp", "m", 1.0, 6),
+    ];
+    let mut panels = Vec::new();
+    for (what, sym, unit, scale, first) in groups {
+        for (k, axis) in ["N", "E", "D"].iter().enumerate() {
+            let y_label = if log {
+                format!("|{sym}_{axis}| [{unit}]")
+            } else {
+                format!("{sym}_{axis} [{unit}]")
+            };
+            panels.push(Panel {
+                title: format!("{what}, {axis}"),
+                x_label: "time [s]".into(),
+                y_label,
+                log_y: log,
+                series: o
+                    .sums
+                    .iter()
+                    .zip(&o.ned)
+                    .map(|(s, ser)| Series {
+                        name: s.algo.clone(),
+                        points: ser
+                            .iter()
+                            .map(|(t, v)| {
+                                let y = v[first + k] * scale;
+                                (*t, if log { y.abs() } else { y })
+                            })
+                            .collect(),
+                    })
+                    .collect(),
+            });
+        }
+    }
+    Figure {
+        panels,
+        cols: 3,
+        size: (1500, 1150),
     }
 }
 
@@ -402,6 +466,19 @@ fn write_report(o: &Outcome) -> Result<(), CliError> {
         "Error norms against the exact truth (log scale), one line per algorithm.",
     )?;
     fig.png(&o.out.join("errors.png"))?;
+    let ned = ned_figure(o);
+    r.figure(
+        &ned,
+        &format!(
+            "Errors per NED axis against the exact truth ({}), one line per algorithm: attitude ε (arcsec), velocity (m/s), position (m). Also errors_ned.png.",
+            if o.plot_scale == PlotScale::Log {
+                "log scale of the absolute value"
+            } else {
+                "linear scale, signed"
+            }
+        ),
+    )?;
+    ned.png(&o.out.join("errors_ned.png"))?;
     let bars = Bars {
         title: "navigation time per update".into(),
         y_label: "time [ns/update]".into(),
