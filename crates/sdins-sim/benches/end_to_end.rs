@@ -9,25 +9,10 @@
 
 mod common;
 
-use common::{record, scenario, Recorded};
+use common::{full_run, record, scenario};
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
-use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AnyMechanization, Mechanization};
-use sdins_sim::pipeline::{nav_error, NavError};
+use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
 use std::time::{Duration, Instant};
-
-/// One full run: every update is followed by the error against the truth; returns the
-/// maximum absolute errors (so nothing can be optimized away).
-fn full_run(rec: &Recorded, spec: &AlgorithmSpec) -> NavError {
-    let n = rec.n;
-    let mut m = AnyMechanization::new(spec, rec.earth, rec.dt_s, &rec.init);
-    let mut max = NavError::default();
-    for (chunk, end) in rec.incs.chunks_exact(n).zip(&rec.ends) {
-        m.update(chunk);
-        let e = nav_error(&rec.earth, &m.state(), end);
-        max = max.max_abs(&e);
-    }
-    max
-}
 
 fn mach1(c: &mut Criterion) {
     let scn = scenario("mach1-east");

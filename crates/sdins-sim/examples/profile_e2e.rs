@@ -16,9 +16,8 @@
 #[path = "../benches/common/mod.rs"]
 mod common;
 
-use common::{record, scenario, Recorded};
+use common::{full_run, record, scenario, Recorded};
 use sdins_core::nav::{AlgorithmSpec, AnyMechanization, Mechanization};
-use sdins_sim::pipeline::{nav_error, NavError};
 use std::time::Instant;
 
 /// The navigation loop alone (same buffer), for the split between update and errors.
@@ -30,19 +29,6 @@ fn nav_only(rec: &Recorded, spec: &AlgorithmSpec) -> f64 {
         m.update(chunk);
     }
     m.state().h_m
-}
-
-#[inline(never)]
-fn full_run(rec: &Recorded, spec: &AlgorithmSpec) -> NavError {
-    let n = rec.n;
-    let mut m = AnyMechanization::new(spec, rec.earth, rec.dt_s, &rec.init);
-    let mut max = NavError::default();
-    for (chunk, end) in rec.incs.chunks_exact(n).zip(&rec.ends) {
-        m.update(chunk);
-        let e = nav_error(&rec.earth, &m.state(), end);
-        max = max.max_abs(&e);
-    }
-    max
 }
 
 /// CPU time of this thread [s] from /proc (10 ms resolution; None off Linux): on a

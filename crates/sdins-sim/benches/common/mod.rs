@@ -67,3 +67,23 @@ pub fn record(scn: &Scenario, n: usize, max_samples: Option<usize>) -> Recorded 
         n,
     }
 }
+
+/// One full end-to-end run from the in-memory buffer: every navigation update is followed
+/// by its error against the truth, and the maximum absolute errors are returned (so
+/// nothing can be optimised away). Not inlined, so callgrind can select it by name
+/// (`--toggle-collect='*full_run*'`).
+#[inline(never)]
+pub fn full_run(
+    rec: &Recorded,
+    spec: &sdins_core::nav::AlgorithmSpec,
+) -> sdins_sim::pipeline::NavError {
+    use sdins_core::nav::{AnyMechanization, Mechanization};
+    let mut m = AnyMechanization::new(spec, rec.earth, rec.dt_s, &rec.init);
+    let mut max = sdins_sim::pipeline::NavError::default();
+    for (chunk, end) in rec.incs.chunks_exact(rec.n).zip(&rec.ends) {
+        m.update(chunk);
+        let e = sdins_sim::pipeline::nav_error(&rec.earth, &m.state(), end);
+        max = max.max_abs(&e);
+    }
+    max
+}
