@@ -19,6 +19,9 @@ pub enum CliError {
     /// Anything else. Exit code 1.
     #[error("{0}")]
     Other(String),
+    /// Stopped by SIGINT/SIGTERM through the cancellation token. Exit code 130 or 143.
+    #[error("interrupted: no output written")]
+    Interrupted,
 }
 
 impl CliError {
@@ -27,11 +30,18 @@ impl CliError {
         match self {
             CliError::BadInput(_) => 2,
             CliError::Io { .. } | CliError::Other(_) => 1,
+            CliError::Interrupted => crate::progress::cancel_exit_code(),
         }
     }
     /// Shorthand for a bad-input error.
     pub fn bad(msg: impl Into<String>) -> Self {
         CliError::BadInput(msg.into())
+    }
+}
+
+impl From<sdins_sim::cancel::Cancelled> for CliError {
+    fn from(_: sdins_sim::cancel::Cancelled) -> Self {
+        CliError::Interrupted
     }
 }
 

@@ -54,7 +54,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    progress::install_ctrlc();
+    progress::install_signal_handlers();
     let result = match cli.command {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Scenarios(a) => cmd::scenarios::run(a),

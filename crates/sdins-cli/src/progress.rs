@@ -1,26 +1,51 @@
 //! Progress bars (indicatif) on stderr: hidden when stderr is not a terminal or with
-//! `--quiet`. Ctrl-C sets a flag that long loops poll, so they stop cleanly without
-//! leaving partial output files.
+//! `--quiet`; and the process's signal handling. SIGINT and SIGTERM set the library's
+//! [`CancelToken`], which every long library call polls, so a command stops within about a
+//! second, removes its staged files and exits 130 (SIGINT) or 143 (SIGTERM). A second
+//! signal exits at once.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use sdins_sim::cancel::CancelToken;
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
 
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+static TOKEN: OnceLock<CancelToken> = OnceLock::new();
+static TERMINATED: OnceLock<Arc<AtomicBool>> = OnceLock::new();
 
-/// Install the Ctrl-C handler (once).
-pub fn install_ctrlc() {
-    let _ = ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
-        }
-        eprintln!("\nsdins: interrupted, stopping (press Ctrl-C again to abort at once)");
-    });
+/// Install the SIGINT/SIGTERM handlers (once). Registration failures leave the default
+/// handlers in place (the process then dies on the signal, as any Unix tool).
+pub fn install_signal_handlers() {
+    let token = TOKEN.get_or_init(CancelToken::new).clone();
+    let term = TERMINATED
+        .get_or_init(|| Arc::new(AtomicBool::new(false)))
+        .clone();
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    for (sig, code) in [(SIGINT, 130), (SIGTERM, 143)] {
+        // order matters: the conditional shutdown sees the flag of an earlier signal
+        let _ = signal_hook::flag::register_conditional_shutdown(sig, code, token.flag());
+        let _ = signal_hook::flag::register(sig, token.flag());
+    }
+    let _ = signal_hook::flag::register(SIGTERM, term);
 }
 
-/// Whether Ctrl-C was pressed.
+/// The process's cancellation token (set by SIGINT/SIGTERM).
+pub fn token() -> CancelToken {
+    TOKEN.get_or_init(CancelToken::new).clone()
+}
+
+/// Whether a signal asked us to stop.
 pub fn interrupted() -> bool {
-    INTERRUPTED.load(Ordering::Relaxed)
+    TOKEN.get().is_some_and(CancelToken::is_cancelled)
+}
+
+/// Exit code for a cancelled command: 143 after SIGTERM, else 130.
+pub fn cancel_exit_code() -> u8 {
+    if TERMINATED.get().is_some_and(|t| t.load(Ordering::Relaxed)) {
+        143
+    } else {
+        130
+    }
 }
 
 /// A progress bar that may be hidden.

@@ -519,8 +519,19 @@ fn unwritable_output_leaves_no_file() {
 #[cfg(unix)]
 #[test]
 fn sigint_stops_cleanly_without_partial_files() {
+    signal_stops_cleanly("INT", 130);
+}
+
+#[test]
+fn sigterm_stops_cleanly_without_partial_files() {
+    signal_stops_cleanly("TERM", 143);
+}
+
+/// Batch schedulers send SIGTERM, terminals SIGINT: both stop the run through the
+/// library's cancellation token, remove the staged files and exit 128 + signal number.
+fn signal_stops_cleanly(signal: &str, code: i32) {
     use std::time::{Duration, Instant};
-    let d = tmp("sigint");
+    let d = tmp(&format!("sig{signal}"));
     // 90 min at 500 Hz: 2.7 M samples, several seconds of work
     let child = Command::new(env!("CARGO_BIN_EXE_sdins"))
         .args([
@@ -540,13 +551,13 @@ fn sigint_stops_cleanly_without_partial_files() {
     }
     std::thread::sleep(Duration::from_millis(200));
     let st = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([&format!("-{signal}"), &child.id().to_string()])
         .status()
         .unwrap();
     assert!(st.success());
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "{err}");
+    assert_eq!(out.status.code(), Some(code), "{err}");
     assert!(err.contains("interrupted"), "{err}");
     let left: Vec<_> = std::fs::read_dir(&d)
         .unwrap()

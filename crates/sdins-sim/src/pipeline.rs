@@ -4,6 +4,7 @@
 //! fed the same block; each algorithm's time is measured around its own update loop only
 //! (the `wall_s` of `sdins run --json`).
 
+use crate::cancel::{CancelToken, Cancelled};
 use crate::imu_error::{ImuErrorModel, ImuErrorState};
 use crate::scenario::Scenario;
 use crate::truth::{lon_diff, TruthConfig, TruthGenerator, TruthSample};
@@ -167,13 +168,27 @@ pub struct RunOptions {
 
 /// Run the scenario's truth through every algorithm; `observe(i, state, truth, err)` is
 /// called every `opts.every` updates for algorithm `i`. `progress(done, total)` is
-/// called once per block.
+/// called once per block. Not cancellable: see [`run_cancellable`].
 pub fn run(
     scn: &Scenario,
     opts: &RunOptions,
+    observe: impl FnMut(usize, &NavState, &TruthSample, &NavError),
+    progress: impl FnMut(u64, u64),
+) -> Vec<RunSummary> {
+    match run_cancellable(scn, opts, &CancelToken::new(), observe, progress) {
+        Ok(v) => v,
+        Err(Cancelled) => Vec::new(), // unreachable: nobody holds the token
+    }
+}
+
+/// [`run`], polling `cancel` once per block of 2048 updates (a few ms of work).
+pub fn run_cancellable(
+    scn: &Scenario,
+    opts: &RunOptions,
+    cancel: &CancelToken,
     mut observe: impl FnMut(usize, &NavState, &TruthSample, &NavError),
     mut progress: impl FnMut(u64, u64),
-) -> Vec<RunSummary> {
+) -> Result<Vec<RunSummary>, Cancelled> {
     let earth = scn.nav.earth.model();
     let cfg = TruthConfig {
         earth,
@@ -214,6 +229,7 @@ pub fn run(
     let every = opts.every.max(1);
     let mut done = 0_u64;
     while done < total_updates {
+        cancel.check()?;
         let count = ((total_updates - done) as usize).min(BLOCK);
         incs.clear();
         ends.clear();
@@ -270,7 +286,7 @@ pub fn run(
             break;
         }
     }
-    mechs
+    Ok(mechs
         .iter()
         .enumerate()
         .map(|(i, _)| RunSummary {
@@ -281,7 +297,7 @@ pub fn run(
             final_err: last[i],
             max_abs: maxes[i],
         })
-        .collect()
+        .collect())
 }
 
 /// Navigate over recorded increments (`sdins nav`): `observe` gets the state after

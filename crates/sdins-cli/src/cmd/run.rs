@@ -6,7 +6,7 @@ use crate::plot::PlotScale;
 use crate::progress::Progress;
 use sdins_core::coning::ConingSet;
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AttitudeMode, RotVector};
-use sdins_sim::pipeline::{run as run_pipeline, RunOptions, RunSummary};
+use sdins_sim::pipeline::{run_cancellable as run_pipeline, RunOptions, RunSummary};
 use sdins_sim::scenario::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
@@ -236,6 +236,7 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let summaries = run_pipeline(
         &scn,
         &opts,
+        &crate::progress::token(),
         |i, st, _tr, e| {
             let eu = st.euler();
             let r1 = writeln!(
@@ -292,9 +293,7 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     if let Some(source) = io_error {
         return Err(CliError::Io { path: out, source });
     }
-    if crate::progress::interrupted() {
-        return Err(CliError::Other("interrupted: no output written".into()));
-    }
+    let summaries = summaries?;
     for f in nav_files.into_iter().chain(err_files) {
         f.commit()?;
     }

@@ -94,7 +94,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         if k % 65536 == 0 {
             bar.set(k as u64);
             if crate::progress::interrupted() {
-                return Err(CliError::Other("interrupted: no output written".into()));
+                return Err(CliError::Interrupted);
             }
         }
     }
