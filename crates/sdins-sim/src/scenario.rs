@@ -576,6 +576,9 @@ impl Scenario {
                 );
             }
             let n = dur / dt;
+            if n.round() < 1.0 {
+                return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is shorter than one IMU sample ({dt} s at {rate_hz} Hz)"));
+            }
             if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
                 return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));
             }
@@ -646,8 +649,8 @@ impl Scenario {
                             format!("{a} m/s² exceeds 1000 g"),
                         );
                     }
-                    speed_now += a * dur;
-                    if speed_now < -1e-9 {
+                    speed_now = crate::trajectory::accelerated_speed(speed_now, a, dur);
+                    if speed_now < 0.0 {
                         return cx.err(s.span(), "segment.accel_mps2", format!("the speed would become negative ({speed_now} m/s) by the end of this segment"));
                     }
                     Motion::Accelerate { accel_mps2: a }
@@ -812,6 +815,21 @@ impl Scenario {
         }
 
         let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
+        if let Err(e) = crate::envelope::check_trajectory(
+            &trajectory,
+            crate::envelope::StartPosition {
+                lat_rad: start.lat_rad,
+                h_m: start.h_m,
+            },
+            dt,
+            &crate::envelope::Envelope::DEFAULT,
+        ) {
+            let span = match e.segment().and_then(|k| doc.segment.get(k)) {
+                Some(seg) => seg.span(),
+                None => doc.start.span(),
+            };
+            return cx.err(span, "segment", e.to_string());
+        }
         let mut nav = nav;
         if nav.substeps == 0 {
             nav.substeps = crate::truth::auto_substeps(dt, &trajectory);
