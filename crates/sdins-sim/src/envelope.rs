@@ -310,7 +310,12 @@ pub fn check_trajectory(
         rep.max_abs_lat_rad = rep.max_abs_lat_rad.max(lat.abs());
         rep.h_range_m = (rep.h_range_m.0.min(hgt), rep.h_range_m.1.max(hgt));
         if !(lat.is_finite() && hgt.is_finite()) {
-            return Err(fail(Quantity::NotFinite, f64::NAN, "finite position".into(), t));
+            return Err(fail(
+                Quantity::NotFinite,
+                f64::NAN,
+                "finite position".into(),
+                t,
+            ));
         }
         if lat.abs() > env.max_abs_lat_rad {
             return Err(fail(
@@ -359,7 +364,10 @@ mod tests {
         let r = check_trajectory(&t, start(), 0.01, &Envelope::DEFAULT).unwrap();
         assert!((r.max_speed_mps - 200.0).abs() < 1e-9);
         // 600 s north at 200 m/s: 120 km of latitude change ≈ 1.08°
-        assert!((r.max_abs_lat_rad - 0.5 - 120e3 / 6.36e6).abs() < 2e-4, "{r:?}");
+        assert!(
+            (r.max_abs_lat_rad - 0.5 - 120e3 / 6.36e6).abs() < 2e-4,
+            "{r:?}"
+        );
     }
 
     #[test]
@@ -372,17 +380,34 @@ mod tests {
                 Quantity::AngularRate,
             ),
             (
-                traj(0.0, 0.0, &[(Motion::Accelerate { accel_mps2: 50.0 }, 100.0)]),
+                traj(
+                    0.0,
+                    0.0,
+                    &[(Motion::Accelerate { accel_mps2: 50.0 }, 100.0)],
+                ),
                 start(),
                 Quantity::Speed,
             ),
             (
-                traj(0.0, 0.0, &[(Motion::Accelerate { accel_mps2: 2000.0 }, 1.0)]),
+                traj(
+                    0.0,
+                    0.0,
+                    &[(Motion::Accelerate { accel_mps2: 2000.0 }, 1.0)],
+                ),
                 start(),
                 Quantity::Acceleration,
             ),
             (
-                traj(100.0, 0.0, &[(Motion::Climb { to_climb_rate_mps: -50.0 }, 300.0)]),
+                traj(
+                    100.0,
+                    0.0,
+                    &[(
+                        Motion::Climb {
+                            to_climb_rate_mps: -50.0,
+                        },
+                        300.0,
+                    )],
+                ),
                 start(),
                 Quantity::Height,
             ),

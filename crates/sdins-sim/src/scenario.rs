@@ -519,6 +519,16 @@ impl Scenario {
             climb_rate_mps: climb,
             euler,
         };
+        // the one initial-state validator every source uses (the ranges above name the key)
+        if let Err(e) = crate::initial::validate_initial_state(&sdins_core::nav::InitialState {
+            lat_rad: start.lat_rad,
+            lon_rad: start.lon_rad,
+            h_m: start.h_m,
+            v_n_mps: sdins_core::math::Vec3::new(speed, 0.0, -climb),
+            c_b_n: sdins_core::math::c_b_n_from_euler(&euler),
+        }) {
+            return cx.err(doc.start.span(), "start", e.to_string());
+        }
 
         let im = doc.imu.get_ref();
         let rate_hz = cx.positive(&im.rate_hz, "imu.rate_hz")?;
@@ -577,7 +587,11 @@ impl Scenario {
             }
             let n = dur / dt;
             if n.round() < 1.0 {
-                return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is shorter than one IMU sample ({dt} s at {rate_hz} Hz)"));
+                return cx.err(
+                    sd.duration_s.span(),
+                    "segment.duration_s",
+                    format!("{dur} s is shorter than one IMU sample ({dt} s at {rate_hz} Hz)"),
+                );
             }
             if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
                 return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));

@@ -19,7 +19,10 @@ fn refused(start: &str, segments: &str, want: &str, line: usize) {
         Err(ScenarioError::Invalid {
             line: l, message, ..
         }) => {
-            assert!(message.contains(want), "{segments}: `{message}` lacks `{want}`");
+            assert!(
+                message.contains(want),
+                "{segments}: `{message}` lacks `{want}`"
+            );
             assert_eq!(l, line, "{segments}: {message}");
         }
         other => panic!("{segments}: accepted or wrong error: {other:?}"),
