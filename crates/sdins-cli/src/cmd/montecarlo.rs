@@ -79,7 +79,7 @@ pub struct Args {
 /// Map a library error to the CLI's exit codes.
 pub fn mc_err(e: McError) -> CliError {
     match e {
-        McError::Interrupted => CliError::Other("interrupted: no output written".into()),
+        McError::Interrupted => CliError::Interrupted,
         McError::Config(_)
         | McError::Model(_)
         | McError::Mismatch(_)
@@ -319,9 +319,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let cancelled = crate::progress::interrupted;
     let compute = || run_shard(&scn, &opts, shard, &on_run, &cancelled);
+    if let Some(t) = args.threads {
+        if !(1..=1024).contains(&t) {
+            return Err(CliError::bad(format!("--threads {t}: expected 1 … 1024")));
+        }
+    }
     let result = match args.threads {
         Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t.max(1))
+            .num_threads(t)
             .build()
             .map_err(|e| CliError::Other(e.to_string()))?
             .install(compute),

@@ -41,6 +41,10 @@ fn channels(e: &NavError) -> [f64; N_CHANNELS] {
     [p[0], p[1], p[2], v[0], v[1], v[2], a[0], a[1], a[2]]
 }
 
+/// Largest number of runs of one job (the per-epoch moments are exact far beyond it; the
+/// cap keeps block and shard arithmetic and run-time estimates sane).
+pub const MAX_RUNS: u64 = 100_000_000;
+
 /// One realisation: the errors at every output epoch.
 pub fn run_one(
     scn: &Scenario,
@@ -63,8 +67,11 @@ pub fn run_one(
 
 /// The job identity and the per-run scenario (seed replaced).
 pub fn job(scn: &Scenario, opts: &McOptions) -> Result<(McJob, Scenario), McError> {
-    if opts.runs == 0 {
-        return Err(McError::Config("runs must be ≥ 1".into()));
+    if opts.runs == 0 || opts.runs > MAX_RUNS {
+        return Err(McError::Config(format!(
+            "runs = {}: expected 1 … {MAX_RUNS}",
+            opts.runs
+        )));
     }
     if opts.block == 0 {
         return Err(McError::Config("block size must be ≥ 1".into()));
