@@ -662,3 +662,39 @@ fn process_conditions_and_resource_bounds() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("invalid UTF-8"));
 }
+
+/// Provenance: run.toml holds u64 seeds losslessly (as strings: TOML integers are i64) and
+/// the scenario text as it was read.
+#[test]
+fn run_toml_keeps_u64_seeds_and_the_scenario_text() {
+    let d = tmp("prov");
+    let (code, _, err) = sdins(&[
+        "montecarlo",
+        "turn-90dps",
+        "--runs",
+        "2",
+        "--seed",
+        "18446744073709551615",
+        "--grade",
+        "tactical",
+        "--quiet",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let t: toml::Table = std::fs::read_to_string(d.join("run.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(t["seed"].as_str(), Some("18446744073709551615"));
+    let p = d.join("s.toml");
+    std::fs::write(&p, GOOD).unwrap();
+    let r = d.join("run");
+    let (code, _, err) = sdins(&["run", p.to_str().unwrap(), "--out", r.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let t: toml::Table = std::fs::read_to_string(r.join("run.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(t["scenario"].as_str(), Some(GOOD));
+}

@@ -293,6 +293,9 @@ pub struct Scenario {
     pub nav: NavConfig,
     /// the trajectory
     pub trajectory: Trajectory,
+    /// the scenario text exactly as it was read (provenance: `run.toml` records this, not
+    /// the file as it may be later)
+    pub source_toml: String,
 }
 
 struct Ctx<'a> {
@@ -859,6 +862,7 @@ impl Scenario {
             imu,
             nav,
             trajectory,
+            source_toml: text.to_string(),
         })
     }
 

@@ -191,8 +191,9 @@ fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliE
         job.fingerprint.clone().into(),
     );
     t.insert("algo".into(), job.algo.clone().into());
-    t.insert("runs".into(), (job.runs as i64).into());
-    t.insert("seed".into(), (job.seed as i64).into());
+    // u64 values as strings: TOML integers are i64
+    t.insert("runs".into(), job.runs.to_string().into());
+    t.insert("seed".into(), job.seed.to_string().into());
     crate::report::write_run_toml(dir, t)
 }
 
