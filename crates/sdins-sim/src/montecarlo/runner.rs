@@ -274,6 +274,24 @@ duration_s = 60.0
     }
 
     #[test]
+    fn tampered_states_are_refused() {
+        let scn = small_scenario();
+        let o = opts(9);
+        let st = run_shard(&scn, &o, Shard::ALL, &|| {}, &|| false).unwrap();
+        st.validate().unwrap();
+        let tamper = |f: &dyn Fn(&mut McState)| {
+            let mut t = st.clone();
+            f(&mut t);
+            McState::merge(&[t]).unwrap_err().to_string()
+        };
+        assert!(tamper(&|t| t.blocks[0].moments[0].n += 1).contains("n = "));
+        assert!(tamper(&|t| t.blocks[0].moments[3].m2 = -1.0).contains("m2"));
+        assert!(tamper(&|t| t.blocks[0].moments[1].mean = f64::NAN).contains("mean"));
+        assert!(tamper(&|t| t.times_s[0] = f64::INFINITY).contains("epoch"));
+        assert!(tamper(&|t| t.hist[2] = Default::default()).contains("histogram"));
+    }
+
+    #[test]
     fn bit_identical_for_threads_and_shards() {
         let scn = small_scenario();
         let o = opts(61); // 4 blocks, the last one partial
