@@ -18,3 +18,4 @@ pub mod scenario;
 pub mod trajectory;
 pub mod truth;
 pub mod truth_file;
+pub mod vehicle;
