@@ -6,6 +6,7 @@
 //! exactly the keys accepted here: [`ACCEPTED_KEYS`]).
 
 use crate::trajectory::{Axis, Motion, Overlay, OverlayKind, Trajectory};
+use crate::vehicle::{Vehicle, VehicleError};
 use sdins_core::earth::EarthModel;
 use sdins_core::math::Euler;
 use serde::Deserialize;
@@ -63,6 +64,8 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "nav",
             "segment",
             "overlay",
+            "vehicle",
+            "angle_of_attack_deg",
         ],
     ),
     (
@@ -96,6 +99,8 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "profile",
             "amplitude_dps",
             "to_climb_rate_mps",
+            "bank_deg",
+            "roll_rate_dps",
         ],
     ),
     (
@@ -127,6 +132,8 @@ struct FileDoc {
     segment: Vec<S<SegmentDoc>>,
     #[serde(default)]
     overlay: Vec<S<OverlayDoc>>,
+    vehicle: Option<S<String>>,
+    angle_of_attack_deg: Option<S<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -167,13 +174,15 @@ struct NavDoc {
 struct SegmentDoc {
     #[serde(rename = "type")]
     kind: S<String>,
-    duration_s: S<f64>,
+    duration_s: Option<S<f64>>,
     accel_mps2: Option<S<f64>>,
     rate_dps: Option<S<f64>>,
     angle_deg: Option<S<f64>>,
     profile: Option<S<String>>,
     amplitude_dps: Option<S<f64>>,
     to_climb_rate_mps: Option<S<f64>>,
+    bank_deg: Option<S<f64>>,
+    roll_rate_dps: Option<S<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -562,35 +571,66 @@ impl Scenario {
         let nav = parse_nav(&cx, doc.nav.as_ref())?;
 
         let dt = 1.0 / rate_hz;
+        let vehicle = parse_vehicle(&cx, &doc)?;
+        if vehicle != Vehicle::Free {
+            for (v, key) in [(&st.roll_deg, "start.roll_deg"), (&st.pitch_deg, "start.pitch_deg")] {
+                if let Some(v) = v {
+                    if *v.get_ref() != 0.0 {
+                        return cx.err(v.span(), key, format!("with vehicle = \"{}\" roll and pitch follow the motion (bank, flight-path angle, road grade): leave this key out", vehicle.name()));
+                    }
+                }
+            }
+        }
         let mut motions = Vec::new();
+        // the [[segment]] of each motion (a coordinated turn is three motions)
+        let mut seg_of_motion: Vec<std::ops::Range<usize>> = Vec::new();
         let mut speed_now = speed;
         for s in &doc.segment {
             let sd = s.get_ref();
             let kind = sd.kind.get_ref().as_str();
-            let dur = cx.positive(&sd.duration_s, "segment.duration_s")?;
+            let profile = sd
+                .profile
+                .as_ref()
+                .map(|p| p.get_ref().as_str());
+            let coordinated = kind == "turn" && profile == Some("coordinated");
+            let dur = match (&sd.duration_s, coordinated) {
+                (Some(d), false) => cx.positive(d, "segment.duration_s")?,
+                (Some(d), true) => {
+                    return cx.err(d.span(), "segment.duration_s", "a coordinated turn takes its duration from angle_deg, bank_deg and roll_rate_dps: leave duration_s out");
+                }
+                (None, true) => 1.0,
+                (None, false) => {
+                    return cx.err(s.span(), "segment.duration_s", "missing required key");
+                }
+            };
             if dur > MAX_SEGMENT_S {
+                let span = sd.duration_s.as_ref().map_or(s.span(), |d| d.span());
                 return cx.err(
-                    sd.duration_s.span(),
+                    span,
                     "segment.duration_s",
                     format!("{dur} s is too long: expected at most {MAX_SEGMENT_S:e} s (116 days)"),
                 );
             }
             let n = dur / dt;
-            if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
-                return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));
+            if !coordinated && (n - n.round()).abs() > 1e-6 * n.max(1.0) {
+                let span = sd.duration_s.as_ref().map_or(s.span(), |d| d.span());
+                return cx.err(span, "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));
             }
             // keys allowed per type
             let allowed: &[&str] = match kind {
                 "static" | "cruise" => &[],
-                "accelerate" => &["accel_mps2"],
+                "accelerate" => &["accel_mps2", "profile"],
+                "turn" if coordinated => &["angle_deg", "profile", "bank_deg", "roll_rate_dps"],
                 "turn" => &["rate_dps", "angle_deg", "profile"],
                 "sturn" => &["amplitude_dps"],
-                "climb" => &["to_climb_rate_mps"],
+                "climb" => &["to_climb_rate_mps", "profile"],
                 other => {
                     return cx.err(sd.kind.span(), "segment.type", format!("unknown segment type `{other}`: expected one of static, cruise, accelerate, turn, sturn, climb"));
                 }
             };
-            let present: [(&str, Option<std::ops::Range<usize>>); 6] = [
+            let present: [(&str, Option<std::ops::Range<usize>>); 8] = [
+                ("bank_deg", sd.bank_deg.as_ref().map(|v| v.span())),
+                ("roll_rate_dps", sd.roll_rate_dps.as_ref().map(|v| v.span())),
                 ("accel_mps2", sd.accel_mps2.as_ref().map(|v| v.span())),
                 ("rate_dps", sd.rate_dps.as_ref().map(|v| v.span())),
                 ("angle_deg", sd.angle_deg.as_ref().map(|v| v.span())),
@@ -637,6 +677,32 @@ impl Scenario {
                     Motion::Static
                 }
                 "cruise" => Motion::Cruise,
+                "turn" if coordinated => {
+                    let angle = need(&sd.angle_deg, "segment.angle_deg")?;
+                    let bank = need(&sd.bank_deg, "segment.bank_deg")?;
+                    let roll = need(&sd.roll_rate_dps, "segment.roll_rate_dps")?;
+                    if !(bank > 0.0 && bank < 90.0) {
+                        let span = sd.bank_deg.as_ref().map_or(s.span(), |v| v.span());
+                        return cx.err(span, "segment.bank_deg", format!("{bank} deg: expected a bank limit in (0, 90) deg"));
+                    }
+                    if !(roll > 0.0 && roll <= 360.0) {
+                        let span = sd.roll_rate_dps.as_ref().map_or(s.span(), |v| v.span());
+                        return cx.err(span, "segment.roll_rate_dps", format!("{roll} deg/s: expected a roll-rate limit in (0, 360] deg/s"));
+                    }
+                    if angle == 0.0 || speed_now <= 0.0 {
+                        return cx.err(s.span(), "segment.angle_deg", format!("a coordinated turn needs a non-zero angle and a moving vehicle (speed here {speed_now} m/s)"));
+                    }
+                    match crate::vehicle::coordinated_turn(speed_now, angle * D2R, bank * D2R, roll * D2R, dt) {
+                        Ok(parts) => {
+                            for p in parts {
+                                motions.push(p);
+                                seg_of_motion.push(s.span());
+                            }
+                        }
+                        Err(e) => return cx.err(s.span(), "segment.type", e.to_string()),
+                    }
+                    continue;
+                }
                 "accelerate" => {
                     let a = need(&sd.accel_mps2, "segment.accel_mps2")?;
                     if a.abs() > 1000.0 * 9.80665 {
@@ -650,7 +716,16 @@ impl Scenario {
                     if speed_now < -1e-9 {
                         return cx.err(s.span(), "segment.accel_mps2", format!("the speed would become negative ({speed_now} m/s) by the end of this segment"));
                     }
-                    Motion::Accelerate { accel_mps2: a }
+                    match profile {
+                        None | Some("linear") => Motion::Accelerate { accel_mps2: a },
+                        Some("smooth") => Motion::AccelerateSmooth {
+                            delta_speed_mps: a * dur,
+                        },
+                        Some(other) => {
+                            let span = sd.profile.as_ref().map_or(s.span(), |p| p.span());
+                            return cx.err(span, "segment.profile", format!("unknown profile `{other}` for accelerate: expected linear or smooth"));
+                        }
+                    }
                 }
                 "turn" => {
                     let profile = sd
@@ -697,11 +772,24 @@ impl Scenario {
                 "sturn" => Motion::STurn {
                     amplitude_rps: need(&sd.amplitude_dps, "segment.amplitude_dps")? * D2R,
                 },
-                _ => Motion::Climb {
-                    to_climb_rate_mps: need(&sd.to_climb_rate_mps, "segment.to_climb_rate_mps")?,
-                },
+                _ => {
+                    let to = need(&sd.to_climb_rate_mps, "segment.to_climb_rate_mps")?;
+                    match profile {
+                        None | Some("linear") => Motion::Climb {
+                            to_climb_rate_mps: to,
+                        },
+                        Some("smooth") => Motion::ClimbSmooth {
+                            to_climb_rate_mps: to,
+                        },
+                        Some(other) => {
+                            let span = sd.profile.as_ref().map_or(s.span(), |p| p.span());
+                            return cx.err(span, "segment.profile", format!("unknown profile `{other}` for climb: expected linear or smooth"));
+                        }
+                    }
+                }
             };
             motions.push((motion, (n.round()) * dt));
+            seg_of_motion.push(s.span());
         }
         if motions.is_empty() {
             return Err(ScenarioError::Invalid {
@@ -812,6 +900,31 @@ impl Scenario {
         }
 
         let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
+        let trajectory = match trajectory.with_vehicle(vehicle, nav.earth.model(), lat * D2R, h) {
+            Ok(t) => t,
+            Err(e) => {
+                let i = match &e {
+                    VehicleError::Joint { index, .. } | VehicleError::Vertical { index, .. } => {
+                        *index
+                    }
+                };
+                let span = seg_of_motion
+                    .get(i.saturating_sub(1))
+                    .cloned()
+                    .unwrap_or(0..0);
+                let which = doc
+                    .segment
+                    .iter()
+                    .position(|d| d.span() == span)
+                    .map_or(i, |p| p + 1);
+                let msg = e.to_string().replacen(
+                    &format!("segment {i} (1-based)"),
+                    &format!("[[segment]] number {which}"),
+                    1,
+                );
+                return cx.err(span, "segment", msg);
+            }
+        };
         let mut nav = nav;
         if nav.substeps == 0 {
             nav.substeps = crate::truth::auto_substeps(dt, &trajectory);
@@ -863,6 +976,30 @@ impl Scenario {
     pub fn duration_s(&self) -> f64 {
         self.trajectory.duration_s
     }
+}
+
+fn parse_vehicle(cx: &Ctx<'_>, doc: &FileDoc) -> Result<Vehicle, ScenarioError> {
+    let alpha = match &doc.angle_of_attack_deg {
+        Some(a) => Some((
+            cx.range(a, "angle_of_attack_deg", -30.0, 30.0, "an angle of attack in [-30, 30] deg")? * D2R,
+            a.span(),
+        )),
+        None => None,
+    };
+    let v = match doc.vehicle.as_ref().map(|v| (v.get_ref().as_str(), v.span())) {
+        None | Some(("free", _)) => Vehicle::Free,
+        Some(("car", _)) => Vehicle::Car,
+        Some(("aircraft", _)) => Vehicle::Aircraft {
+            angle_of_attack_rad: alpha.as_ref().map_or(0.0, |a| a.0),
+        },
+        Some((other, span)) => {
+            return cx.err(span, "vehicle", format!("unknown vehicle `{other}`: expected free, aircraft or car"));
+        }
+    };
+    if let (Some((_, span)), false) = (alpha, matches!(v, Vehicle::Aircraft { .. })) {
+        return cx.err(span, "angle_of_attack_deg", "only an aircraft has an angle of attack (set vehicle = \"aircraft\")");
+    }
+    Ok(v)
 }
 
 fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioError> {

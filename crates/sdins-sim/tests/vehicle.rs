@@ -279,3 +279,83 @@ fn aircraft_rejects_steps_in_the_acceleration() {
     );
     assert!(matches!(r, Err(VehicleError::Vertical { index: 1, .. })), "{r:?}");
 }
+
+const FLIGHT_TOML: &str = r#"
+name = "coordinated"
+vehicle = "aircraft"
+angle_of_attack_deg = 3.0
+[start]
+lat_deg = 45.0
+lon_deg = 10.0
+h_m = 3000.0
+speed_mps = 200.0
+yaw_deg = 30.0
+[imu]
+rate_hz = 100.0
+[[segment]]
+type = "cruise"
+duration_s = 5.0
+[[segment]]
+type = "climb"
+profile = "smooth"
+to_climb_rate_mps = 10.0
+duration_s = 10.0
+[[segment]]
+type = "turn"
+profile = "coordinated"
+angle_deg = 90.0
+bank_deg = 45.0
+roll_rate_dps = 15.0
+[[segment]]
+type = "accelerate"
+profile = "smooth"
+accel_mps2 = 1.0
+duration_s = 10.0
+[[segment]]
+type = "cruise"
+duration_s = 2.0
+"#;
+
+#[test]
+fn scenario_file_flies_a_coordinated_turn() {
+    let scn = sdins_sim::scenario::Scenario::from_toml(FLIGHT_TOML, "f.toml").unwrap();
+    assert_eq!(scn.trajectory.vehicle().name(), "aircraft");
+    let d = scn.duration_s() / 0.01;
+    assert!((d - d.round()).abs() < 1e-6, "whole samples: {d}");
+    let e = scn.nav.earth.model();
+    let c = TruthConfig {
+        earth: e,
+        dt_s: scn.imu.dt_s(),
+        lat0_rad: scn.start.lat_rad,
+        lon0_rad: scn.start.lon_rad,
+        h0_m: scn.start.h_m,
+        substeps: scn.nav.substeps,
+    };
+    let mut fy = 0.0_f64;
+    for s in TruthGenerator::new(&scn.trajectory, c) {
+        fy = fy.max(body_f_v(&scn.trajectory, &e, &s).0.y.abs());
+    }
+    assert!(fy <= 1e-12, "{fy:e}");
+}
+
+#[test]
+fn scenario_vehicle_errors_are_located() {
+    let err = |text: &str| {
+        sdins_sim::scenario::Scenario::from_toml(text, "f.toml")
+            .unwrap_err()
+            .to_string()
+    };
+    // a linear climb steps the acceleration: the aircraft's bank would jump
+    let e = err(&FLIGHT_TOML.replacen("profile = \"smooth\"\nto_climb", "to_climb", 1));
+    assert!(e.starts_with("f.toml:16: segment:") && e.contains("[[segment]] number 2"), "{e}");
+    let e = err(&FLIGHT_TOML.replace("\"aircraft\"", "\"boat\""));
+    assert!(e.starts_with("f.toml:3: vehicle:") && e.contains("unknown vehicle"), "{e}");
+    let e = err(&FLIGHT_TOML.replace("yaw_deg = 30.0", "yaw_deg = 30.0\npitch_deg = 2.0"));
+    assert!(e.contains("start.pitch_deg") && e.contains("leave this key out"), "{e}");
+    let e = err(&FLIGHT_TOML.replace("bank_deg = 45.0", "bank_deg = 95.0"));
+    assert!(e.contains("segment.bank_deg") && e.contains("(0, 90)"), "{e}");
+    let e = err(&FLIGHT_TOML.replace("roll_rate_dps = 15.0", "roll_rate_dps = 15.0\nduration_s = 4.0"));
+    assert!(e.contains("segment.duration_s") && e.contains("leave duration_s out"), "{e}");
+    let e = err(&FLIGHT_TOML.replace("vehicle = \"aircraft\"", "vehicle = \"car\""));
+    assert!(e.contains("angle_of_attack_deg") && e.contains("only an aircraft"), "{e}");
+}
