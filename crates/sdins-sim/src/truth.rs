@@ -181,6 +181,63 @@ pub struct TruthGenerator<'a> {
     /// `(L, sin L, cos L)` of the last latitude whose sin/cos was taken (the sample-end
     /// latitude is the next panel's start latitude)
     lat_sc: (f64, f64, f64),
+    /// IMU lever arm and mounting ([`TruthGenerator::with_mount`])
+    mount: Option<ImuMount>,
+    /// `ω_ib^b` at the current sample start (the previous sample's end value)
+    w_ib_prev: Option<Vec3>,
+}
+
+/// Where the IMU sits on the vehicle: a lever arm from the vehicle reference point and a
+/// mounting rotation, both in the vehicle (body) frame.
+///
+/// The IMU senses `ω_is^s = C_b^s ω_ib^b` and `f^s = C_b^s (f_ref^b + ω̇_ib^b × l +
+/// ω_ib^b × (ω_ib^b × l))` (rigid body, Groves 2nd ed. eq. 2.125 differentiated twice with
+/// the earth terms of `f` unchanged), so over a sample `Δθ^s = C_b^s Δθ^b` and
+/// `Δv^s = C_b^s (Δv_ref^b + [ω_ib^b(t₁) − ω_ib^b(t₀)] × l + ∫ ω_ib^b × (ω_ib^b × l) dt)`:
+/// the angular-acceleration term integrates in closed form (a step in ω inside or at the
+/// start of a sample, e.g. the start of a constant-rate turn, is the impulse it is), the
+/// centripetal term by the same quadrature as `f`. The truth samples stay at the reference
+/// point; [`ImuMount::imu_point`] gives the IMU's own position, velocity and attitude.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuMount {
+    /// lever arm from the vehicle reference point to the IMU, vehicle frame [m]
+    pub lever_arm_b_m: Vec3,
+    /// rotation from the vehicle frame to the IMU (sensor) frame, `C_b^s`
+    pub c_b_s: Mat3,
+}
+
+impl ImuMount {
+    /// Lever arm `l` [m] and mounting Euler angles (roll, pitch, yaw of the IMU axes in the
+    /// vehicle frame: `C_s^b = Rz Ry Rx`).
+    pub fn new(lever_arm_b_m: Vec3, mount: sdins_core::math::Euler) -> Self {
+        Self {
+            lever_arm_b_m,
+            c_b_s: sdins_core::math::c_b_n_from_euler(&mount).transpose(),
+        }
+    }
+
+    /// The IMU's truth from a reference-point sample and the trajectory kinematics at the
+    /// same instant: position `r + C_b^n l` (the NED offset converted with the radii of
+    /// curvature at the reference point: the curvature error is `|l|²/R ≈ 1e-13 m` per m²
+    /// of lever arm), velocity `v + C_b^n (ω_eb^b × l)` with
+    /// `ω_eb^b = ω_nb^b + C_n^b ω_en^n` (Groves eq. 2.128 form), attitude `C_s^n = C_b^n C_s^b`.
+    /// Returns `(lat_rad, lon_rad, h_m, v_n_mps, c_s_n)`.
+    pub fn imu_point(
+        &self,
+        earth: &EarthModel,
+        s: &TruthSample,
+        kin: &Kinematics,
+    ) -> (f64, f64, f64, Vec3, Mat3) {
+        let d_n = s.c_b_n * self.lever_arm_b_m;
+        let r = earth.radii(s.lat_rad);
+        let lat = s.lat_rad + d_n.x / (r.r_m_m + s.h_m);
+        let lon = wrap_pi(s.lon_rad + d_n.y / ((r.r_n_m + s.h_m) * s.lat_rad.cos()));
+        let h = s.h_m - d_n.z;
+        let w_en = earth.omega_en_n(s.lat_rad, s.h_m, &s.v_n_mps);
+        let w_eb = kin.omega_nb_b_rps + s.c_b_n.transpose() * w_en;
+        let v = s.v_n_mps + s.c_b_n * w_eb.cross(&self.lever_arm_b_m);
+        (lat, lon, h, v, s.c_b_n * self.c_b_s.transpose())
+    }
 }
 
 /// Gauss–Legendre 3-node nodes, Butcher `A` (collocation) matrix; weights 5/18, 4/9, 5/18
@@ -334,6 +391,8 @@ impl<'a> TruthGenerator<'a> {
             ph_tmp: Default::default(),
             ph_zero: OverlayPhases::default(),
             lat_sc: (f64::NAN, 0.0, 1.0),
+            mount: None,
+            w_ib_prev: None,
         };
         traj.phases_offset(0.0, &mut g.ph_zero);
         // node offsets of the regular panel layout, formed as in `sample_gauss`
@@ -352,6 +411,24 @@ impl<'a> TruthGenerator<'a> {
             g.closed = Some(g.closed_form());
         }
         g
+    }
+
+    /// IMU increments at a lever arm and mounting ([`ImuMount`]); the samples' position,
+    /// velocity and attitude stay those of the vehicle reference point. Uses the general
+    /// (integrated) path.
+    pub fn with_mount(mut self, mount: ImuMount) -> Self {
+        self.closed = None;
+        self.mount = Some(mount);
+        self
+    }
+
+    /// `ω_ib^b` at time `t` (branch `t_sel`) at the current position.
+    fn omega_ib(&self, t: f64, t_sel: f64) -> Vec3 {
+        let kin = self.traj.kinematics(t, t_sel);
+        let e = &self.cfg.earth;
+        let lat = self.cfg.lat0_rad + self.dlat;
+        let w = e.omega_ie_n(lat) + e.omega_en_n(lat, self.h, &kin.v_n_mps);
+        kin.omega_nb_b_rps + kin.c_b_n.transpose() * w
     }
 
     /// Force the general (integrated) path even where the closed form applies (for tests).
@@ -378,6 +455,7 @@ impl<'a> TruthGenerator<'a> {
     /// propagated to `t_k`, and the closed-form path is not used.
     pub fn starting_at_sample(mut self, k: u64) -> Self {
         self.closed = None;
+        self.w_ib_prev = None;
         self.k = k.min(self.n_samples);
         let t0 = self.k as f64 * self.cfg.dt_s;
         self.bi = self.breaks.partition_point(|&b| b <= t0);
@@ -460,7 +538,11 @@ impl<'a> TruthGenerator<'a> {
         let w_en = e.omega_en_n(lat, h, &v);
         let c_n_b = kin.c_b_n.transpose();
         let w_ib = kin.omega_nb_b_rps + c_n_b * (w_ie + w_en);
-        let f_b = c_n_b * (kin.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - e.gravity_n(lat, h));
+        let mut f_b =
+            c_n_b * (kin.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - e.gravity_n(lat, h));
+        if let Some(m) = &self.mount {
+            f_b += w_ib.cross(&w_ib.cross(&m.lever_arm_b_m));
+        }
         let (lat_dot, lon_dot) = if e.transport {
             (v.x / (r.r_m_m + h), v.y / ((r.r_n_m + h) * lat.cos()))
         } else {
@@ -633,8 +715,11 @@ impl TruthGenerator<'_> {
             let w_en = e.omega_en_n_local(&le, h, &v);
             let c_n_b = k.c_b_n.transpose();
             let th_i = k.omega_nb_b_rps + c_n_b * (w_ie + w_en);
-            let f_i = c_n_b
+            let mut f_i = c_n_b
                 * (k.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - Vec3::new(0.0, 0.0, le.g_mps2));
+            if let Some(m) = &self.mount {
+                f_i += th_i.cross(&th_i.cross(&m.lever_arm_b_m));
+            }
             for a in 0..3 {
                 th[a][i] = th_i[a];
                 f[a][i] = f_i[a];
@@ -674,7 +759,12 @@ impl Iterator for TruthGenerator<'_> {
                 (cf.inc, cf.v_n_mps, cf.c_b_n, cf.sin_cos_lat)
             }
             None => {
-                let inc = match self.scheme {
+                let w0 = match (&self.mount, self.w_ib_prev) {
+                    (None, _) => Vec3::zeros(),
+                    (Some(_), Some(w)) => w,
+                    (Some(_), None) => self.omega_ib(t0, t0),
+                };
+                let mut inc = match self.scheme {
                     TruthScheme::Gauss => self.sample_gauss(t0),
                     TruthScheme::Rk4 => self.sample_rk4(t0),
                 };
@@ -687,6 +777,12 @@ impl Iterator for TruthGenerator<'_> {
                     .kinematics_phased(t1, 0.0, t_sel, &self.ph_end, &self.ph_zero);
                 std::mem::swap(&mut self.ph_base, &mut self.ph_end);
                 self.ph_base_t = t1;
+                if let Some(m) = self.mount {
+                    let w1 = self.omega_ib(t1, t_sel);
+                    self.w_ib_prev = Some(w1);
+                    let dv = inc.dv_b_mps + (w1 - w0).cross(&m.lever_arm_b_m);
+                    inc = Increment::new(m.c_b_s * inc.dtheta_b_rad, m.c_b_s * dv);
+                }
                 let lat_rad = self.cfg.lat0_rad + self.dlat;
                 (inc, kin.v_n_mps, kin.c_b_n, self.sin_cos_lat(lat_rad))
             }
