@@ -7,6 +7,7 @@ use sdins_core::earth::EarthModel;
 use sdins_core::math::Vec3;
 use sdins_core::nav::InitialState;
 use sdins_sim::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::initial::validate_initial_state;
 use sdins_sim::pipeline::{nav_error, navigate_recorded_timed, NavError};
 use sdins_sim::scenario::Scenario;
 use sdins_sim::truth_file::{c_b_n_from_psins, read_truth};
@@ -135,25 +136,44 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     data.dt_s
                 )));
             }
-            InitialState {
+            let s = InitialState {
                 lat_rad: r.lat_rad,
                 lon_rad: r.lon_rad,
                 h_m: r.h_m,
                 v_n_mps: r.v_n_mps,
                 c_b_n: r.c_b_n,
-            }
+            };
+            validate_initial_state(&s).map_err(|e| {
+                CliError::bad(format!(
+                    "{}: first row (the initial state): {e}",
+                    args.truth
+                        .as_deref()
+                        .unwrap_or(std::path::Path::new(""))
+                        .display()
+                ))
+            })?;
+            s
         }
-        (None, _, Some(h)) => InitialState {
-            lat_rad: h.lat_deg * D2R,
-            lon_rad: h.lon_deg * D2R,
-            h_m: h.h_m,
-            v_n_mps: Vec3::new(h.vel0_enu_mps[1], h.vel0_enu_mps[0], -h.vel0_enu_mps[2]),
-            c_b_n: c_b_n_from_psins(
-                h.att0_deg[0] * D2R,
-                h.att0_deg[1] * D2R,
-                h.att0_deg[2] * D2R,
-            ),
-        },
+        (None, _, Some(h)) => {
+            let s = InitialState {
+                lat_rad: h.lat_deg * D2R,
+                lon_rad: h.lon_deg * D2R,
+                h_m: h.h_m,
+                v_n_mps: Vec3::new(h.vel0_enu_mps[1], h.vel0_enu_mps[0], -h.vel0_enu_mps[2]),
+                c_b_n: c_b_n_from_psins(
+                    h.att0_deg[0] * D2R,
+                    h.att0_deg[1] * D2R,
+                    h.att0_deg[2] * D2R,
+                ),
+            };
+            validate_initial_state(&s).map_err(|e| {
+                CliError::bad(format!(
+                    "{}: PSINS header (the initial state): {e}",
+                    args.imu.display()
+                ))
+            })?;
+            s
+        }
         _ => {
             return Err(CliError::bad(
                 "--init is required (no truth file or PSINS header to take it from)",
