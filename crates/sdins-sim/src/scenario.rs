@@ -66,7 +66,12 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "overlay",
             "vehicle",
             "angle_of_attack_deg",
+            "mounting",
         ],
+    ),
+    (
+        "mounting",
+        &["imu_lever_arm_m", "imu_mount_deg", "gnss_lever_arm_m"],
     ),
     (
         "start",
@@ -134,6 +139,26 @@ struct FileDoc {
     overlay: Vec<S<OverlayDoc>>,
     vehicle: Option<S<String>>,
     angle_of_attack_deg: Option<S<f64>>,
+    mounting: Option<S<MountingDoc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MountingDoc {
+    imu_lever_arm_m: Option<S<Vec<f64>>>,
+    imu_mount_deg: Option<S<Vec<f64>>>,
+    gnss_lever_arm_m: Option<S<Vec<f64>>>,
+}
+
+/// Sensor placement on the vehicle (`[mounting]`): lever arms from the vehicle reference
+/// point in the vehicle frame, the IMU's mounting rotation. The truth is reported at the
+/// reference point.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Mounting {
+    /// the IMU's lever arm and mounting (none: the IMU at the reference point, aligned)
+    pub imu: Option<crate::truth::ImuMount>,
+    /// the GNSS antenna's lever arm, vehicle frame [m] (for the INS/GNSS simulation)
+    pub gnss_lever_arm_b_m: Option<sdins_core::math::Vec3>,
 }
 
 #[derive(Deserialize)]
@@ -302,6 +327,8 @@ pub struct Scenario {
     pub nav: NavConfig,
     /// the trajectory
     pub trajectory: Trajectory,
+    /// sensor placement (`[mounting]`)
+    pub mounting: Mounting,
 }
 
 struct Ctx<'a> {
@@ -959,6 +986,7 @@ impl Scenario {
             };
             return cx.err(span, "segment", e.to_string());
         }
+        let mounting = parse_mounting(&cx, doc.mounting.as_ref())?;
         let mut nav = nav;
         if nav.substeps == 0 {
             nav.substeps = crate::truth::auto_substeps(dt, &trajectory);
@@ -974,6 +1002,7 @@ impl Scenario {
             imu,
             nav,
             trajectory,
+            mounting,
         })
     }
 
@@ -1010,6 +1039,43 @@ impl Scenario {
     pub fn duration_s(&self) -> f64 {
         self.trajectory.duration_s
     }
+}
+
+fn parse_mounting(cx: &Ctx<'_>, m: Option<&S<MountingDoc>>) -> Result<Mounting, ScenarioError> {
+    let Some(m) = m else {
+        return Ok(Mounting::default());
+    };
+    let vec3 = |v: &Option<S<Vec<f64>>>, key: &str, lim: f64, unit: &str| {
+        let Some(v) = v else {
+            return Ok(None);
+        };
+        let x = v.get_ref();
+        if x.len() != 3 || x.iter().any(|c| !c.is_finite() || c.abs() > lim) {
+            return cx.err(
+                v.span(),
+                key,
+                format!("expected three finite numbers [x, y, z] within ±{lim} {unit}, got {x:?}"),
+            );
+        }
+        Ok(Some(sdins_core::math::Vec3::new(x[0], x[1], x[2])))
+    };
+    let m = m.get_ref();
+    let arm = vec3(&m.imu_lever_arm_m, "mounting.imu_lever_arm_m", 100.0, "m")?;
+    let ang = vec3(&m.imu_mount_deg, "mounting.imu_mount_deg", 180.0, "deg")?;
+    let gnss = vec3(&m.gnss_lever_arm_m, "mounting.gnss_lever_arm_m", 100.0, "m")?;
+    let imu = if arm.is_some() || ang.is_some() {
+        let a = ang.unwrap_or_default() * D2R;
+        Some(crate::truth::ImuMount::new(
+            arm.unwrap_or_default(),
+            Euler::new(a.x, a.y, a.z),
+        ))
+    } else {
+        None
+    };
+    Ok(Mounting {
+        imu,
+        gnss_lever_arm_b_m: gnss,
+    })
 }
 
 fn parse_vehicle(cx: &Ctx<'_>, doc: &FileDoc) -> Result<Vehicle, ScenarioError> {

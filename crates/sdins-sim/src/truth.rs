@@ -149,6 +149,32 @@ struct ClosedForm {
     sin_cos_lat: (f64, f64),
 }
 
+/// The difference of the gravitational attraction between the IMU at `d_n = C_b^n l` and
+/// the reference point, in the reference point's NED axes, under the navigation's own
+/// earth model: `γ = g + ω_ie×(ω_ie×r)` (plumb-bob gravity `g` minus the centrifugal term),
+/// so `Δγ = C_{n'}^n g^{n'} − g^n + ω_ie×(ω_ie×d_n)`. The local vertical at the IMU is tilted
+/// by `(δE/(R_N+h), −δN/(R_M+h))`, which puts `−g·(δN/(R_M+h), δE/(R_N+h))` on the
+/// horizontal axes (flat model: one vertical, no tilt); `g2 − g` is the model's gravity
+/// change to the IMU's latitude and height. Neglected: second order in `|l|/R`
+/// (≈ 1e-13 g per m² of lever arm). The IMU senses `f^b = … − C_n^b Δγ`
+/// ([`ImuMount`]).
+fn gravity_difference(
+    e: &EarthModel,
+    le: &sdins_core::earth::LocalEarth,
+    h: f64,
+    w_ie: &Vec3,
+    d_n: &Vec3,
+    g2: f64,
+) -> Vec3 {
+    let g = le.g_mps2;
+    let tilt = if e.transport {
+        Vec3::new(-g * d_n.x / (le.r_m_m + h), -g * d_n.y / (le.r_n_m + h), 0.0)
+    } else {
+        Vec3::zeros()
+    };
+    tilt + Vec3::new(0.0, 0.0, g2 - g) + w_ie.cross(&w_ie.cross(d_n))
+}
+
 /// Streaming truth generator (constant memory): an iterator of [`TruthSample`].
 #[derive(Clone, Debug)]
 pub struct TruthGenerator<'a> {
@@ -191,9 +217,12 @@ pub struct TruthGenerator<'a> {
 /// mounting rotation, both in the vehicle (body) frame.
 ///
 /// The IMU senses `ω_is^s = C_b^s ω_ib^b` and `f^s = C_b^s (f_ref^b + ω̇_ib^b × l +
-/// ω_ib^b × (ω_ib^b × l))` (rigid body, Groves 2nd ed. eq. 2.125 differentiated twice with
-/// the earth terms of `f` unchanged), so over a sample `Δθ^s = C_b^s Δθ^b` and
-/// `Δv^s = C_b^s (Δv_ref^b + [ω_ib^b(t₁) − ω_ib^b(t₀)] × l + ∫ ω_ib^b × (ω_ib^b × l) dt)`:
+/// ω_ib^b × (ω_ib^b × l) − C_n^b Δγ)` (rigid body in inertial space, Groves 2nd ed.
+/// §2.5; `Δγ` the model's gravitational attraction at the IMU minus that at the reference
+/// point, ≈ 3e-6 s⁻² per m of lever arm, without which a navigation of the IMU point
+/// drifts by ~1e-4 m/s per minute), so over a sample `Δθ^s = C_b^s Δθ^b` and
+/// `Δv^s = C_b^s (Δv_ref^b + [ω_ib^b(t₁) − ω_ib^b(t₀)] × l + ∫ (ω_ib^b × (ω_ib^b × l) −
+/// C_n^b Δγ) dt)`:
 /// the angular-acceleration term integrates in closed form (a step in ω inside or at the
 /// start of a sample, e.g. the start of a constant-rate turn, is the impulse it is), the
 /// centripetal term by the same quadrature as `f`. The truth samples stay at the reference
@@ -217,26 +246,38 @@ impl ImuMount {
     }
 
     /// The IMU's truth from a reference-point sample and the trajectory kinematics at the
-    /// same instant: position `r + C_b^n l` (the NED offset converted with the radii of
-    /// curvature at the reference point: the curvature error is `|l|²/R ≈ 1e-13 m` per m²
-    /// of lever arm), velocity `v + C_b^n (ω_eb^b × l)` with
-    /// `ω_eb^b = ω_nb^b + C_n^b ω_en^n` (Groves eq. 2.128 form), attitude `C_s^n = C_b^n C_s^b`.
-    /// Returns `(lat_rad, lon_rad, h_m, v_n_mps, c_s_n)`.
+    /// same instant, in the NED frame at the IMU (the frame a navigation of the IMU data
+    /// keeps; it differs from the reference point's NED frame by `|l|/R ≈ 3e-7 rad` per
+    /// 2 m of horizontal lever arm). Position `r^e + C_n^e C_b^n l` through ECEF
+    /// ([`EarthModel::ecef_from_geodetic`] and back); earth-relative velocity
+    /// `v + C_b^n (ω_eb^b × l)`, `ω_eb^b = ω_nb^b + C_n^b ω_en^n` (Groves 2nd ed. eq. 2.150
+    /// form), and attitude `C_s^n = C_b^n C_s^b`, both rotated by `C_n^{n'} = C_e^{n'} C_n^e`.
+    /// The flat model (no transport rate) has one NED frame: the offset is converted with
+    /// the radii of curvature at the reference point. Returns
+    /// `(lat_rad, lon_rad, h_m, v_n_mps, c_s_n)`.
     pub fn imu_point(
         &self,
         earth: &EarthModel,
         s: &TruthSample,
         kin: &Kinematics,
     ) -> (f64, f64, f64, Vec3, Mat3) {
-        let d_n = s.c_b_n * self.lever_arm_b_m;
-        let r = earth.radii(s.lat_rad);
-        let lat = s.lat_rad + d_n.x / (r.r_m_m + s.h_m);
-        let lon = wrap_pi(s.lon_rad + d_n.y / ((r.r_n_m + s.h_m) * s.lat_rad.cos()));
-        let h = s.h_m - d_n.z;
+        let l = self.lever_arm_b_m;
+        let d_n = s.c_b_n * l;
         let w_en = earth.omega_en_n(s.lat_rad, s.h_m, &s.v_n_mps);
         let w_eb = kin.omega_nb_b_rps + s.c_b_n.transpose() * w_en;
-        let v = s.v_n_mps + s.c_b_n * w_eb.cross(&self.lever_arm_b_m);
-        (lat, lon, h, v, s.c_b_n * self.c_b_s.transpose())
+        let v = s.v_n_mps + s.c_b_n * w_eb.cross(&l);
+        let c_s_n = s.c_b_n * self.c_b_s.transpose();
+        if !earth.transport {
+            let r = earth.radii(s.lat_rad);
+            let lat = s.lat_rad + d_n.x / (r.r_m_m + s.h_m);
+            let lon = wrap_pi(s.lon_rad + d_n.y / ((r.r_n_m + s.h_m) * s.lat_rad.cos()));
+            return (lat, lon, s.h_m - d_n.z, v, c_s_n);
+        }
+        let c_e_n = EarthModel::c_e_n(s.lat_rad, s.lon_rad);
+        let r_e = earth.ecef_from_geodetic(s.lat_rad, s.lon_rad, s.h_m) + c_e_n.transpose() * d_n;
+        let (lat, lon, h) = earth.geodetic_from_ecef(&r_e);
+        let c_n_n2 = EarthModel::c_e_n(lat, lon) * c_e_n.transpose();
+        (lat, lon, h, c_n_n2 * v, c_n_n2 * c_s_n)
     }
 }
 
@@ -487,16 +528,39 @@ impl<'a> TruthGenerator<'a> {
         self.n_samples
     }
 
-    /// The navigation initial state at t = 0 (exact).
+    /// The navigation initial state at t = 0 (exact), at the IMU when a mount is set
+    /// ([`TruthGenerator::with_mount`], [`ImuMount::imu_point`]).
     pub fn initial_state(&self) -> InitialState {
         let k = self.traj.kinematics(0.0, 0.0);
+        let s = TruthSample::new(
+            0.0,
+            Increment::new(Vec3::zeros(), Vec3::zeros()),
+            self.cfg.lat0_rad,
+            self.cfg.lon0_rad,
+            self.cfg.h0_m,
+            k.v_n_mps,
+            k.c_b_n,
+        );
+        let s = self.at_imu(&s);
         InitialState {
-            lat_rad: self.cfg.lat0_rad,
-            lon_rad: self.cfg.lon0_rad,
-            h_m: self.cfg.h0_m,
-            v_n_mps: k.v_n_mps,
-            c_b_n: k.c_b_n,
+            lat_rad: s.lat_rad,
+            lon_rad: s.lon_rad,
+            h_m: s.h_m,
+            v_n_mps: s.v_n_mps,
+            c_b_n: s.c_b_n,
         }
+    }
+
+    /// A sample of this generator moved to the IMU ([`ImuMount::imu_point`]; unchanged
+    /// without a mount): what a navigation of the IMU data is compared with.
+    pub fn at_imu(&self, s: &TruthSample) -> TruthSample {
+        let Some(m) = &self.mount else {
+            return *s;
+        };
+        let t_sel = s.t_s - 0.25 * self.cfg.dt_s / self.cfg.substeps.max(1) as f64;
+        let kin = self.traj.kinematics(s.t_s, t_sel.max(0.0));
+        let (lat, lon, h, v, c) = m.imu_point(&self.cfg.earth, s, &kin);
+        TruthSample::new(s.t_s, s.inc, lat, lon, h, v, c)
     }
 
     fn closed_form(&self) -> ClosedForm {
@@ -541,7 +605,11 @@ impl<'a> TruthGenerator<'a> {
         let mut f_b =
             c_n_b * (kin.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - e.gravity_n(lat, h));
         if let Some(m) = &self.mount {
-            f_b += w_ib.cross(&w_ib.cross(&m.lever_arm_b_m));
+            let d_n = kin.c_b_n * m.lever_arm_b_m;
+            let le = e.local(lat, h);
+            let g2 = e.gravity(lat + d_n.x / (le.r_m_m + h), h - d_n.z);
+            let dg = gravity_difference(e, &le, h, &w_ie, &d_n, g2);
+            f_b += w_ib.cross(&w_ib.cross(&m.lever_arm_b_m)) - c_n_b * dg;
         }
         let (lat_dot, lon_dot) = if e.transport {
             (v.x / (r.r_m_m + h), v.y / ((r.r_n_m + h) * lat.cos()))
@@ -718,7 +786,11 @@ impl TruthGenerator<'_> {
             let mut f_i = c_n_b
                 * (k.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - Vec3::new(0.0, 0.0, le.g_mps2));
             if let Some(m) = &self.mount {
-                f_i += th_i.cross(&th_i.cross(&m.lever_arm_b_m));
+                let d_n = k.c_b_n * m.lever_arm_b_m;
+                let (s2, c2) = sin_cos_shift(s, c, d_n.x / (le.r_m_m + h));
+                let g2 = e.local_sc(s2, c2, h - d_n.z).g_mps2;
+                let dg = gravity_difference(&e, &le, h, &w_ie, &d_n, g2);
+                f_i += th_i.cross(&th_i.cross(&m.lever_arm_b_m)) - c_n_b * dg;
             }
             for a in 0..3 {
                 th[a][i] = th_i[a];
