@@ -610,7 +610,10 @@ impl Scenario {
         let dt = 1.0 / rate_hz;
         let vehicle = parse_vehicle(&cx, &doc)?;
         if vehicle != Vehicle::Free {
-            for (v, key) in [(&st.roll_deg, "start.roll_deg"), (&st.pitch_deg, "start.pitch_deg")] {
+            for (v, key) in [
+                (&st.roll_deg, "start.roll_deg"),
+                (&st.pitch_deg, "start.pitch_deg"),
+            ] {
                 if let Some(v) = v {
                     if *v.get_ref() != 0.0 {
                         return cx.err(v.span(), key, format!("with vehicle = \"{}\" roll and pitch follow the motion (bank, flight-path angle, road grade): leave this key out", vehicle.name()));
@@ -625,10 +628,7 @@ impl Scenario {
         for s in &doc.segment {
             let sd = s.get_ref();
             let kind = sd.kind.get_ref().as_str();
-            let profile = sd
-                .profile
-                .as_ref()
-                .map(|p| p.get_ref().as_str());
+            let profile = sd.profile.as_ref().map(|p| p.get_ref().as_str());
             let coordinated = kind == "turn" && profile == Some("coordinated");
             let dur = match (&sd.duration_s, coordinated) {
                 (Some(d), false) => cx.positive(d, "segment.duration_s")?,
@@ -727,16 +727,30 @@ impl Scenario {
                     let roll = need(&sd.roll_rate_dps, "segment.roll_rate_dps")?;
                     if !(bank > 0.0 && bank < 90.0) {
                         let span = sd.bank_deg.as_ref().map_or(s.span(), |v| v.span());
-                        return cx.err(span, "segment.bank_deg", format!("{bank} deg: expected a bank limit in (0, 90) deg"));
+                        return cx.err(
+                            span,
+                            "segment.bank_deg",
+                            format!("{bank} deg: expected a bank limit in (0, 90) deg"),
+                        );
                     }
                     if !(roll > 0.0 && roll <= 360.0) {
                         let span = sd.roll_rate_dps.as_ref().map_or(s.span(), |v| v.span());
-                        return cx.err(span, "segment.roll_rate_dps", format!("{roll} deg/s: expected a roll-rate limit in (0, 360] deg/s"));
+                        return cx.err(
+                            span,
+                            "segment.roll_rate_dps",
+                            format!("{roll} deg/s: expected a roll-rate limit in (0, 360] deg/s"),
+                        );
                     }
                     if angle == 0.0 || speed_now <= 0.0 {
                         return cx.err(s.span(), "segment.angle_deg", format!("a coordinated turn needs a non-zero angle and a moving vehicle (speed here {speed_now} m/s)"));
                     }
-                    match crate::vehicle::coordinated_turn(speed_now, angle * D2R, bank * D2R, roll * D2R, dt) {
+                    match crate::vehicle::coordinated_turn(
+                        speed_now,
+                        angle * D2R,
+                        bank * D2R,
+                        roll * D2R,
+                        dt,
+                    ) {
                         Ok(parts) => {
                             for p in parts {
                                 motions.push(p);
@@ -1081,23 +1095,41 @@ fn parse_mounting(cx: &Ctx<'_>, m: Option<&S<MountingDoc>>) -> Result<Mounting, 
 fn parse_vehicle(cx: &Ctx<'_>, doc: &FileDoc) -> Result<Vehicle, ScenarioError> {
     let alpha = match &doc.angle_of_attack_deg {
         Some(a) => Some((
-            cx.range(a, "angle_of_attack_deg", -30.0, 30.0, "an angle of attack in [-30, 30] deg")? * D2R,
+            cx.range(
+                a,
+                "angle_of_attack_deg",
+                -30.0,
+                30.0,
+                "an angle of attack in [-30, 30] deg",
+            )? * D2R,
             a.span(),
         )),
         None => None,
     };
-    let v = match doc.vehicle.as_ref().map(|v| (v.get_ref().as_str(), v.span())) {
+    let v = match doc
+        .vehicle
+        .as_ref()
+        .map(|v| (v.get_ref().as_str(), v.span()))
+    {
         None | Some(("free", _)) => Vehicle::Free,
         Some(("car", _)) => Vehicle::Car,
         Some(("aircraft", _)) => Vehicle::Aircraft {
             angle_of_attack_rad: alpha.as_ref().map_or(0.0, |a| a.0),
         },
         Some((other, span)) => {
-            return cx.err(span, "vehicle", format!("unknown vehicle `{other}`: expected free, aircraft or car"));
+            return cx.err(
+                span,
+                "vehicle",
+                format!("unknown vehicle `{other}`: expected free, aircraft or car"),
+            );
         }
     };
     if let (Some((_, span)), false) = (alpha, matches!(v, Vehicle::Aircraft { .. })) {
-        return cx.err(span, "angle_of_attack_deg", "only an aircraft has an angle of attack (set vehicle = \"aircraft\")");
+        return cx.err(
+            span,
+            "angle_of_attack_deg",
+            "only an aircraft has an angle of attack (set vehicle = \"aircraft\")",
+        );
     }
     Ok(v)
 }

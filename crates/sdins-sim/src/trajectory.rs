@@ -6,7 +6,9 @@
 //! values (flat turns, as in the papers' scenarios). Overlays add body coning, sculling
 //! and vibration on top.
 
-use crate::vehicle::{aircraft_attitude, car_attitude, velocity_derivs, Track, Vehicle, VehicleError};
+use crate::vehicle::{
+    aircraft_attitude, car_attitude, velocity_derivs, Track, Vehicle, VehicleError,
+};
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Mat3, Quat, Vec3};
 use std::f64::consts::PI;

@@ -168,7 +168,11 @@ fn gravity_difference(
 ) -> Vec3 {
     let g = le.g_mps2;
     let tilt = if e.transport {
-        Vec3::new(-g * d_n.x / (le.r_m_m + h), -g * d_n.y / (le.r_n_m + h), 0.0)
+        Vec3::new(
+            -g * d_n.x / (le.r_m_m + h),
+            -g * d_n.y / (le.r_n_m + h),
+            0.0,
+        )
     } else {
         Vec3::zeros()
     };

@@ -132,7 +132,11 @@ impl Track {
     /// `(L̇, ḣ)` as the truth generator integrates them (the flat model moves over the
     /// ellipsoid at the start latitude).
     fn rates(&self, lat: f64, h: f64, v: &Vec3) -> (f64, f64) {
-        let l = if self.earth.transport { lat } else { self.lat0_rad };
+        let l = if self.earth.transport {
+            lat
+        } else {
+            self.lat0_rad
+        };
         let r = self.earth.radii(l);
         (v.x / (r.r_m_m + h), -v.z)
     }
@@ -226,8 +230,11 @@ impl Track {
         let e_h = (self.earth_terms(lat, h + dh, &v[0]) - self.earth_terms(lat, h - dh, &v[0]))
             / (2.0 * dh);
         let omega = 2.0 * e.omega_ie_n(lat) + e.omega_en_n(lat, h, &v[0]);
-        let f_dot =
-            v[2] + e_l * ld + e_h * hd + omega.cross(&v[1]) + e.omega_en_n(lat, h, &v[1]).cross(&v[0]);
+        let f_dot = v[2]
+            + e_l * ld
+            + e_h * hd
+            + omega.cross(&v[1])
+            + e.omega_en_n(lat, h, &v[1]).cross(&v[0]);
         (f, f_dot)
     }
 }

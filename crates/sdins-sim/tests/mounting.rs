@@ -30,7 +30,10 @@ fn constant_rate_turn_has_the_centripetal_term() {
         30.0,
         0.0,
         Euler::new(0.0, 0.0, 0.3),
-        &[(Motion::Cruise, 1.0), (Motion::TurnRate { rate_rps: r }, 2.0)],
+        &[
+            (Motion::Cruise, 1.0),
+            (Motion::TurnRate { rate_rps: r }, 2.0),
+        ],
         vec![],
     );
     let l = Vec3::new(1.2, -0.7, 0.4);
@@ -116,7 +119,10 @@ fn imu_point_truth_moves_with_the_lever_arm() {
     let kin = tr.kinematics(s.t_s, s.t_s - 1e-6);
     let (_, _, h, v, c) = m.imu_point(&e, &s, &kin);
     let v_b = s.c_b_n.transpose() * v;
-    assert!((v_b - Vec3::new(30.0 - r * 2.0, 0.0, 0.0)).norm() < 1e-13, "{v_b:?}");
+    assert!(
+        (v_b - Vec3::new(30.0 - r * 2.0, 0.0, 0.0)).norm() < 1e-13,
+        "{v_b:?}"
+    );
     assert!((h - s.h_m).abs() < 1e-12);
     assert!((c - s.c_b_n).abs().max() < 1e-15);
 }

@@ -112,7 +112,11 @@ fn coordinated_flight_has_no_side_force_or_sideslip() {
         assert!((max_bank / D2R - 50.0).abs() < 0.2, "{}", max_bank / D2R);
         // the climb pitches the aircraft: γ = atan(15/200) = 4.29°, plus α
         let gamma = (15.0_f64 / 200.0).atan() / D2R;
-        assert!((max_pitch / D2R - gamma).abs() < 0.05, "{}", max_pitch / D2R);
+        assert!(
+            (max_pitch / D2R - gamma).abs() < 0.05,
+            "{}",
+            max_pitch / D2R
+        );
         // load factor 1/cos 50° = 1.556 in the level part of the turn
         assert!((max_fz / 9.80665 - 1.0 / (50.0 * D2R).cos()).abs() < 0.02);
     }
@@ -277,7 +281,10 @@ fn aircraft_rejects_steps_in_the_acceleration() {
         LAT0,
         H0,
     );
-    assert!(matches!(r, Err(VehicleError::Vertical { index: 1, .. })), "{r:?}");
+    assert!(
+        matches!(r, Err(VehicleError::Vertical { index: 1, .. })),
+        "{r:?}"
+    );
 }
 
 const FLIGHT_TOML: &str = r#"
@@ -347,17 +354,38 @@ fn scenario_vehicle_errors_are_located() {
     };
     // a linear climb steps the acceleration: the aircraft's bank would jump
     let e = err(&FLIGHT_TOML.replacen("profile = \"smooth\"\nto_climb", "to_climb", 1));
-    assert!(e.starts_with("f.toml:16: segment:") && e.contains("[[segment]] number 2"), "{e}");
+    assert!(
+        e.starts_with("f.toml:16: segment:") && e.contains("[[segment]] number 2"),
+        "{e}"
+    );
     let e = err(&FLIGHT_TOML.replace("\"aircraft\"", "\"boat\""));
-    assert!(e.starts_with("f.toml:3: vehicle:") && e.contains("unknown vehicle"), "{e}");
+    assert!(
+        e.starts_with("f.toml:3: vehicle:") && e.contains("unknown vehicle"),
+        "{e}"
+    );
     let e = err(&FLIGHT_TOML.replace("yaw_deg = 30.0", "yaw_deg = 30.0\npitch_deg = 2.0"));
-    assert!(e.contains("start.pitch_deg") && e.contains("leave this key out"), "{e}");
+    assert!(
+        e.contains("start.pitch_deg") && e.contains("leave this key out"),
+        "{e}"
+    );
     let e = err(&FLIGHT_TOML.replace("bank_deg = 45.0", "bank_deg = 95.0"));
-    assert!(e.contains("segment.bank_deg") && e.contains("(0, 90)"), "{e}");
-    let e = err(&FLIGHT_TOML.replace("roll_rate_dps = 15.0", "roll_rate_dps = 15.0\nduration_s = 4.0"));
-    assert!(e.contains("segment.duration_s") && e.contains("leave duration_s out"), "{e}");
+    assert!(
+        e.contains("segment.bank_deg") && e.contains("(0, 90)"),
+        "{e}"
+    );
+    let e = err(&FLIGHT_TOML.replace(
+        "roll_rate_dps = 15.0",
+        "roll_rate_dps = 15.0\nduration_s = 4.0",
+    ));
+    assert!(
+        e.contains("segment.duration_s") && e.contains("leave duration_s out"),
+        "{e}"
+    );
     let e = err(&FLIGHT_TOML.replace("vehicle = \"aircraft\"", "vehicle = \"car\""));
-    assert!(e.contains("angle_of_attack_deg") && e.contains("only an aircraft"), "{e}");
+    assert!(
+        e.contains("angle_of_attack_deg") && e.contains("only an aircraft"),
+        "{e}"
+    );
 }
 
 fn nav_max(scn: &sdins_sim::scenario::Scenario) -> sdins_sim::pipeline::NavError {
@@ -390,7 +418,10 @@ fn navigation_of_mounted_imu_on_an_aircraft_tracks_the_imu_point() {
         let e = nav_max(scn);
         let pos = e.pos_err_ned_m.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
         let att = e.att_err_rad.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-        eprintln!("{name}: max |pos err| {pos:e} m, max |att err| {att:e} rad, vel {:?}", e.vel_err_ned_mps);
+        eprintln!(
+            "{name}: max |pos err| {pos:e} m, max |att err| {att:e} rad, vel {:?}",
+            e.vel_err_ned_mps
+        );
         assert!(pos <= 1e-3, "{name}: {pos:e}");
         assert!(att <= 2e-10, "{name}: {att:e}");
     }
