@@ -397,7 +397,7 @@ fn nav_max(scn: &sdins_sim::scenario::Scenario) -> sdins_sim::pipeline::NavError
         until_s: None,
         sensor_run: None,
     };
-    let r = sdins_sim::pipeline::run(scn, &opts, |_, _, _, _| {}, |_, _| {});
+    let r = sdins_sim::pipeline::run(scn, &opts, |_, _, _, _| {}, |_, _| {}).unwrap();
     r[0].max_abs
 }
 
