@@ -19,3 +19,4 @@ pub mod scenario;
 pub mod trajectory;
 pub mod truth;
 pub mod truth_file;
+pub mod vehicle;

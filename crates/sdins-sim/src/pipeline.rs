@@ -272,6 +272,10 @@ pub fn run_cancellable(
         substeps: scn.nav.substeps,
     };
     let mut truth = TruthGenerator::new(&scn.trajectory, cfg);
+    if let Some(m) = scn.mounting.imu {
+        // IMU data at the lever arm and mounting; navigation compared at the IMU
+        truth = truth.with_mount(m);
+    }
     let init = truth.initial_state();
     let mut mechs: Vec<AnyMechanization> = opts
         .algos
@@ -313,7 +317,7 @@ pub fn run_cancellable(
                 }
             }
             if let Some(e) = end {
-                ends.push(e);
+                ends.push(truth.at_imu(&e));
             }
         }
         let count = ends.len();

@@ -6,6 +6,7 @@
 //! exactly the keys accepted here: [`ACCEPTED_KEYS`]).
 
 use crate::trajectory::{Axis, Motion, Overlay, OverlayKind, Trajectory};
+use crate::vehicle::{Vehicle, VehicleError};
 use sdins_core::earth::EarthModel;
 use sdins_core::math::Euler;
 use serde::Deserialize;
@@ -63,7 +64,14 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "nav",
             "segment",
             "overlay",
+            "vehicle",
+            "angle_of_attack_deg",
+            "mounting",
         ],
+    ),
+    (
+        "mounting",
+        &["imu_lever_arm_m", "imu_mount_deg", "gnss_lever_arm_m"],
     ),
     (
         "start",
@@ -96,6 +104,8 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "profile",
             "amplitude_dps",
             "to_climb_rate_mps",
+            "bank_deg",
+            "roll_rate_dps",
         ],
     ),
     (
@@ -127,6 +137,28 @@ struct FileDoc {
     segment: Vec<S<SegmentDoc>>,
     #[serde(default)]
     overlay: Vec<S<OverlayDoc>>,
+    vehicle: Option<S<String>>,
+    angle_of_attack_deg: Option<S<f64>>,
+    mounting: Option<S<MountingDoc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MountingDoc {
+    imu_lever_arm_m: Option<S<Vec<f64>>>,
+    imu_mount_deg: Option<S<Vec<f64>>>,
+    gnss_lever_arm_m: Option<S<Vec<f64>>>,
+}
+
+/// Sensor placement on the vehicle (`[mounting]`): lever arms from the vehicle reference
+/// point in the vehicle frame, the IMU's mounting rotation. The truth is reported at the
+/// reference point.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Mounting {
+    /// the IMU's lever arm and mounting (none: the IMU at the reference point, aligned)
+    pub imu: Option<crate::truth::ImuMount>,
+    /// the GNSS antenna's lever arm, vehicle frame [m] (for the INS/GNSS simulation)
+    pub gnss_lever_arm_b_m: Option<sdins_core::math::Vec3>,
 }
 
 #[derive(Deserialize)]
@@ -167,13 +199,15 @@ struct NavDoc {
 struct SegmentDoc {
     #[serde(rename = "type")]
     kind: S<String>,
-    duration_s: S<f64>,
+    duration_s: Option<S<f64>>,
     accel_mps2: Option<S<f64>>,
     rate_dps: Option<S<f64>>,
     angle_deg: Option<S<f64>>,
     profile: Option<S<String>>,
     amplitude_dps: Option<S<f64>>,
     to_climb_rate_mps: Option<S<f64>>,
+    bank_deg: Option<S<f64>>,
+    roll_rate_dps: Option<S<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -296,6 +330,8 @@ pub struct Scenario {
     /// the scenario text exactly as it was read (provenance: `run.toml` records this, not
     /// the file as it may be later)
     pub source_toml: String,
+    /// sensor placement (`[mounting]`)
+    pub mounting: Mounting,
 }
 
 struct Ctx<'a> {
@@ -575,42 +611,73 @@ impl Scenario {
         let nav = parse_nav(&cx, doc.nav.as_ref())?;
 
         let dt = 1.0 / rate_hz;
+        let vehicle = parse_vehicle(&cx, &doc)?;
+        if vehicle != Vehicle::Free {
+            for (v, key) in [
+                (&st.roll_deg, "start.roll_deg"),
+                (&st.pitch_deg, "start.pitch_deg"),
+            ] {
+                if let Some(v) = v {
+                    if *v.get_ref() != 0.0 {
+                        return cx.err(v.span(), key, format!("with vehicle = \"{}\" roll and pitch follow the motion (bank, flight-path angle, road grade): leave this key out", vehicle.name()));
+                    }
+                }
+            }
+        }
         let mut motions = Vec::new();
+        // the [[segment]] of each motion (a coordinated turn is three motions)
+        let mut seg_of_motion: Vec<std::ops::Range<usize>> = Vec::new();
         let mut speed_now = speed;
         for s in &doc.segment {
             let sd = s.get_ref();
             let kind = sd.kind.get_ref().as_str();
-            let dur = cx.positive(&sd.duration_s, "segment.duration_s")?;
+            let profile = sd.profile.as_ref().map(|p| p.get_ref().as_str());
+            let coordinated = kind == "turn" && profile == Some("coordinated");
+            let dur = match (&sd.duration_s, coordinated) {
+                (Some(d), false) => cx.positive(d, "segment.duration_s")?,
+                (Some(d), true) => {
+                    return cx.err(d.span(), "segment.duration_s", "a coordinated turn takes its duration from angle_deg, bank_deg and roll_rate_dps: leave duration_s out");
+                }
+                (None, true) => 1.0,
+                (None, false) => {
+                    return cx.err(s.span(), "segment.duration_s", "missing required key");
+                }
+            };
             if dur > MAX_SEGMENT_S {
+                let span = sd.duration_s.as_ref().map_or(s.span(), |d| d.span());
                 return cx.err(
-                    sd.duration_s.span(),
+                    span,
                     "segment.duration_s",
                     format!("{dur} s is too long: expected at most {MAX_SEGMENT_S:e} s (116 days)"),
                 );
             }
             let n = dur / dt;
-            if n.round() < 1.0 {
+            let dspan = sd.duration_s.as_ref().map_or(s.span(), |d| d.span());
+            if !coordinated && n.round() < 1.0 {
                 return cx.err(
-                    sd.duration_s.span(),
+                    dspan,
                     "segment.duration_s",
                     format!("{dur} s is shorter than one IMU sample ({dt} s at {rate_hz} Hz)"),
                 );
             }
-            if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
-                return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));
+            if !coordinated && (n - n.round()).abs() > 1e-6 * n.max(1.0) {
+                return cx.err(dspan, "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));
             }
             // keys allowed per type
             let allowed: &[&str] = match kind {
                 "static" | "cruise" => &[],
-                "accelerate" => &["accel_mps2"],
+                "accelerate" => &["accel_mps2", "profile"],
+                "turn" if coordinated => &["angle_deg", "profile", "bank_deg", "roll_rate_dps"],
                 "turn" => &["rate_dps", "angle_deg", "profile"],
                 "sturn" => &["amplitude_dps"],
-                "climb" => &["to_climb_rate_mps"],
+                "climb" => &["to_climb_rate_mps", "profile"],
                 other => {
                     return cx.err(sd.kind.span(), "segment.type", format!("unknown segment type `{other}`: expected one of static, cruise, accelerate, turn, sturn, climb"));
                 }
             };
-            let present: [(&str, Option<std::ops::Range<usize>>); 6] = [
+            let present: [(&str, Option<std::ops::Range<usize>>); 8] = [
+                ("bank_deg", sd.bank_deg.as_ref().map(|v| v.span())),
+                ("roll_rate_dps", sd.roll_rate_dps.as_ref().map(|v| v.span())),
                 ("accel_mps2", sd.accel_mps2.as_ref().map(|v| v.span())),
                 ("rate_dps", sd.rate_dps.as_ref().map(|v| v.span())),
                 ("angle_deg", sd.angle_deg.as_ref().map(|v| v.span())),
@@ -657,6 +724,46 @@ impl Scenario {
                     Motion::Static
                 }
                 "cruise" => Motion::Cruise,
+                "turn" if coordinated => {
+                    let angle = need(&sd.angle_deg, "segment.angle_deg")?;
+                    let bank = need(&sd.bank_deg, "segment.bank_deg")?;
+                    let roll = need(&sd.roll_rate_dps, "segment.roll_rate_dps")?;
+                    if !(bank > 0.0 && bank < 90.0) {
+                        let span = sd.bank_deg.as_ref().map_or(s.span(), |v| v.span());
+                        return cx.err(
+                            span,
+                            "segment.bank_deg",
+                            format!("{bank} deg: expected a bank limit in (0, 90) deg"),
+                        );
+                    }
+                    if !(roll > 0.0 && roll <= 360.0) {
+                        let span = sd.roll_rate_dps.as_ref().map_or(s.span(), |v| v.span());
+                        return cx.err(
+                            span,
+                            "segment.roll_rate_dps",
+                            format!("{roll} deg/s: expected a roll-rate limit in (0, 360] deg/s"),
+                        );
+                    }
+                    if angle == 0.0 || speed_now <= 0.0 {
+                        return cx.err(s.span(), "segment.angle_deg", format!("a coordinated turn needs a non-zero angle and a moving vehicle (speed here {speed_now} m/s)"));
+                    }
+                    match crate::vehicle::coordinated_turn(
+                        speed_now,
+                        angle * D2R,
+                        bank * D2R,
+                        roll * D2R,
+                        dt,
+                    ) {
+                        Ok(parts) => {
+                            for p in parts {
+                                motions.push(p);
+                                seg_of_motion.push(s.span());
+                            }
+                        }
+                        Err(e) => return cx.err(s.span(), "segment.type", e.to_string()),
+                    }
+                    continue;
+                }
                 "accelerate" => {
                     let a = need(&sd.accel_mps2, "segment.accel_mps2")?;
                     if a.abs() > 1000.0 * 9.80665 {
@@ -670,7 +777,16 @@ impl Scenario {
                     if speed_now < 0.0 {
                         return cx.err(s.span(), "segment.accel_mps2", format!("the speed would become negative ({speed_now} m/s) by the end of this segment"));
                     }
-                    Motion::Accelerate { accel_mps2: a }
+                    match profile {
+                        None | Some("linear") => Motion::Accelerate { accel_mps2: a },
+                        Some("smooth") => Motion::AccelerateSmooth {
+                            delta_speed_mps: a * dur,
+                        },
+                        Some(other) => {
+                            let span = sd.profile.as_ref().map_or(s.span(), |p| p.span());
+                            return cx.err(span, "segment.profile", format!("unknown profile `{other}` for accelerate: expected linear or smooth"));
+                        }
+                    }
                 }
                 "turn" => {
                     let profile = sd
@@ -717,11 +833,24 @@ impl Scenario {
                 "sturn" => Motion::STurn {
                     amplitude_rps: need(&sd.amplitude_dps, "segment.amplitude_dps")? * D2R,
                 },
-                _ => Motion::Climb {
-                    to_climb_rate_mps: need(&sd.to_climb_rate_mps, "segment.to_climb_rate_mps")?,
-                },
+                _ => {
+                    let to = need(&sd.to_climb_rate_mps, "segment.to_climb_rate_mps")?;
+                    match profile {
+                        None | Some("linear") => Motion::Climb {
+                            to_climb_rate_mps: to,
+                        },
+                        Some("smooth") => Motion::ClimbSmooth {
+                            to_climb_rate_mps: to,
+                        },
+                        Some(other) => {
+                            let span = sd.profile.as_ref().map_or(s.span(), |p| p.span());
+                            return cx.err(span, "segment.profile", format!("unknown profile `{other}` for climb: expected linear or smooth"));
+                        }
+                    }
+                }
             };
             motions.push((motion, (n.round()) * dt));
+            seg_of_motion.push(s.span());
         }
         if motions.is_empty() {
             return Err(ScenarioError::Invalid {
@@ -832,6 +961,31 @@ impl Scenario {
         }
 
         let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
+        let trajectory = match trajectory.with_vehicle(vehicle, nav.earth.model(), lat * D2R, h) {
+            Ok(t) => t,
+            Err(e) => {
+                let i = match &e {
+                    VehicleError::Joint { index, .. } | VehicleError::Vertical { index, .. } => {
+                        *index
+                    }
+                };
+                let span = seg_of_motion
+                    .get(i.saturating_sub(1))
+                    .cloned()
+                    .unwrap_or(0..0);
+                let which = doc
+                    .segment
+                    .iter()
+                    .position(|d| d.span() == span)
+                    .map_or(i, |p| p + 1);
+                let msg = e.to_string().replacen(
+                    &format!("segment {i} (1-based)"),
+                    &format!("[[segment]] number {which}"),
+                    1,
+                );
+                return cx.err(span, "segment", msg);
+            }
+        };
         if let Err(e) = crate::envelope::check_trajectory(
             &trajectory,
             crate::envelope::StartPosition {
@@ -841,12 +995,15 @@ impl Scenario {
             dt,
             &crate::envelope::Envelope::DEFAULT,
         ) {
-            let span = match e.segment().and_then(|k| doc.segment.get(k)) {
-                Some(seg) => seg.span(),
+            // the trajectory's segment k comes from a [[segment]] (a coordinated turn
+            // gives three)
+            let span = match e.segment().and_then(|k| seg_of_motion.get(k)) {
+                Some(span) => span.clone(),
                 None => doc.start.span(),
             };
             return cx.err(span, "segment", e.to_string());
         }
+        let mounting = parse_mounting(&cx, doc.mounting.as_ref())?;
         let mut nav = nav;
         if nav.substeps == 0 {
             nav.substeps = crate::truth::auto_substeps(dt, &trajectory);
@@ -863,6 +1020,7 @@ impl Scenario {
             nav,
             trajectory,
             source_toml: text.to_string(),
+            mounting,
         })
     }
 
@@ -899,6 +1057,85 @@ impl Scenario {
     pub fn duration_s(&self) -> f64 {
         self.trajectory.duration_s
     }
+}
+
+fn parse_mounting(cx: &Ctx<'_>, m: Option<&S<MountingDoc>>) -> Result<Mounting, ScenarioError> {
+    let Some(m) = m else {
+        return Ok(Mounting::default());
+    };
+    let vec3 = |v: &Option<S<Vec<f64>>>, key: &str, lim: f64, unit: &str| {
+        let Some(v) = v else {
+            return Ok(None);
+        };
+        let x = v.get_ref();
+        if x.len() != 3 || x.iter().any(|c| !c.is_finite() || c.abs() > lim) {
+            return cx.err(
+                v.span(),
+                key,
+                format!("expected three finite numbers [x, y, z] within ±{lim} {unit}, got {x:?}"),
+            );
+        }
+        Ok(Some(sdins_core::math::Vec3::new(x[0], x[1], x[2])))
+    };
+    let m = m.get_ref();
+    let arm = vec3(&m.imu_lever_arm_m, "mounting.imu_lever_arm_m", 100.0, "m")?;
+    let ang = vec3(&m.imu_mount_deg, "mounting.imu_mount_deg", 180.0, "deg")?;
+    let gnss = vec3(&m.gnss_lever_arm_m, "mounting.gnss_lever_arm_m", 100.0, "m")?;
+    let imu = if arm.is_some() || ang.is_some() {
+        let a = ang.unwrap_or_default() * D2R;
+        Some(crate::truth::ImuMount::new(
+            arm.unwrap_or_default(),
+            Euler::new(a.x, a.y, a.z),
+        ))
+    } else {
+        None
+    };
+    Ok(Mounting {
+        imu,
+        gnss_lever_arm_b_m: gnss,
+    })
+}
+
+fn parse_vehicle(cx: &Ctx<'_>, doc: &FileDoc) -> Result<Vehicle, ScenarioError> {
+    let alpha = match &doc.angle_of_attack_deg {
+        Some(a) => Some((
+            cx.range(
+                a,
+                "angle_of_attack_deg",
+                -30.0,
+                30.0,
+                "an angle of attack in [-30, 30] deg",
+            )? * D2R,
+            a.span(),
+        )),
+        None => None,
+    };
+    let v = match doc
+        .vehicle
+        .as_ref()
+        .map(|v| (v.get_ref().as_str(), v.span()))
+    {
+        None | Some(("free", _)) => Vehicle::Free,
+        Some(("car", _)) => Vehicle::Car,
+        Some(("aircraft", _)) => Vehicle::Aircraft {
+            angle_of_attack_rad: alpha.as_ref().map_or(0.0, |a| a.0),
+        },
+        Some((other, span)) => {
+            return cx.err(
+                span,
+                "vehicle",
+                format!("unknown vehicle `{other}`: expected free, aircraft or car"),
+            );
+        }
+    };
+    if let (Some((_, span)), false) = (alpha, matches!(v, Vehicle::Aircraft { .. })) {
+        return cx.err(
+            span,
+            "angle_of_attack_deg",
+            "only an aircraft has an angle of attack (set vehicle = \"aircraft\")",
+        );
+    }
+    Ok(v)
 }
 
 fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioError> {

@@ -6,6 +6,10 @@
 //! values (flat turns, as in the papers' scenarios). Overlays add body coning, sculling
 //! and vibration on top.
 
+use crate::vehicle::{
+    aircraft_attitude, car_attitude, velocity_derivs, Track, Vehicle, VehicleError,
+};
+use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Mat3, Quat, Vec3};
 use std::f64::consts::PI;
 
@@ -43,6 +47,39 @@ pub enum Motion {
         /// climb rate at the end of the segment [m/s], positive up
         to_climb_rate_mps: f64,
     },
+    /// smooth speed change by `delta_speed_mps`: `s = s0 + Δ·S(x)` with the smooth step
+    /// `S(x) = x − sin(2πx)/(2π)`, `x = τ/T`: `ṡ = (Δ/T)(1 − cos 2πx)` and `s̈` vanish at
+    /// both ends (peak acceleration 2Δ/T at mid-segment)
+    AccelerateSmooth {
+        /// speed change Δ [m/s]
+        delta_speed_mps: f64,
+    },
+    /// smooth change of the climb rate to `to_climb_rate_mps`: `v_D = v_D0 + Δ·S(x)`,
+    /// `Δ = −to_climb_rate − v_D0`, with the smooth step `S` of
+    /// [`Motion::AccelerateSmooth`]
+    ClimbSmooth {
+        /// climb rate at the end of the segment [m/s], positive up
+        to_climb_rate_mps: f64,
+    },
+    /// turn-rate ramp from `from_rps` to `to_rps`: `ψ̇ = r0 + (r1 − r0)·S(x)`,
+    /// `ψ = ψ0 + r0 τ + (r1 − r0) T (x²/2 + (cos 2πx − 1)/(4π²))`; ψ̈ and ψ⃛ vanish at both
+    /// ends (the entry and exit of a coordinated turn)
+    TurnRamp {
+        /// yaw rate at the start [rad/s]
+        from_rps: f64,
+        /// yaw rate at the end [rad/s]
+        to_rps: f64,
+    },
+}
+
+/// The smooth step `S(x) = x − sin(2πx)/(2π)` and its first two derivatives in `x`,
+/// with `S(1) = 1` exactly.
+fn smooth_step(x: f64) -> (f64, f64, f64) {
+    if x >= 1.0 {
+        return (1.0, 0.0, 0.0);
+    }
+    let (s, c) = (2.0 * PI * x).sin_cos();
+    (x - s / (2.0 * PI), 1.0 - c, 2.0 * PI * s)
 }
 
 /// Speed after accelerating at `accel_mps2` for `duration_s` from `speed0_mps`, with a
@@ -193,6 +230,12 @@ pub struct Trajectory {
     /// per-trajectory constants of [`Trajectory::kinematics_split`]: sin/cos of roll and
     /// pitch, and per overlay sin/cos of the coning half-angle α/2 and of α
     consts: KinConsts,
+    /// the vehicle whose attitude follows the motion ([`crate::vehicle`])
+    vehicle: Vehicle,
+    /// aircraft: the position track of the earth terms
+    track: Option<Box<Track>>,
+    /// aircraft: sin/cos of the angle of attack
+    sc_alpha: (f64, f64),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -225,8 +268,13 @@ impl KinConsts {
                 Motion::Static
                 | Motion::Cruise
                 | Motion::Accelerate { .. }
-                | Motion::Climb { .. } => Some(s.heading0.sin_cos()),
-                Motion::TurnRate { .. } | Motion::TurnSmooth { .. } | Motion::STurn { .. } => None,
+                | Motion::Climb { .. }
+                | Motion::AccelerateSmooth { .. }
+                | Motion::ClimbSmooth { .. } => Some(s.heading0.sin_cos()),
+                Motion::TurnRate { .. }
+                | Motion::TurnSmooth { .. }
+                | Motion::STurn { .. }
+                | Motion::TurnRamp { .. } => None,
             })
             .collect();
         Self {
@@ -242,26 +290,30 @@ impl KinConsts {
     }
 }
 
-struct Nominal {
-    speed: f64,
-    speed_dot: f64,
-    heading: f64,
-    heading_dot: f64,
-    v_d: f64,
-    v_d_dot: f64,
+/// The nominal motion of a segment at one instant: horizontal speed, heading and down
+/// velocity with their first two time derivatives.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Nominal {
+    pub(crate) speed: f64,
+    pub(crate) speed_dot: f64,
+    pub(crate) speed_ddot: f64,
+    pub(crate) heading: f64,
+    pub(crate) heading_dot: f64,
+    pub(crate) heading_ddot: f64,
+    pub(crate) v_d: f64,
+    pub(crate) v_d_dot: f64,
+    pub(crate) v_d_ddot: f64,
 }
 
 impl Segment {
-    fn eval(&self, t: f64) -> Nominal {
+    pub(crate) fn eval(&self, t: f64) -> Nominal {
         let tau = t - self.t0_s;
         let big_t = self.duration_s;
         let mut n = Nominal {
             speed: self.speed0,
-            speed_dot: 0.0,
             heading: self.heading0,
-            heading_dot: 0.0,
             v_d: self.v_d0,
-            v_d_dot: 0.0,
+            ..Nominal::default()
         };
         match self.motion {
             Motion::Static | Motion::Cruise => {}
@@ -279,19 +331,48 @@ impl Segment {
             }
             Motion::TurnSmooth { angle_rad } => {
                 let x = tau / big_t;
-                n.heading = self.heading0 + angle_rad * (x - (2.0 * PI * x).sin() / (2.0 * PI));
-                n.heading_dot = angle_rad / big_t * (1.0 - (2.0 * PI * x).cos());
+                let (s2, c2) = (2.0 * PI * x).sin_cos();
+                n.heading = self.heading0 + angle_rad * (x - s2 / (2.0 * PI));
+                n.heading_dot = angle_rad / big_t * (1.0 - c2);
+                n.heading_ddot = angle_rad / (big_t * big_t) * 2.0 * PI * s2;
             }
             Motion::STurn { amplitude_rps } => {
                 let w = 2.0 * PI / big_t;
                 let (s, c) = (w * tau).sin_cos();
                 n.heading = self.heading0 + amplitude_rps / w * (1.0 - c);
                 n.heading_dot = amplitude_rps * s;
+                n.heading_ddot = amplitude_rps * w * c;
             }
             Motion::Climb { to_climb_rate_mps } => {
                 let rate = (-to_climb_rate_mps - self.v_d0) / big_t;
                 n.v_d = self.v_d0 + rate * tau;
                 n.v_d_dot = rate;
+            }
+            Motion::AccelerateSmooth { delta_speed_mps } => {
+                let (st, st1, st2) = smooth_step(tau / big_t);
+                n.speed = self.speed0 + delta_speed_mps * st;
+                n.speed_dot = delta_speed_mps / big_t * st1;
+                n.speed_ddot = delta_speed_mps / (big_t * big_t) * st2;
+            }
+            Motion::ClimbSmooth { to_climb_rate_mps } => {
+                let d = -to_climb_rate_mps - self.v_d0;
+                let (st, st1, st2) = smooth_step(tau / big_t);
+                n.v_d = self.v_d0 + d * st;
+                n.v_d_dot = d / big_t * st1;
+                n.v_d_ddot = d / (big_t * big_t) * st2;
+            }
+            Motion::TurnRamp { from_rps, to_rps } => {
+                let x = tau / big_t;
+                let d = to_rps - from_rps;
+                let (st, st1, _) = smooth_step(x);
+                let int = if x >= 1.0 {
+                    0.5
+                } else {
+                    0.5 * x * x + ((2.0 * PI * x).cos() - 1.0) / (4.0 * PI * PI)
+                };
+                n.heading = self.heading0 + from_rps * tau + d * big_t * int;
+                n.heading_dot = from_rps + d * st;
+                n.heading_ddot = d / big_t * st1;
             }
         }
         n
@@ -303,6 +384,9 @@ impl Segment {
         let heading = match self.motion {
             Motion::TurnSmooth { angle_rad } => self.heading0 + angle_rad,
             Motion::STurn { .. } => self.heading0,
+            Motion::TurnRamp { from_rps, to_rps } => {
+                self.heading0 + self.duration_s * (from_rps + 0.5 * (to_rps - from_rps))
+            }
             _ => n.heading,
         };
         (n.speed, heading, n.v_d)
@@ -346,7 +430,77 @@ impl Trajectory {
             segments,
             overlays,
             duration_s: t,
+            vehicle: Vehicle::Free,
+            track: None,
+            sc_alpha: (0.0, 1.0),
         }
+    }
+
+    /// The same motion flown or driven by `vehicle` ([`crate::vehicle`]): the attitude
+    /// follows the nominal velocity (roll and pitch of the start Euler angles are not
+    /// used). An aircraft needs the earth model and start position of the truth (its bank
+    /// includes gravity, Coriolis and transport rate along its position track) and
+    /// segment joints that continue `v̇` and `v̈` (else [`VehicleError::Joint`]); a car or
+    /// aircraft at zero speed cannot move vertically ([`VehicleError::Vertical`]).
+    pub fn with_vehicle(
+        mut self,
+        vehicle: Vehicle,
+        earth: EarthModel,
+        lat0_rad: f64,
+        h0_m: f64,
+    ) -> Result<Self, VehicleError> {
+        self.vehicle = vehicle;
+        self.track = None;
+        if vehicle == Vehicle::Free {
+            return Ok(self);
+        }
+        for (i, s) in self.segments.iter().enumerate() {
+            for t in [s.t0_s, s.t0_s + s.duration_s] {
+                let n = s.eval(t);
+                if n.speed == 0.0 && n.v_d != 0.0 {
+                    return Err(VehicleError::Vertical {
+                        index: i + 1,
+                        vehicle: vehicle.name(),
+                        v_d_mps: n.v_d,
+                    });
+                }
+            }
+        }
+        if let Vehicle::Aircraft {
+            angle_of_attack_rad,
+        } = vehicle
+        {
+            for i in 1..self.segments.len() {
+                let (a, b) = (&self.segments[i - 1], &self.segments[i]);
+                let t = b.t0_s;
+                let (na, nb) = (a.eval(t), b.eval(t));
+                let va = velocity_derivs(&na, na.heading.sin_cos());
+                let vb = velocity_derivs(&nb, nb.heading.sin_cos());
+                for (k, quantity) in [(1, "acceleration [m/s²]"), (2, "jerk [m/s³]")] {
+                    let jump = (va[k] - vb[k]).norm();
+                    if jump > 1e-9 * (1.0 + va[k].norm()) {
+                        return Err(VehicleError::Joint {
+                            index: i + 1,
+                            quantity,
+                            jump,
+                        });
+                    }
+                }
+            }
+            self.track = Some(Box::new(Track::build(
+                &self.segments,
+                earth,
+                lat0_rad,
+                h0_m,
+            )));
+            self.sc_alpha = libm::sincos(angle_of_attack_rad);
+        }
+        Ok(self)
+    }
+
+    /// The vehicle ([`Trajectory::with_vehicle`]).
+    pub fn vehicle(&self) -> Vehicle {
+        self.vehicle
     }
 
     /// The segments.
@@ -358,7 +512,11 @@ impl Trajectory {
     /// S-turns) [rad/s]; zero if none.
     pub fn max_frequency_rps(&self) -> f64 {
         let seg = self.segments.iter().map(|s| match s.motion {
-            Motion::TurnSmooth { .. } | Motion::STurn { .. } => 2.0 * PI / s.duration_s,
+            Motion::TurnSmooth { .. }
+            | Motion::STurn { .. }
+            | Motion::AccelerateSmooth { .. }
+            | Motion::ClimbSmooth { .. }
+            | Motion::TurnRamp { .. } => 2.0 * PI / s.duration_s,
             _ => 0.0,
         });
         let ov = self.overlays.iter().map(|o| match o.kind {
@@ -377,7 +535,8 @@ impl Trajectory {
     /// Whether the kinematics are constant with v_N = v_D = 0 (no overlays, only static or
     /// cruise segments): then the truth has the closed form of spec §7.0 (A0, A1).
     pub fn is_constant_parallel(&self) -> bool {
-        self.overlays.is_empty()
+        self.track.is_none()
+            && self.overlays.is_empty()
             && self
                 .segments
                 .iter()
@@ -468,14 +627,7 @@ impl Trajectory {
         let seg = self.segment_at(t_sel);
         let n = match seg {
             Some(i) => self.segments[i].eval(t),
-            None => Nominal {
-                speed: 0.0,
-                speed_dot: 0.0,
-                heading: 0.0,
-                heading_dot: 0.0,
-                v_d: 0.0,
-                v_d_dot: 0.0,
-            },
+            None => Nominal::default(),
         };
         // constant-heading segments: n.heading is their start heading, whose sin/cos is cached
         let (sh, ch) = match seg.and_then(|i| self.consts.heading[i]) {
@@ -488,16 +640,26 @@ impl Trajectory {
             n.speed_dot * sh + n.speed * n.heading_dot * ch,
             n.v_d_dot,
         );
-        // c_b_n_from_euler(roll0, pitch0, heading) with the constant sin/cos of roll and
-        // pitch and the heading's sin/cos from above
-        let [sr, cr, sp, cp] = self.consts.roll_pitch;
-        let c_nom = sdins_core::math::c_b_n_from_sin_cos((sr, cr), (sp, cp), (sh, ch));
-        // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (spec §1.2)
-        let w_nom = Vec3::new(
-            -n.heading_dot * sp,
-            n.heading_dot * cp * sr,
-            n.heading_dot * cp * cr,
-        );
+        let (c_nom, w_nom) = match (self.vehicle, &self.track, seg) {
+            (Vehicle::Car, _, _) => car_attitude(&n, (sh, ch)),
+            (Vehicle::Aircraft { .. }, Some(tr), Some(i)) => {
+                let p = tr.eval(i, &self.segments[i], t);
+                aircraft_attitude(tr, &p, &n, (sh, ch), self.sc_alpha)
+            }
+            _ => {
+                // c_b_n_from_euler(roll0, pitch0, heading) with the constant sin/cos of
+                // roll and pitch and the heading's sin/cos from above
+                let [sr, cr, sp, cp] = self.consts.roll_pitch;
+                let c_nom = sdins_core::math::c_b_n_from_sin_cos((sr, cr), (sp, cp), (sh, ch));
+                // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (spec §1.2)
+                let w_nom = Vec3::new(
+                    -n.heading_dot * sp,
+                    n.heading_dot * cp * sr,
+                    n.heading_dot * cp * cr,
+                );
+                (c_nom, w_nom)
+            }
+        };
 
         // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (spec §7.0)
         let mut c_c = Mat3::identity();

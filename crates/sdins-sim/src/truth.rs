@@ -149,6 +149,36 @@ struct ClosedForm {
     sin_cos_lat: (f64, f64),
 }
 
+/// The difference of the gravitational attraction between the IMU at `d_n = C_b^n l` and
+/// the reference point, in the reference point's NED axes, under the navigation's own
+/// earth model: `γ = g + ω_ie×(ω_ie×r)` (plumb-bob gravity `g` minus the centrifugal term),
+/// so `Δγ = C_{n'}^n g^{n'} − g^n + ω_ie×(ω_ie×d_n)`. The local vertical at the IMU is tilted
+/// by `(δE/(R_N+h), −δN/(R_M+h))`, which puts `−g·(δN/(R_M+h), δE/(R_N+h))` on the
+/// horizontal axes (flat model: one vertical, no tilt); `g2 − g` is the model's gravity
+/// change to the IMU's latitude and height. Neglected: second order in `|l|/R`
+/// (≈ 1e-13 g per m² of lever arm). The IMU senses `f^b = … − C_n^b Δγ`
+/// ([`ImuMount`]).
+fn gravity_difference(
+    e: &EarthModel,
+    le: &sdins_core::earth::LocalEarth,
+    h: f64,
+    w_ie: &Vec3,
+    d_n: &Vec3,
+    g2: f64,
+) -> Vec3 {
+    let g = le.g_mps2;
+    let tilt = if e.transport {
+        Vec3::new(
+            -g * d_n.x / (le.r_m_m + h),
+            -g * d_n.y / (le.r_n_m + h),
+            0.0,
+        )
+    } else {
+        Vec3::zeros()
+    };
+    tilt + Vec3::new(0.0, 0.0, g2 - g) + w_ie.cross(&w_ie.cross(d_n))
+}
+
 /// Streaming truth generator (constant memory): an iterator of [`TruthSample`].
 #[derive(Clone, Debug)]
 pub struct TruthGenerator<'a> {
@@ -181,6 +211,78 @@ pub struct TruthGenerator<'a> {
     /// `(L, sin L, cos L)` of the last latitude whose sin/cos was taken (the sample-end
     /// latitude is the next panel's start latitude)
     lat_sc: (f64, f64, f64),
+    /// IMU lever arm and mounting ([`TruthGenerator::with_mount`])
+    mount: Option<ImuMount>,
+    /// `ω_ib^b` at the current sample start (the previous sample's end value)
+    w_ib_prev: Option<Vec3>,
+}
+
+/// Where the IMU sits on the vehicle: a lever arm from the vehicle reference point and a
+/// mounting rotation, both in the vehicle (body) frame.
+///
+/// The IMU senses `ω_is^s = C_b^s ω_ib^b` and `f^s = C_b^s (f_ref^b + ω̇_ib^b × l +
+/// ω_ib^b × (ω_ib^b × l) − C_n^b Δγ)` (rigid body in inertial space, Groves 2nd ed.
+/// §2.5; `Δγ` the model's gravitational attraction at the IMU minus that at the reference
+/// point, ≈ 3e-6 s⁻² per m of lever arm, without which a navigation of the IMU point
+/// drifts by ~1e-4 m/s per minute), so over a sample `Δθ^s = C_b^s Δθ^b` and
+/// `Δv^s = C_b^s (Δv_ref^b + [ω_ib^b(t₁) − ω_ib^b(t₀)] × l + ∫ (ω_ib^b × (ω_ib^b × l) −
+/// C_n^b Δγ) dt)`:
+/// the angular-acceleration term integrates in closed form (a step in ω inside or at the
+/// start of a sample, e.g. the start of a constant-rate turn, is the impulse it is), the
+/// centripetal term by the same quadrature as `f`. The truth samples stay at the reference
+/// point; [`ImuMount::imu_point`] gives the IMU's own position, velocity and attitude.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuMount {
+    /// lever arm from the vehicle reference point to the IMU, vehicle frame [m]
+    pub lever_arm_b_m: Vec3,
+    /// rotation from the vehicle frame to the IMU (sensor) frame, `C_b^s`
+    pub c_b_s: Mat3,
+}
+
+impl ImuMount {
+    /// Lever arm `l` [m] and mounting Euler angles (roll, pitch, yaw of the IMU axes in the
+    /// vehicle frame: `C_s^b = Rz Ry Rx`).
+    pub fn new(lever_arm_b_m: Vec3, mount: sdins_core::math::Euler) -> Self {
+        Self {
+            lever_arm_b_m,
+            c_b_s: sdins_core::math::c_b_n_from_euler(&mount).transpose(),
+        }
+    }
+
+    /// The IMU's truth from a reference-point sample and the trajectory kinematics at the
+    /// same instant, in the NED frame at the IMU (the frame a navigation of the IMU data
+    /// keeps; it differs from the reference point's NED frame by `|l|/R ≈ 3e-7 rad` per
+    /// 2 m of horizontal lever arm). Position `r^e + C_n^e C_b^n l` through ECEF
+    /// ([`EarthModel::ecef_from_geodetic`] and back); earth-relative velocity
+    /// `v + C_b^n (ω_eb^b × l)`, `ω_eb^b = ω_nb^b + C_n^b ω_en^n` (Groves 2nd ed. eq. 2.150
+    /// form), and attitude `C_s^n = C_b^n C_s^b`, both rotated by `C_n^{n'} = C_e^{n'} C_n^e`.
+    /// The flat model (no transport rate) has one NED frame: the offset is converted with
+    /// the radii of curvature at the reference point. Returns
+    /// `(lat_rad, lon_rad, h_m, v_n_mps, c_s_n)`.
+    pub fn imu_point(
+        &self,
+        earth: &EarthModel,
+        s: &TruthSample,
+        kin: &Kinematics,
+    ) -> (f64, f64, f64, Vec3, Mat3) {
+        let l = self.lever_arm_b_m;
+        let d_n = s.c_b_n * l;
+        let w_en = earth.omega_en_n(s.lat_rad, s.h_m, &s.v_n_mps);
+        let w_eb = kin.omega_nb_b_rps + s.c_b_n.transpose() * w_en;
+        let v = s.v_n_mps + s.c_b_n * w_eb.cross(&l);
+        let c_s_n = s.c_b_n * self.c_b_s.transpose();
+        if !earth.transport {
+            let r = earth.radii(s.lat_rad);
+            let lat = s.lat_rad + d_n.x / (r.r_m_m + s.h_m);
+            let lon = wrap_pi(s.lon_rad + d_n.y / ((r.r_n_m + s.h_m) * s.lat_rad.cos()));
+            return (lat, lon, s.h_m - d_n.z, v, c_s_n);
+        }
+        let c_e_n = EarthModel::c_e_n(s.lat_rad, s.lon_rad);
+        let r_e = earth.ecef_from_geodetic(s.lat_rad, s.lon_rad, s.h_m) + c_e_n.transpose() * d_n;
+        let (lat, lon, h) = earth.geodetic_from_ecef(&r_e);
+        let c_n_n2 = EarthModel::c_e_n(lat, lon) * c_e_n.transpose();
+        (lat, lon, h, c_n_n2 * v, c_n_n2 * c_s_n)
+    }
 }
 
 /// Gauss–Legendre 3-node nodes, Butcher `A` (collocation) matrix; weights 5/18, 4/9, 5/18
@@ -334,6 +436,8 @@ impl<'a> TruthGenerator<'a> {
             ph_tmp: Default::default(),
             ph_zero: OverlayPhases::default(),
             lat_sc: (f64::NAN, 0.0, 1.0),
+            mount: None,
+            w_ib_prev: None,
         };
         traj.phases_offset(0.0, &mut g.ph_zero);
         // node offsets of the regular panel layout, formed as in `sample_gauss`
@@ -352,6 +456,24 @@ impl<'a> TruthGenerator<'a> {
             g.closed = Some(g.closed_form());
         }
         g
+    }
+
+    /// IMU increments at a lever arm and mounting ([`ImuMount`]); the samples' position,
+    /// velocity and attitude stay those of the vehicle reference point. Uses the general
+    /// (integrated) path.
+    pub fn with_mount(mut self, mount: ImuMount) -> Self {
+        self.closed = None;
+        self.mount = Some(mount);
+        self
+    }
+
+    /// `ω_ib^b` at time `t` (branch `t_sel`) at the current position.
+    fn omega_ib(&self, t: f64, t_sel: f64) -> Vec3 {
+        let kin = self.traj.kinematics(t, t_sel);
+        let e = &self.cfg.earth;
+        let lat = self.cfg.lat0_rad + self.dlat;
+        let w = e.omega_ie_n(lat) + e.omega_en_n(lat, self.h, &kin.v_n_mps);
+        kin.omega_nb_b_rps + kin.c_b_n.transpose() * w
     }
 
     /// Force the general (integrated) path even where the closed form applies (for tests).
@@ -378,6 +500,7 @@ impl<'a> TruthGenerator<'a> {
     /// propagated to `t_k`, and the closed-form path is not used.
     pub fn starting_at_sample(mut self, k: u64) -> Self {
         self.closed = None;
+        self.w_ib_prev = None;
         self.k = k.min(self.n_samples);
         let t0 = self.k as f64 * self.cfg.dt_s;
         self.bi = self.breaks.partition_point(|&b| b <= t0);
@@ -409,16 +532,39 @@ impl<'a> TruthGenerator<'a> {
         self.n_samples
     }
 
-    /// The navigation initial state at t = 0 (exact).
+    /// The navigation initial state at t = 0 (exact), at the IMU when a mount is set
+    /// ([`TruthGenerator::with_mount`], [`ImuMount::imu_point`]).
     pub fn initial_state(&self) -> InitialState {
         let k = self.traj.kinematics(0.0, 0.0);
+        let s = TruthSample::new(
+            0.0,
+            Increment::new(Vec3::zeros(), Vec3::zeros()),
+            self.cfg.lat0_rad,
+            self.cfg.lon0_rad,
+            self.cfg.h0_m,
+            k.v_n_mps,
+            k.c_b_n,
+        );
+        let s = self.at_imu(&s);
         InitialState {
-            lat_rad: self.cfg.lat0_rad,
-            lon_rad: self.cfg.lon0_rad,
-            h_m: self.cfg.h0_m,
-            v_n_mps: k.v_n_mps,
-            c_b_n: k.c_b_n,
+            lat_rad: s.lat_rad,
+            lon_rad: s.lon_rad,
+            h_m: s.h_m,
+            v_n_mps: s.v_n_mps,
+            c_b_n: s.c_b_n,
         }
+    }
+
+    /// A sample of this generator moved to the IMU ([`ImuMount::imu_point`]; unchanged
+    /// without a mount): what a navigation of the IMU data is compared with.
+    pub fn at_imu(&self, s: &TruthSample) -> TruthSample {
+        let Some(m) = &self.mount else {
+            return *s;
+        };
+        let t_sel = s.t_s - 0.25 * self.cfg.dt_s / self.cfg.substeps.max(1) as f64;
+        let kin = self.traj.kinematics(s.t_s, t_sel.max(0.0));
+        let (lat, lon, h, v, c) = m.imu_point(&self.cfg.earth, s, &kin);
+        TruthSample::new(s.t_s, s.inc, lat, lon, h, v, c)
     }
 
     fn closed_form(&self) -> ClosedForm {
@@ -460,7 +606,15 @@ impl<'a> TruthGenerator<'a> {
         let w_en = e.omega_en_n(lat, h, &v);
         let c_n_b = kin.c_b_n.transpose();
         let w_ib = kin.omega_nb_b_rps + c_n_b * (w_ie + w_en);
-        let f_b = c_n_b * (kin.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - e.gravity_n(lat, h));
+        let mut f_b =
+            c_n_b * (kin.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - e.gravity_n(lat, h));
+        if let Some(m) = &self.mount {
+            let d_n = kin.c_b_n * m.lever_arm_b_m;
+            let le = e.local(lat, h);
+            let g2 = e.gravity(lat + d_n.x / (le.r_m_m + h), h - d_n.z);
+            let dg = gravity_difference(e, &le, h, &w_ie, &d_n, g2);
+            f_b += w_ib.cross(&w_ib.cross(&m.lever_arm_b_m)) - c_n_b * dg;
+        }
         let (lat_dot, lon_dot) = if e.transport {
             (v.x / (r.r_m_m + h), v.y / ((r.r_n_m + h) * lat.cos()))
         } else {
@@ -633,8 +787,15 @@ impl TruthGenerator<'_> {
             let w_en = e.omega_en_n_local(&le, h, &v);
             let c_n_b = k.c_b_n.transpose();
             let th_i = k.omega_nb_b_rps + c_n_b * (w_ie + w_en);
-            let f_i = c_n_b
+            let mut f_i = c_n_b
                 * (k.v_dot_n_mps2 + (2.0 * w_ie + w_en).cross(&v) - Vec3::new(0.0, 0.0, le.g_mps2));
+            if let Some(m) = &self.mount {
+                let d_n = k.c_b_n * m.lever_arm_b_m;
+                let (s2, c2) = sin_cos_shift(s, c, d_n.x / (le.r_m_m + h));
+                let g2 = e.local_sc(s2, c2, h - d_n.z).g_mps2;
+                let dg = gravity_difference(&e, &le, h, &w_ie, &d_n, g2);
+                f_i += th_i.cross(&th_i.cross(&m.lever_arm_b_m)) - c_n_b * dg;
+            }
             for a in 0..3 {
                 th[a][i] = th_i[a];
                 f[a][i] = f_i[a];
@@ -674,7 +835,12 @@ impl Iterator for TruthGenerator<'_> {
                 (cf.inc, cf.v_n_mps, cf.c_b_n, cf.sin_cos_lat)
             }
             None => {
-                let inc = match self.scheme {
+                let w0 = match (&self.mount, self.w_ib_prev) {
+                    (None, _) => Vec3::zeros(),
+                    (Some(_), Some(w)) => w,
+                    (Some(_), None) => self.omega_ib(t0, t0),
+                };
+                let mut inc = match self.scheme {
                     TruthScheme::Gauss => self.sample_gauss(t0),
                     TruthScheme::Rk4 => self.sample_rk4(t0),
                 };
@@ -687,6 +853,12 @@ impl Iterator for TruthGenerator<'_> {
                     .kinematics_phased(t1, 0.0, t_sel, &self.ph_end, &self.ph_zero);
                 std::mem::swap(&mut self.ph_base, &mut self.ph_end);
                 self.ph_base_t = t1;
+                if let Some(m) = self.mount {
+                    let w1 = self.omega_ib(t1, t_sel);
+                    self.w_ib_prev = Some(w1);
+                    let dv = inc.dv_b_mps + (w1 - w0).cross(&m.lever_arm_b_m);
+                    inc = Increment::new(m.c_b_s * inc.dtheta_b_rad, m.c_b_s * dv);
+                }
                 let lat_rad = self.cfg.lat0_rad + self.dlat;
                 (inc, kin.v_n_mps, kin.c_b_n, self.sin_cos_lat(lat_rad))
             }

@@ -43,7 +43,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         h0_m: scn.start.h_m,
         substeps: scn.nav.substeps,
     };
-    let gen = TruthGenerator::new(&scn.trajectory, cfg);
+    let mut gen = TruthGenerator::new(&scn.trajectory, cfg);
+    // truth.csv stays at the vehicle reference point; imu.csv is sensed at the IMU
+    let init = gen.initial_state();
+    if let Some(m) = scn.mounting.imu {
+        gen = gen.with_mount(m);
+        eprintln!("note: imu.csv is sensed at the IMU lever arm and mounting ([mounting]); truth.csv is at the vehicle reference point");
+    }
     let total = gen.len_samples();
     let mut truth = AtomicFile::create(&out.join("truth.csv"))?;
     let mut imu = AtomicFile::create(&out.join("imu.csv"))?;
@@ -54,7 +60,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps"
     )
     .map_err(|e| io_err(&out, "imu.csv", e))?;
-    let init = gen.initial_state();
     let e0 = euler_from_c_b_n(&init.c_b_n);
     let q0 = Quat::from_dcm(&init.c_b_n);
     let d = 180.0 / std::f64::consts::PI;
