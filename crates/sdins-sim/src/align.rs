@@ -14,6 +14,7 @@ use crate::truth::{auto_substeps, TruthConfig, TruthGenerator};
 use nalgebra::{SMatrix, SVector};
 use sdins_core::align::coarse::{self, CoarseMethod, StaticMean};
 use sdins_core::align::fine::{FineAlign, FineConfig};
+use sdins_core::align::i0::InertialAlign;
 use sdins_core::align::model::{pseudo_transform, BiasFrame, Mat12};
 use sdins_core::align::multiheading::{AlgorithmB, AttitudeErrorTransition};
 use sdins_core::align::{AlignError, Site};
@@ -136,6 +137,23 @@ pub fn coarse_window(
         m.add(inc, dt_s);
     }
     coarse::align(method, &m, site)
+}
+
+/// Inertial-frame (i0) coarse alignment over the samples `[i0, i0 + n)`
+/// ([`sdins_core::align::i0`]): returns `C_b^n` at the **end** of the window (sample
+/// `i0 + n − 1`), robust to sway, rocking, heave and surge of the base.
+pub fn i0_window(
+    incs: &[Increment],
+    dt_s: f64,
+    i0: usize,
+    n: usize,
+    site: &Site,
+) -> Result<Mat3, AlignError> {
+    let mut a = InertialAlign::new(*site);
+    for inc in incs.iter().skip(i0).take(n) {
+        a.add(inc, dt_s);
+    }
+    a.c_b_n()
 }
 
 /// Run a fine alignment over `incs` from `c0`; `on_update(j, &filter)` is called after
