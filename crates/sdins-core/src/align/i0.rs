@@ -21,8 +21,13 @@
 //! v^{n0}(t) = [ t I + (1 − cos Ωt)/Ω² [ω×] + (t − sin(Ωt)/Ω)/Ω² [ω×]² ] f^n
 //! ```
 //!
-//! and `C_{ib0}^{n0}` solves Wahba's problem `min Σ_k |v^{n0}(t_k) − C v^{ib0}(t_k)|²`
-//! over all samples, i.e. maximises `tr(Cᵀ B)`, `B = Σ_k v^{n0}_k (v^{ib0}_k)ᵀ`. `B` is
+//! and `C_{ib0}^{n0}` solves the weighted Wahba problem
+//! `min Σ_k w_k |v^{n0}(t_k) − C v^{ib0}(t_k)|²` over all samples, i.e. maximises
+//! `tr(Cᵀ B)`, `B = Σ_k w_k v^{n0}_k (v^{ib0}_k)ᵀ`, with the taper `w_k = 1 − t_k/T`: it
+//! makes the estimator's kernel vanish at the window end, so that an oscillating
+//! (heave, surge) velocity leaks into the heading as `O(1/(ωT)²)` instead of
+//! `O(1/(ωT))` (docs/alignment_i0.md §4). `B = B₀ − B₁/T` from the online sums
+//! `B₀ = Σ v^{n0} v^{ib0ᵀ}`, `B₁ = Σ t_k v^{n0} v^{ib0ᵀ}`. `B` is
 //! nearly rank one (gravity dominates its sweep by `(ΩT)²`, singular-value ratio ~1e-6),
 //! which makes an SVD lose the heading; instead a TRIAD start from `v(T)` and `Σ v(t_k)`
 //! is refined by Newton steps on the rotation vector (see [`InertialAlign::c_ib0_n0`]).
@@ -33,19 +38,18 @@
 //! `φ_D = −δψ`… see the doc for signs), independent of the window; the angle random walk
 //! `σ_g` and velocity random walk `σ_a` give
 //! `σ_ψ² = 4 (g² σ_g² T³ K₁ + σ_a² T K₂) / (T⁴ (g Ω cos L)²) + σ_g² T` with the exact
-//! constants [`K1`], [`K2`] of the unweighted velocity fit.
+//! constants [`K1`], [`K2`] of the tapered velocity fit.
 
 use super::{AlignError, Site};
 use crate::coning::Increment;
 use crate::math::{dcm_from_rotvec, skew, Mat3, Quat, Vec3};
 
-/// `K₁ = ∫₀¹ k(v)² dv`, `k(v) = (10/3) v − 10 v³ + (20/3) v⁴`: gyro angle random walk
-/// weight of the heading estimate (docs/alignment_i0.md §3).
-pub const K1: f64 = 100.0 / 9.0 - 30.0 + 100.0 / 7.0 + 400.0 / 81.0;
-/// `K₂ = ∫₀¹ h₁(v)² dv`, `h₁(v) = −10/3 + 30 v² − (80/3) v³`: accelerometer velocity
-/// random walk weight (docs/alignment_i0.md §3).
-pub const K2: f64 = 100.0 / 9.0 + 900.0 / 5.0 + 6400.0 / 63.0 - 200.0 / 3.0 + 400.0 / 9.0
-    - 800.0 / 3.0;
+/// `K₁ = ∫₀¹ k(v)² dv = 260/693`, `k(v) = 5v − 30v³ + 40v⁴ − 15v⁵`: gyro angle random
+/// walk weight of the heading estimate (docs/alignment_i0.md §3).
+pub const K1: f64 = 260.0 / 693.0;
+/// `K₂ = ∫₀¹ j(v)² dv = 40/7`, `j(v) = −5 + 90v² − 160v³ + 75v⁴`: accelerometer
+/// velocity random walk weight (docs/alignment_i0.md §3).
+pub const K2: f64 = 40.0 / 7.0;
 
 /// Online inertial-frame coarse alignment.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,6 +59,7 @@ pub struct InertialAlign {
     v_ib0: Vec3,
     t_s: f64,
     b: Mat3,
+    b1: Mat3,
     sum_v_ib0: Vec3,
     sum_v_n0: Vec3,
     n: u64,
@@ -96,6 +101,7 @@ impl InertialAlign {
             v_ib0: Vec3::zeros(),
             t_s: 0.0,
             b: Mat3::zeros(),
+            b1: Mat3::zeros(),
             sum_v_ib0: Vec3::zeros(),
             sum_v_n0: Vec3::zeros(),
             n: 0,
@@ -104,7 +110,7 @@ impl InertialAlign {
 
     /// Add one sample: `v^{ib0} += C_b^{ib0}(mid) Δv` with the mid-sample attitude
     /// `C_b^{ib0}(t_{k−1}) exp(½Δθ)` (rotation compensation to second order), then
-    /// `C_b^{ib0} ← C_b^{ib0} exp(Δθ)`, and the Wahba sum `B += v^{n0}(t_k) v^{ib0}(t_k)ᵀ`.
+    /// `C_b^{ib0} ← C_b^{ib0} exp(Δθ)`, and the Wahba sums `B₀ += v^{n0}(t_k) v^{ib0}(t_k)ᵀ`, `B₁ += t_k v^{n0} v^{ib0ᵀ}`.
     pub fn add(&mut self, inc: &Increment, dt_s: f64) {
         let half = Quat::from_rotvec(&(0.5 * inc.dtheta_b_rad));
         let q_mid = self.q_b_ib0.mul(&half);
@@ -113,7 +119,9 @@ impl InertialAlign {
         self.t_s += dt_s;
         self.n += 1;
         let v_n0 = gravity_velocity_n0(&self.site, self.t_s);
-        self.b += v_n0 * self.v_ib0.transpose();
+        let outer = v_n0 * self.v_ib0.transpose();
+        self.b += outer;
+        self.b1 += outer * self.t_s;
         self.sum_v_ib0 += self.v_ib0;
         self.sum_v_n0 += v_n0;
     }
@@ -133,7 +141,7 @@ impl InertialAlign {
         self.q_b_ib0.to_dcm()
     }
 
-    /// `C_{ib0}^{n0}` from Wahba's problem (module doc).
+    /// `C_{ib0}^{n0}` from the tapered Wahba problem (module doc).
     pub fn c_ib0_n0(&self) -> Result<Mat3, AlignError> {
         if self.n < 2 {
             return Err(AlignError::NoData);
@@ -141,7 +149,8 @@ impl InertialAlign {
         if libm::fabs(self.site.lat_rad) > 80.0_f64.to_radians() {
             return Err(AlignError::LatitudeTooHigh);
         }
-        if !self.b.iter().all(|x| x.is_finite()) || self.site.g_mps2 <= 0.0 {
+        let b = self.b - self.b1 / self.t_s;
+        if !b.iter().all(|x| x.is_finite()) || self.site.g_mps2 <= 0.0 {
             return Err(AlignError::Degenerate);
         }
         // start: TRIAD of (v(T), Σ v(t_k)) in both frames
@@ -152,7 +161,7 @@ impl InertialAlign {
         // H = tr M·I − sym M (positive definite while gravity sweeps: two non-zero
         // singular values of B). Three steps reach roundoff from the TRIAD start.
         for _ in 0..3 {
-            let m = self.b * c.transpose();
+            let m = b * c.transpose();
             let h = Mat3::identity() * m.trace() - 0.5 * (m + m.transpose());
             let Some(h_inv) = h.try_inverse() else {
                 return Err(AlignError::Degenerate);
@@ -236,8 +245,8 @@ mod tests {
         let (mut k1, mut k2) = (0.0, 0.0);
         for i in 0..n {
             let v = (i as f64 + 0.5) / n as f64;
-            let k = 10.0 / 3.0 * v - 10.0 * v * v * v + 20.0 / 3.0 * v * v * v * v;
-            let h = -10.0 / 3.0 + 30.0 * v * v - 80.0 / 3.0 * v * v * v;
+            let k = 5.0 * v - 30.0 * v.powi(3) + 40.0 * v.powi(4) - 15.0 * v.powi(5);
+            let h = -5.0 + 90.0 * v * v - 160.0 * v.powi(3) + 75.0 * v.powi(4);
             k1 += k * k / n as f64;
             k2 += h * h / n as f64;
         }
