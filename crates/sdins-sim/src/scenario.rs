@@ -1017,7 +1017,7 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "dq-paper", summary: "B: stationary, accelerate, S-turn with 1 Hz coning (dual-quaternion paper, spec §7.5)", toml: include_str!("../scenarios/dq-paper.toml") },
     Builtin { name: "alignment", summary: "stationary alignment reference: roll/pitch/yaw 2/-3/40 deg at 37.5N (alignment spec §6)", toml: include_str!("../scenarios/alignment.toml") },
     Builtin { name: "moored-ship", summary: "disturbed base: moored ship at 40N, roll/pitch sway ±5 deg, 0.5 m heave, 0.2 m surge, marine grade", toml: include_str!("../scenarios/moored-ship.toml") },
-    Builtin { name: "rocking-car", summary: "disturbed base: parked car rocking ±0.8/0.5 deg at 1.3/1.7 Hz with 1 cm heave, aviation grade", toml: include_str!("../scenarios/rocking-car.toml") },
+    Builtin { name: "rocking-car", summary: "disturbed base: parked car rocking ±0.8/0.5 deg at 1.373/1.827 Hz with 1 cm heave, aviation grade", toml: include_str!("../scenarios/rocking-car.toml") },
 ];
 
 /// Look up a built-in scenario by name.
