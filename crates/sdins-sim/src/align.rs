@@ -156,6 +156,45 @@ pub fn i0_window(
     a.c_b_n()
 }
 
+/// Fine alignment started from i0 (docs/alignment_i0.md §6): i0 over the first `n`
+/// samples gives `C_b^n(0)` and the RMS velocity residual `r` of its fit; the filter
+/// `cfg` runs over all of `incs` from `C_b^n(0)` with the zero-velocity σ sized from the
+/// disturbance, `σ_z = max(cfg.sigma_z_mps, r)` (the base's own velocity is the error of
+/// the zero-velocity measurement). A short or disturbed start window leaves i0 degrees
+/// off, outside the small-angle filter's reach and absorbed into the east gyro bias; so
+/// the start is refined once: the first pass's final attitude is carried back to t = 0
+/// through the gyros, `Ĉ_b^n(0) = exp([ω_ie^n×] T) Ĉ_b^n(T) C_b^{ib0}(T)ᵀ`
+/// ([`sdins_core::align::i0`] frame split), and the filter is rerun from it with fresh
+/// bias states. `on_update` sees the second pass. Returns the filter, the (refined)
+/// start attitude and the σ_z used.
+pub fn fine_from_i0<F: FnMut(usize, &FineAlign)>(
+    incs: &[Increment],
+    dt_s: f64,
+    mut cfg: FineConfig,
+    n: usize,
+    on_update: F,
+) -> Result<(FineAlign, Mat3, f64), AlignError> {
+    let mut a = InertialAlign::new(cfg.site);
+    for inc in incs.iter().take(n) {
+        a.add(inc, dt_s);
+    }
+    let c0 = a.c_b_n0()?;
+    cfg.sigma_z_mps = cfg.sigma_z_mps.max(a.residual_rms_mps()?);
+    let sz = cfg.sigma_z_mps;
+    let first = run_fine(incs, dt_s, cfg, &c0, |_, _| {});
+    // C_b^{ib0}(T) from the gyros
+    let mut q = sdins_core::math::Quat::IDENTITY;
+    for inc in incs {
+        q = q
+            .mul(&sdins_core::math::Quat::from_rotvec(&inc.dtheta_b_rad))
+            .normalized();
+    }
+    let t = incs.len() as f64 * dt_s;
+    let r = dcm_from_rotvec(&(cfg.site.omega_ie_n() * t));
+    let c0b = sdins_core::math::orthonormalize(&(r * first.c_b_n() * q.to_dcm().transpose()));
+    Ok((run_fine(incs, dt_s, cfg, &c0b, on_update), c0b, sz))
+}
+
 /// Run a fine alignment over `incs` from `c0`; `on_update(j, &filter)` is called after
 /// every Kalman cycle, with `j` the index of the sample that ended it.
 pub fn run_fine<F: FnMut(usize, &FineAlign)>(

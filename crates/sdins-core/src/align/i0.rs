@@ -62,6 +62,8 @@ pub struct InertialAlign {
     b1: Mat3,
     sum_v_ib0: Vec3,
     sum_v_n0: Vec3,
+    sum_sq: [f64; 2],
+    sum_w: [f64; 2],
     n: u64,
 }
 
@@ -104,6 +106,8 @@ impl InertialAlign {
             b1: Mat3::zeros(),
             sum_v_ib0: Vec3::zeros(),
             sum_v_n0: Vec3::zeros(),
+            sum_sq: [0.0; 2],
+            sum_w: [0.0; 2],
             n: 0,
         }
     }
@@ -122,6 +126,11 @@ impl InertialAlign {
         let outer = v_n0 * self.v_ib0.transpose();
         self.b += outer;
         self.b1 += outer * self.t_s;
+        let sq = v_n0.norm_squared() + self.v_ib0.norm_squared();
+        self.sum_sq[0] += sq;
+        self.sum_sq[1] += sq * self.t_s;
+        self.sum_w[0] += 1.0;
+        self.sum_w[1] += self.t_s;
         self.sum_v_ib0 += self.v_ib0;
         self.sum_v_n0 += v_n0;
     }
@@ -173,6 +182,24 @@ impl InertialAlign {
             c = dcm_from_rotvec(&phi) * c;
         }
         Ok(c)
+    }
+
+    /// RMS velocity residual of the fit [m/s],
+    /// `√(Σ w_k |v^{n0}_k − C v^{ib0}_k|² / Σ w_k) = √((Σ w |v^{n0}|² + Σ w |v^{ib0}|² − 2 tr(Cᵀ B)) / Σ w)`:
+    /// the disturbance (heave, surge, sway about an offset centre) velocity of the base
+    /// plus the sensor-noise walk; the scale of the zero-velocity measurement error of a
+    /// fine filter on this base (docs/alignment_i0.md §6). Roundoff ≈ `ε g T` m/s.
+    pub fn residual_rms_mps(&self) -> Result<f64, AlignError> {
+        let c = self.c_ib0_n0()?;
+        let t = self.t_s;
+        let b = self.b - self.b1 / t;
+        let sq = self.sum_sq[0] - self.sum_sq[1] / t;
+        let w = self.sum_w[0] - self.sum_w[1] / t;
+        let rss = sq - 2.0 * (c.transpose() * b).trace();
+        if !(w > 0.0) || !rss.is_finite() {
+            return Err(AlignError::Degenerate);
+        }
+        Ok(libm::sqrt(rss.max(0.0) / w))
     }
 
     /// The attitude `C_b^n` at the end of the samples added so far (module doc).
