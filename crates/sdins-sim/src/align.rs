@@ -227,9 +227,14 @@ pub fn fine_from_i0<F: FnMut(usize, &FineAlign)>(
         a.add(inc, dt_s);
     }
     let c0 = a.c_b_n0()?;
-    cfg.sigma_z_mps = cfg
-        .sigma_z_mps
-        .max(disturbance_sigma_z(incs, dt_s, n, &cfg.site, &c0, cfg.kf_dt_s));
+    cfg.sigma_z_mps = cfg.sigma_z_mps.max(disturbance_sigma_z(
+        incs,
+        dt_s,
+        n,
+        &cfg.site,
+        &c0,
+        cfg.kf_dt_s,
+    ));
     let sz = cfg.sigma_z_mps;
     let first = run_fine(incs, dt_s, cfg, &c0, |_, _| {});
     // C_b^{ib0}(T) from the gyros

@@ -792,7 +792,13 @@ impl Scenario {
                         );
                     }
                     let phase = match &od.phase_deg {
-                        Some(v) => cx.range(v, "overlay.phase_deg", -360.0, 360.0, "a phase in degrees within ±360")?,
+                        Some(v) => cx.range(
+                            v,
+                            "overlay.phase_deg",
+                            -360.0,
+                            360.0,
+                            "a phase in degrees within ±360",
+                        )?,
                         None => 0.0,
                     };
                     OverlayKind::Sway {

@@ -39,8 +39,15 @@ fn lasergyro_i0_heading_over_300s_windows() {
     let mut yaw = Vec::new();
     for k in 0..nwin {
         let c = i0_window(&data.increments, dt, k * win, win, &site).unwrap();
-        let c2 = coarse_window(&data.increments, dt, k * win, win, &site, CoarseMethod::TwoStep)
-            .unwrap();
+        let c2 = coarse_window(
+            &data.increments,
+            dt,
+            k * win,
+            win,
+            &site,
+            CoarseMethod::TwoStep,
+        )
+        .unwrap();
         let e = euler_from_c_b_n(&c);
         let e2 = euler_from_c_b_n(&c2);
         println!(
@@ -52,8 +59,8 @@ fn lasergyro_i0_heading_over_300s_windows() {
         );
         yaw.push(e.yaw_rad / D2R);
     }
-    let spread = yaw.iter().cloned().fold(f64::MIN, f64::max)
-        - yaw.iter().cloned().fold(f64::MAX, f64::min);
+    let spread =
+        yaw.iter().cloned().fold(f64::MIN, f64::max) - yaw.iter().cloned().fold(f64::MAX, f64::min);
     println!("i0 heading spread over {nwin} windows: {spread:.4}°");
     assert!(spread <= 0.1, "spread {spread}°");
 }
@@ -131,7 +138,11 @@ fn mc_check(scenario: &str, grade: &str) {
     assert!((0.872..=1.130).contains(&r), "sd/σ = {r}");
     // the 2-step method fails on the same data: its heading is off by more than 1° on
     // average (the sway's mean rate swamps the earth rate)
-    assert!(two_abs.to_degrees() > 1.0, "2-step {}", two_abs.to_degrees());
+    assert!(
+        two_abs.to_degrees() > 1.0,
+        "2-step {}",
+        two_abs.to_degrees()
+    );
 }
 
 /// Issue acceptance, moored ship (roll/pitch ±5°, heave, surge), aviation grade.
@@ -174,11 +185,15 @@ fn i0_error_free_disturbed_base() {
         );
         let c = i0_window(&tr.increments, dt, 0, n, &tr.site).unwrap();
         let phi = attitude_error(&c, &tr.c_b_n[n - 1]);
-        println!("{name}: error-free i0 φ = {:.3?} μrad", (phi * 1e6).as_slice());
+        println!(
+            "{name}: error-free i0 φ = {:.3?} μrad",
+            (phi * 1e6).as_slice()
+        );
         let leak = if name == "moored-ship" {
             let s = tr.site;
             let (w, t) = (2.0 * std::f64::consts::PI * 0.071, window_s);
-            let v = 0.039802 / w + 0.17073 / (2.0 * std::f64::consts::PI * 0.093) * 5f64.to_radians().sin();
+            let v = 0.039802 / w
+                + 0.17073 / (2.0 * std::f64::consts::PI * 0.093) * 5f64.to_radians().sin();
             2.0 * 300.0 * v / ((w * t).powi(2) * t * t * s.g_mps2 * s.omega_n())
         } else {
             f64::INFINITY
@@ -255,7 +270,10 @@ fn fine_from_i0_moored_ship_nees() {
         scn.start.h_m,
     );
     let model = presets::preset("aviation").unwrap();
-    let (arw, vrw) = (model.gyro_arw_dpsh[0] * DPSH, model.accel_vrw_ugpsqrthz[0] * UG);
+    let (arw, vrw) = (
+        model.gyro_arw_dpsh[0] * DPSH,
+        model.accel_vrw_ugpsqrthz[0] * UG,
+    );
     let mut cfg = reference_config(tr.site, vrw, arw);
     for i in 0..3 {
         cfg.p0[(6 + i, 6 + i)] = (model.accel_bias_turn_on_ug[i] * UG).powi(2);

@@ -379,9 +379,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Method::Fine => {
             let fa = match args.start {
                 Start::Coarse2 => {
-                    let c0 =
-                        coarse_window(&inp.incs, dt, 0, nw, &inp.site, CoarseMethod::TwoStep)
-                            .map_err(bad)?;
+                    let c0 = coarse_window(&inp.incs, dt, 0, nw, &inp.site, CoarseMethod::TwoStep)
+                        .map_err(bad)?;
                     let mut fa = FineAlign::new(cfg, &c0);
                     for (j, inc) in inp.incs.iter().enumerate() {
                         if fa.step(inc, dt) {
@@ -392,8 +391,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 }
                 Start::I0 => {
                     let (fa, _, sz) =
-                        fine_from_i0(&inp.incs, dt, cfg, nw, |j, fa| record(j, fa))
-                            .map_err(bad)?;
+                        fine_from_i0(&inp.incs, dt, cfg, nw, |j, fa| record(j, fa)).map_err(bad)?;
                     if !args.json {
                         println!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
                     }

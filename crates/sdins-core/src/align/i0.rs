@@ -90,7 +90,10 @@ fn sweep_coeffs(om: f64, t_s: f64, series: bool) -> (f64, f64) {
         )
     } else {
         let s = libm::sin(0.5 * x);
-        (2.0 * s * s / (om * om), (t_s - libm::sin(x) / om) / (om * om))
+        (
+            2.0 * s * s / (om * om),
+            (t_s - libm::sin(x) / om) / (om * om),
+        )
     }
 }
 
@@ -240,7 +243,8 @@ pub fn heading_sigma_rad(site: &Site, t_s: f64, arw: f64, vrw: f64) -> f64 {
     let g = site.g_mps2;
     let a = g * site.omega_n();
     let t = t_s;
-    let fit = 4.0 * (g * g * arw * arw * t * t * t * K1 + vrw * vrw * t * K2) / (t * t * t * t * a * a);
+    let fit =
+        4.0 * (g * g * arw * arw * t * t * t * K1 + vrw * vrw * t * K2) / (t * t * t * t * a * a);
     libm::sqrt(fit + arw * arw * t)
 }
 
