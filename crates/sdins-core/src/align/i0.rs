@@ -199,7 +199,7 @@ impl InertialAlign {
         let sq = self.sum_sq[0] - self.sum_sq[1] / t;
         let w = self.sum_w[0] - self.sum_w[1] / t;
         let rss = sq - 2.0 * (c.transpose() * b).trace();
-        if !(w > 0.0) || !rss.is_finite() {
+        if !(w.is_finite() && w > 0.0 && rss.is_finite()) {
             return Err(AlignError::Degenerate);
         }
         Ok(libm::sqrt(rss.max(0.0) / w))
