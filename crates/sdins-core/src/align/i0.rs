@@ -257,6 +257,7 @@ pub fn heading_floor_rad(site: &Site, eps_n: &Vec3, nabla_n: &Vec3, t_s: f64) ->
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
     use crate::math::{c_b_n_from_euler, Euler};
