@@ -295,6 +295,9 @@ pub struct Scenario {
     pub nav: NavConfig,
     /// the trajectory
     pub trajectory: Trajectory,
+    /// the scenario text exactly as it was read (provenance: `run.toml` records this, not
+    /// the file as it may be later)
+    pub source_toml: String,
 }
 
 struct Ctx<'a> {
@@ -887,6 +890,7 @@ impl Scenario {
             imu,
             nav,
             trajectory,
+            source_toml: text.to_string(),
         })
     }
 

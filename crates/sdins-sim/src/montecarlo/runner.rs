@@ -41,6 +41,10 @@ fn channels(e: &NavError) -> [f64; N_CHANNELS] {
     [p[0], p[1], p[2], v[0], v[1], v[2], a[0], a[1], a[2]]
 }
 
+/// Largest number of runs of one job (the per-epoch moments are exact far beyond it; the
+/// cap keeps block and shard arithmetic and run-time estimates sane).
+pub const MAX_RUNS: u64 = 100_000_000;
+
 /// One realisation: the errors at every output epoch.
 pub fn run_one(
     scn: &Scenario,
@@ -63,8 +67,11 @@ pub fn run_one(
 
 /// The job identity and the per-run scenario (seed replaced).
 pub fn job(scn: &Scenario, opts: &McOptions) -> Result<(McJob, Scenario), McError> {
-    if opts.runs == 0 {
-        return Err(McError::Config("runs must be ≥ 1".into()));
+    if opts.runs == 0 || opts.runs > MAX_RUNS {
+        return Err(McError::Config(format!(
+            "runs = {}: expected 1 … {MAX_RUNS}",
+            opts.runs
+        )));
     }
     if opts.block == 0 {
         return Err(McError::Config("block size must be ≥ 1".into()));
@@ -264,6 +271,24 @@ duration_s = 60.0
             .build()
             .unwrap()
             .install(f)
+    }
+
+    #[test]
+    fn tampered_states_are_refused() {
+        let scn = small_scenario();
+        let o = opts(9);
+        let st = run_shard(&scn, &o, Shard::ALL, &|| {}, &|| false).unwrap();
+        st.validate().unwrap();
+        let tamper = |f: &dyn Fn(&mut McState)| {
+            let mut t = st.clone();
+            f(&mut t);
+            McState::merge(&[t]).unwrap_err().to_string()
+        };
+        assert!(tamper(&|t| t.blocks[0].moments[0].n += 1).contains("n = "));
+        assert!(tamper(&|t| t.blocks[0].moments[3].m2 = -1.0).contains("m2"));
+        assert!(tamper(&|t| t.blocks[0].moments[1].mean = f64::NAN).contains("mean"));
+        assert!(tamper(&|t| t.times_s[0] = f64::INFINITY).contains("epoch"));
+        assert!(tamper(&|t| t.hist[2] = Default::default()).contains("histogram"));
     }
 
     #[test]
