@@ -135,3 +135,27 @@ fn align_bad_input_exits_2() {
     let (code, _, err) = sdins(&["align", "alignment", "--window-s", "0"]);
     assert_eq!(code, 2, "{err}");
 }
+
+/// `--method i0` on the moored ship recovers the heading at the window end within 0.05°
+/// (marine grade, 300 s: closed-form σ ≈ 0.03°, docs/alignment_i0.md §3), and a bad
+/// `--sigma-z` exits 2 naming the option.
+#[test]
+fn align_i0_moored_ship_and_sigma_z_validation() {
+    let (code, out, err) = sdins(&[
+        "align",
+        "moored-ship",
+        "--method",
+        "i0",
+        "--window-s",
+        "300",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    assert_eq!(v["method"], "i0");
+    let p = v["phi_urad"].as_array().unwrap()[2].as_f64().unwrap();
+    assert!(p.abs() < 0.05f64.to_radians() * 1e6, "{p}");
+    let (code, _, err) = sdins(&["align", "moored-ship", "--sigma-z=-1"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--sigma-z"), "{err}");
+}

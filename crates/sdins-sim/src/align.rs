@@ -14,6 +14,7 @@ use crate::truth::{auto_substeps, TruthConfig, TruthGenerator};
 use nalgebra::{SMatrix, SVector};
 use sdins_core::align::coarse::{self, CoarseMethod, StaticMean};
 use sdins_core::align::fine::{FineAlign, FineConfig};
+use sdins_core::align::i0::InertialAlign;
 use sdins_core::align::model::{pseudo_transform, BiasFrame, Mat12};
 use sdins_core::align::multiheading::{AlgorithmB, AttitudeErrorTransition};
 use sdins_core::align::{AlignError, Site};
@@ -136,6 +137,117 @@ pub fn coarse_window(
         m.add(inc, dt_s);
     }
     coarse::align(method, &m, site)
+}
+
+/// Inertial-frame (i0) coarse alignment over the samples `[i0, i0 + n)`
+/// ([`sdins_core::align::i0`]): returns `C_b^n` at the **end** of the window (sample
+/// `i0 + n − 1`), robust to sway, rocking, heave and surge of the base.
+pub fn i0_window(
+    incs: &[Increment],
+    dt_s: f64,
+    i0: usize,
+    n: usize,
+    site: &Site,
+) -> Result<Mat3, AlignError> {
+    let mut a = InertialAlign::new(*site);
+    for inc in incs.iter().skip(i0).take(n) {
+        a.add(inc, dt_s);
+    }
+    a.c_b_n()
+}
+
+/// Block length of [`disturbance_sigma_z`] [s]: long against ship and car disturbance
+/// periods (≤ 25 s), short against the fine filter's averaging time (hundreds of s).
+pub const DISTURBANCE_BLOCK_S: f64 = 60.0;
+
+/// White-equivalent zero-velocity σ [m/s] of a disturbed base at Kalman interval
+/// `kf_dt_s` (docs/alignment_i0.md §6): the i0 velocity residual
+/// `r_k = C_{ib0}^{n0} v^{ib0}_k − v^{n0}_k` over the first `n` samples is averaged over
+/// blocks of τ_b = [`DISTURBANCE_BLOCK_S`] and its low-frequency PSD estimated as
+/// `S₀ = τ_b · mean(r̄_block²)` (per axis, averaged over the horizontal axes and the
+/// blocks); `σ_z = √(S₀ / Δt_KF)`. A bounded displacement D gives `r̄ ~ D/τ_b`, so a
+/// swaying or heaving base is not charged its full velocity variance as if it were white
+/// noise at every update. With fewer than two blocks the plain residual RMS is used.
+pub fn disturbance_sigma_z(
+    incs: &[Increment],
+    dt_s: f64,
+    n: usize,
+    site: &Site,
+    c_ib0_n0: &Mat3,
+    kf_dt_s: f64,
+) -> f64 {
+    let per = ((DISTURBANCE_BLOCK_S / dt_s).round() as usize).max(1);
+    let mut q = sdins_core::math::Quat::IDENTITY;
+    let mut v = Vec3::zeros();
+    let (mut blk, mut acc, mut cnt, mut all, mut nall) = (Vec3::zeros(), 0.0, 0usize, 0.0, 0usize);
+    for (k, inc) in incs.iter().take(n).enumerate() {
+        let half = sdins_core::math::Quat::from_rotvec(&(0.5 * inc.dtheta_b_rad));
+        let qm = q.mul(&half);
+        v += qm.rotate(&inc.dv_b_mps);
+        q = qm.mul(&half).normalized();
+        let t = (k + 1) as f64 * dt_s;
+        let r = c_ib0_n0 * v - sdins_core::align::i0::gravity_velocity_n0(site, t);
+        all += r.x * r.x + r.y * r.y;
+        nall += 2;
+        blk += r;
+        if (k + 1) % per == 0 {
+            let m = blk / per as f64;
+            acc += 0.5 * (m.x * m.x + m.y * m.y);
+            cnt += 1;
+            blk = Vec3::zeros();
+        }
+    }
+    if cnt < 2 {
+        return (all / nall.max(1) as f64).sqrt();
+    }
+    let s0 = DISTURBANCE_BLOCK_S * acc / cnt as f64;
+    (s0 / kf_dt_s).sqrt()
+}
+
+/// Fine alignment started from i0 (docs/alignment_i0.md §6): i0 over the first `n`
+/// samples gives `C_b^n(0)`; the filter `cfg` runs over all of `incs` from `C_b^n(0)`
+/// with the zero-velocity σ sized from the disturbance,
+/// `σ_z = max(cfg.sigma_z_mps, σ_dist)`, σ_dist of [`disturbance_sigma_z`] (the base's
+/// own velocity is the error of the zero-velocity measurement). A short or disturbed start window leaves i0 degrees
+/// off, outside the small-angle filter's reach and absorbed into the east gyro bias; so
+/// the start is refined once: the first pass's final attitude is carried back to t = 0
+/// through the gyros, `Ĉ_b^n(0) = exp([ω_ie^n×] T) Ĉ_b^n(T) C_b^{ib0}(T)ᵀ`
+/// ([`sdins_core::align::i0`] frame split), and the filter is rerun from it with fresh
+/// bias states. `on_update` sees the second pass. Returns the filter, the (refined)
+/// start attitude and the σ_z used.
+pub fn fine_from_i0<F: FnMut(usize, &FineAlign)>(
+    incs: &[Increment],
+    dt_s: f64,
+    mut cfg: FineConfig,
+    n: usize,
+    on_update: F,
+) -> Result<(FineAlign, Mat3, f64), AlignError> {
+    let mut a = InertialAlign::new(cfg.site);
+    for inc in incs.iter().take(n) {
+        a.add(inc, dt_s);
+    }
+    let c0 = a.c_b_n0()?;
+    cfg.sigma_z_mps = cfg.sigma_z_mps.max(disturbance_sigma_z(
+        incs,
+        dt_s,
+        n,
+        &cfg.site,
+        &c0,
+        cfg.kf_dt_s,
+    ));
+    let sz = cfg.sigma_z_mps;
+    let first = run_fine(incs, dt_s, cfg, &c0, |_, _| {});
+    // C_b^{ib0}(T) from the gyros
+    let mut q = sdins_core::math::Quat::IDENTITY;
+    for inc in incs {
+        q = q
+            .mul(&sdins_core::math::Quat::from_rotvec(&inc.dtheta_b_rad))
+            .normalized();
+    }
+    let t = incs.len() as f64 * dt_s;
+    let r = dcm_from_rotvec(&(cfg.site.omega_ie_n() * t));
+    let c0b = sdins_core::math::orthonormalize(&(r * first.c_b_n() * q.to_dcm().transpose()));
+    Ok((run_fine(incs, dt_s, cfg, &c0b, on_update), c0b, sz))
 }
 
 /// Run a fine alignment over `incs` from `c0`; `on_update(j, &filter)` is called after

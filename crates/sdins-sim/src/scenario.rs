@@ -117,6 +117,7 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "freq_hz",
             "angle_amp_deg",
             "accel_amp_mps2",
+            "phase_deg",
             "start_s",
             "end_s",
         ],
@@ -220,6 +221,7 @@ struct OverlayDoc {
     freq_hz: Option<S<f64>>,
     angle_amp_deg: Option<S<f64>>,
     accel_amp_mps2: Option<S<f64>>,
+    phase_deg: Option<S<f64>>,
     start_s: Option<S<f64>>,
     end_s: Option<S<f64>>,
 }
@@ -929,8 +931,34 @@ impl Scenario {
                     accel_amp_mps2: need_pos(&od.accel_amp_mps2, "overlay.accel_amp_mps2")?,
                     omega_rps: omega,
                 },
+                "sway" => {
+                    let a = need_pos(&od.angle_amp_deg, "overlay.angle_amp_deg")?;
+                    if a >= 90.0 {
+                        return cx.err(
+                            o.span(),
+                            "overlay.angle_amp_deg",
+                            "sway amplitude must be below 90 deg",
+                        );
+                    }
+                    let phase = match &od.phase_deg {
+                        Some(v) => cx.range(
+                            v,
+                            "overlay.phase_deg",
+                            -360.0,
+                            360.0,
+                            "a phase in degrees within ±360",
+                        )?,
+                        None => 0.0,
+                    };
+                    OverlayKind::Sway {
+                        axis: axis(Axis::X)?,
+                        amp_rad: a * D2R,
+                        omega_rps: omega,
+                        phase_rad: phase * D2R,
+                    }
+                }
                 other => {
-                    return cx.err(od.kind.span(), "overlay.type", format!("unknown overlay type `{other}`: expected coning, sculling or vibration"));
+                    return cx.err(od.kind.span(), "overlay.type", format!("unknown overlay type `{other}`: expected coning, sculling, vibration or sway"));
                 }
             };
             let start_s = match &od.start_s {
@@ -1267,6 +1295,8 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "turn-90dps", summary: "A2: 90 deg/s turn from east to south at Mach 1 (spec §7.3)", toml: include_str!("../scenarios/turn-90dps.toml") },
     Builtin { name: "dq-paper", summary: "B: stationary, accelerate, S-turn with 1 Hz coning (dual-quaternion paper, spec §7.5)", toml: include_str!("../scenarios/dq-paper.toml") },
     Builtin { name: "alignment", summary: "stationary alignment reference: roll/pitch/yaw 2/-3/40 deg at 37.5N (alignment spec §6)", toml: include_str!("../scenarios/alignment.toml") },
+    Builtin { name: "moored-ship", summary: "disturbed base: moored ship at 40N, roll/pitch sway ±5 deg, 0.5 m heave, 0.2 m surge, marine grade", toml: include_str!("../scenarios/moored-ship.toml") },
+    Builtin { name: "rocking-car", summary: "disturbed base: parked car rocking ±0.8/0.5 deg at 1.373/1.827 Hz with 1 cm heave, aviation grade", toml: include_str!("../scenarios/rocking-car.toml") },
 ];
 
 /// Look up a built-in scenario by name.

@@ -172,6 +172,19 @@ pub enum OverlayKind {
         /// angular frequency Ω [rad/s]
         omega_rps: f64,
     },
+    /// angular sway (ship roll/pitch/yaw at its mooring, a rocking car): rotation by
+    /// `θ(τ) = A sin(Ωτ + φ)` about a body axis, `C_k = R_axis(θ)`, body rate
+    /// `θ̇ = A Ω cos(Ωτ + φ)` about that axis (τ from the overlay start)
+    Sway {
+        /// axis of the (nominal, after earlier overlays) body frame
+        axis: Axis,
+        /// angular amplitude A [rad]
+        amp_rad: f64,
+        /// angular frequency Ω [rad/s]
+        omega_rps: f64,
+        /// phase φ [rad]
+        phase_rad: f64,
+    },
 }
 
 impl OverlayKind {
@@ -180,7 +193,8 @@ impl OverlayKind {
         match *self {
             OverlayKind::Coning { omega_rps, .. }
             | OverlayKind::Sculling { omega_rps, .. }
-            | OverlayKind::Vibration { omega_rps, .. } => omega_rps,
+            | OverlayKind::Vibration { omega_rps, .. }
+            | OverlayKind::Sway { omega_rps, .. } => omega_rps,
         }
     }
 }
@@ -258,6 +272,10 @@ impl KinConsts {
                     let (sa2, ca2) = (0.5 * half_angle_rad).sin_cos();
                     let (sa, ca) = half_angle_rad.sin_cos();
                     [sa2, ca2, sa, ca]
+                }
+                OverlayKind::Sway { phase_rad, .. } => {
+                    let (sp, cp) = phase_rad.sin_cos();
+                    [sp, cp, 0.0, 0.0]
                 }
                 _ => [0.0; 4],
             })
@@ -522,7 +540,8 @@ impl Trajectory {
         let ov = self.overlays.iter().map(|o| match o.kind {
             OverlayKind::Coning { omega_rps, .. }
             | OverlayKind::Sculling { omega_rps, .. }
-            | OverlayKind::Vibration { omega_rps, .. } => omega_rps,
+            | OverlayKind::Vibration { omega_rps, .. }
+            | OverlayKind::Sway { omega_rps, .. } => omega_rps,
         });
         seg.chain(ov).fold(0.0, f64::max)
     }
@@ -737,6 +756,28 @@ impl Trajectory {
                     v_dot += c_nom * (w_nom.cross(&u) + u_dot);
                     (Mat3::identity(), Vec3::zeros())
                 }
+                OverlayKind::Sway {
+                    axis,
+                    amp_rad,
+                    omega_rps,
+                    ..
+                } => {
+                    // sin/cos(Ωτ + φ) by angle addition with the cached sin/cos φ
+                    let [sp, cp, _, _] = *kc;
+                    let (swt, cwt) = sincos(omega_rps);
+                    let (s_ph, c_ph) = (swt * cp + cwt * sp, cwt * cp - swt * sp);
+                    let (sa, ca) = (amp_rad * s_ph).sin_cos();
+                    let c = match axis {
+                        Axis::X => Mat3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca),
+                        Axis::Y => Mat3::new(ca, 0.0, sa, 0.0, 1.0, 0.0, -sa, 0.0, ca),
+                        Axis::Z => Mat3::new(ca, -sa, 0.0, sa, ca, 0.0, 0.0, 0.0, 1.0),
+                    };
+                    let mut w = Vec3::zeros();
+                    if active {
+                        w[axis.index()] = amp_rad * omega_rps * c_ph;
+                    }
+                    (c, w)
+                }
             };
             // compose: C_c ← C_c C_k, ω_c ← C_kᵀ ω_c + ω_k (the first directly: the
             // products with the identity and zero would return it unchanged)
@@ -812,6 +853,16 @@ mod tests {
                         axis: Axis::Z,
                         accel_amp_mps2: 0.3,
                         omega_rps: 20.0,
+                    },
+                    start_s: 0.0,
+                    end_s: 100.0,
+                },
+                Overlay {
+                    kind: OverlayKind::Sway {
+                        axis: Axis::Y,
+                        amp_rad: 0.08,
+                        omega_rps: 1.1,
+                        phase_rad: 0.7,
                     },
                     start_s: 0.0,
                     end_s: 100.0,

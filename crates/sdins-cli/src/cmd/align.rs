@@ -24,7 +24,9 @@ use sdins_core::align::Site;
 use sdins_core::coning::Increment;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{attitude_error, c_b_n_from_euler, euler_from_c_b_n, Euler, Mat3, Vec3};
-use sdins_sim::align::{algorithm_a, algorithm_b, coarse_window, corrupt, truth_record};
+use sdins_sim::align::{
+    algorithm_a, algorithm_b, coarse_window, corrupt, fine_from_i0, i0_window, truth_record,
+};
 use sdins_sim::imu_error::{DPH, DPSH, UG};
 use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use sdins_sim::scenario::Scenario;
@@ -39,6 +41,9 @@ pub enum Method {
     Coarse1,
     /// 2-step: levelling + gyrocompassing (spec §1.2)
     Coarse2,
+    /// inertial-frame coarse alignment, robust to sway, rocking, heave and surge
+    /// (docs/alignment_i0.md); the attitude at the end of the window
+    I0,
     /// 12-state zero-velocity Kalman fine alignment (spec §2)
     Fine,
     /// multi-heading: one filter with body-frame bias states across rotations (spec §3.2)
@@ -55,11 +60,21 @@ pub enum Alg {
     B,
 }
 
+/// Start of the fine filter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Start {
+    /// inertial-frame alignment over --window-s (disturbed bases)
+    I0,
+    /// 2-step coarse alignment over --window-s (benign pad)
+    Coarse2,
+}
+
 /// Arguments of `sdins align`.
 #[derive(clap::Args, Debug)]
 #[command(
     after_help = "Examples:\n  sdins align alignment --method fine --run 3 --json\n  \
     sdins align --imu lasergyro.imu --format psins --method coarse2 --window-s 300\n  \
+    sdins align moored-ship --method i0 --window-s 300\n  \
     sdins align --observability"
 )]
 pub struct Args {
@@ -77,6 +92,10 @@ pub struct Args {
     /// multi-heading algorithm
     #[arg(long, value_enum, default_value = "a")]
     pub alg: Alg,
+    /// start of the fine filter: i0 (default; σ_z sized from the disturbance, start
+    /// refined once, docs/alignment_i0.md §6) or coarse2 (2-step, σ_z as given)
+    #[arg(long, value_enum, default_value = "i0")]
+    pub start: Start,
     /// latitude [deg] (files without one in the header; overrides a header)
     #[arg(long, allow_hyphen_values = true)]
     pub lat: Option<f64>,
@@ -92,7 +111,8 @@ pub struct Args {
     /// error-model run index (scenarios)
     #[arg(long, default_value_t = 0)]
     pub run: u64,
-    /// filter: zero-velocity measurement σ [m/s]
+    /// filter: zero-velocity measurement σ [m/s] (with --start i0 a floor: the i0 fit's
+    /// velocity residual sizes it on a disturbed base)
     #[arg(long, default_value_t = 1e-3)]
     pub sigma_z: f64,
     /// filter: VRW [μg/√Hz] (default: the scenario's, else aviation grade 20)
@@ -255,6 +275,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.window_s
         )));
     }
+    if !(args.sigma_z.is_finite() && args.sigma_z > 0.0) {
+        return Err(CliError::bad(format!(
+            "--sigma-z {}: expected a positive velocity σ in m/s",
+            args.sigma_z
+        )));
+    }
     let mut inp = load(&args)?;
     if let Some(d) = args.duration_s {
         let n = (d / inp.dt_s).round().max(0.0) as usize;
@@ -343,15 +369,35 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 att_sigma: None,
             }
         }
+        Method::I0 => Result1 {
+            method: "i0".into(),
+            c_b_n: i0_window(&inp.incs, dt, 0, nw, &inp.site).map_err(bad)?,
+            accel_bias: None,
+            gyro_bias: None,
+            att_sigma: None,
+        },
         Method::Fine => {
-            let c0 = coarse_window(&inp.incs, dt, 0, nw, &inp.site, CoarseMethod::TwoStep)
-                .map_err(bad)?;
-            let mut fa = FineAlign::new(cfg, &c0);
-            for (j, inc) in inp.incs.iter().enumerate() {
-                if fa.step(inc, dt) {
-                    record(j, &fa);
+            let fa = match args.start {
+                Start::Coarse2 => {
+                    let c0 = coarse_window(&inp.incs, dt, 0, nw, &inp.site, CoarseMethod::TwoStep)
+                        .map_err(bad)?;
+                    let mut fa = FineAlign::new(cfg, &c0);
+                    for (j, inc) in inp.incs.iter().enumerate() {
+                        if fa.step(inc, dt) {
+                            record(j, &fa);
+                        }
+                    }
+                    fa
                 }
-            }
+                Start::I0 => {
+                    let (fa, _, sz) =
+                        fine_from_i0(&inp.incs, dt, cfg, nw, |j, fa| record(j, fa)).map_err(bad)?;
+                    if !args.json {
+                        println!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
+                    }
+                    fa
+                }
+            };
             Result1 {
                 method: "fine".into(),
                 c_b_n: fa.c_b_n(),
@@ -390,6 +436,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let c_true_end = inp.truth.as_ref().and_then(|t| {
         let j = match args.method {
             Method::Coarse1 | Method::Coarse2 => 0,
+            Method::I0 => nw - 1,
             _ => inp.incs.len().saturating_sub(1),
         };
         t.get(j).copied()
@@ -602,6 +649,7 @@ fn write_align_toml(
     let method = match args.method {
         Method::Coarse1 => "coarse1",
         Method::Coarse2 => "coarse2",
+        Method::I0 => "i0",
         Method::Fine => "fine",
         Method::Multiheading => "multiheading",
     };

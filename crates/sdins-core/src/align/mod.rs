@@ -7,6 +7,8 @@
 //! * [`model`]: the 12-state stationary error model `F`, its discretisation, the null
 //!   space `n1, n2, n3`, the pseudo (observable) coordinates and the finite-prior
 //!   residual projector `Π` (spec §2.1, §2.3, §2.4).
+//! * [`i0`]: inertial-frame coarse alignment on a disturbed (swaying, heaving) base
+//!   (gravity's apparent motion in the inertially frozen body frame, Wahba fit).
 //! * [`kf`]: the generic Kalman filter core (prediction, Joseph-form update).
 //! * [`fine`]: the 12-state zero-velocity Kalman fine alignment with its own stationary
 //!   attitude/velocity propagation, closed-loop reset or feed-forward (spec §2.2–§2.3,
@@ -25,6 +27,7 @@
 
 pub mod coarse;
 pub mod fine;
+pub mod i0;
 pub mod kf;
 pub mod model;
 pub mod multiheading;
