@@ -35,5 +35,7 @@ def test_shards_on_a_local_cluster_merge_bit_for_bit():
         a, b = getattr(merged, k), getattr(whole, k)
         assert a.tobytes() == b.tobytes(), k
     assert merged.state == whole.state
-    # and the statistics are not trivial (the sensors are noisy)
-    assert np.all(merged.sigma[-1] > 0)
+    # and the statistics are not trivial: the sensors are noisy (the held vertical
+    # channel, pos D and vel D, has no spread)
+    horizontal = [0, 1, 3, 4, 6, 7, 8]
+    assert np.all(merged.sigma[-1, horizontal] > 0)

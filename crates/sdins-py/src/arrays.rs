@@ -36,7 +36,9 @@ pub fn increments(
             dtheta_b_rad: Vec3::new(x[[k, 0]], x[[k, 1]], x[[k, 2]]),
             dv_b_mps: Vec3::new(y[[k, 0]], y[[k, 1]], y[[k, 2]]),
         };
-        if !(inc.dtheta_b_rad.iter().all(|v| v.is_finite()) && inc.dv_b_mps.iter().all(|v| v.is_finite())) {
+        if !(inc.dtheta_b_rad.iter().all(|v| v.is_finite())
+            && inc.dv_b_mps.iter().all(|v| v.is_finite()))
+        {
             return Err(err(format!("dtheta/dv row {k}: not finite")));
         }
         out.push(inc);

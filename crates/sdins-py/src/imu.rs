@@ -83,10 +83,8 @@ pub fn corrupt<'py>(
     let m = model(grade, errors)?;
     let incs = increments(&dtheta, &dv)?;
     let (seed, run) = (seed.unwrap_or(1), run.unwrap_or(0));
-    let out = interrupt::run(py, |_| {
-        sdins_sim::align::corrupt(&incs, dt, &m, seed, run)
-    })?
-    .map_err(err)?;
+    let out = interrupt::run(py, |_| sdins_sim::align::corrupt(&incs, dt, &m, seed, run))?
+        .map_err(err)?;
     from_increments(py, &out)
 }
 

@@ -32,7 +32,10 @@ pub fn run<T: Send>(py: Python<'_>, work: impl FnOnce(&CancelToken) -> T + Send)
         let mut interrupt: Option<PyErr> = None;
         loop {
             let finished = py.detach(|| match done.0.lock() {
-                Ok(g) => match done.1.wait_timeout_while(g, Duration::from_millis(20), |d| !*d) {
+                Ok(g) => match done
+                    .1
+                    .wait_timeout_while(g, Duration::from_millis(20), |d| !*d)
+                {
                     Ok((g, _)) => *g,
                     Err(_) => true,
                 },

@@ -23,8 +23,8 @@ impl McState {
     /// Restore a state from its JSON text (`mc_state.json` of `sdins montecarlo`).
     #[new]
     fn new(json: &str) -> PyResult<Self> {
-        let state: State = serde_json::from_str(json)
-            .map_err(|e| err(format!("not a Monte Carlo state: {e}")))?;
+        let state: State =
+            serde_json::from_str(json).map_err(|e| err(format!("not a Monte Carlo state: {e}")))?;
         state.validate().map_err(err)?;
         Ok(McState { state })
     }

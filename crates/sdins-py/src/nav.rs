@@ -156,7 +156,9 @@ pub fn navigate<'py>(
     let earth = run_setup::earth_by_name(earth.unwrap_or("wgs84")).map_err(err)?;
     let init = initial(init)?;
     // the recorded-navigation defaults of `sdins nav`: songlee-complete, N = 1
-    let nav = sdins_sim::scenario::Scenario::load("stationary").map_err(err)?.nav;
+    let nav = sdins_sim::scenario::Scenario::load("stationary")
+        .map_err(err)?
+        .nav;
     let choice = AlgoChoice {
         algos: Some(algo.unwrap_or_else(|| "songlee-complete".into())),
         samples: Some(samples.unwrap_or(1)),
@@ -213,7 +215,9 @@ pub fn run<'py>(
             Ok(s) => s,
             Err(_) => a
                 .extract::<Vec<String>>()
-                .map_err(|_| err("algos: expected a name, a comma-separated string or a list of names"))?
+                .map_err(|_| {
+                    err("algos: expected a name, a comma-separated string or a list of names")
+                })?
                 .join(","),
         }),
     };
@@ -231,8 +235,8 @@ pub fn run<'py>(
     }
     let hold = run_setup::vertical_hold(vertical, scn.nav.vertical_hold).map_err(err)?;
     let dt_u = scn.imu.dt_s() * specs[0].samples as f64;
-    let every =
-        run_setup::every_updates(every_s.unwrap_or(run_setup::DEFAULT_EVERY_S), dt_u).map_err(err)?;
+    let every = run_setup::every_updates(every_s.unwrap_or(run_setup::DEFAULT_EVERY_S), dt_u)
+        .map_err(err)?;
     if let Some(u) = until_s {
         if !(u.is_finite() && u > 0.0) {
             return Err(err(format!("--until-s {u}: expected > 0")));
@@ -251,8 +255,9 @@ pub fn run<'py>(
     };
     let k = specs.len();
     let (cols, sums) = interrupt::run(py, |tok| {
-        let mut cols: Vec<(States, Errors)> =
-            (0..k).map(|_| (States::default(), Errors::default())).collect();
+        let mut cols: Vec<(States, Errors)> = (0..k)
+            .map(|_| (States::default(), Errors::default()))
+            .collect();
         let r = run_cancellable(
             scn,
             &opts,

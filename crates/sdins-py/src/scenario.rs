@@ -40,7 +40,11 @@ impl Scenario {
             Some(b) => Scenario::parse(b.toml, &format!("<built-in {}>", b.name)),
             None => Err(err(sdins_sim::scenario::ScenarioError::Unknown {
                 name: name.to_string(),
-                known: BUILTINS.iter().map(|b| b.name).collect::<Vec<_>>().join(", "),
+                known: BUILTINS
+                    .iter()
+                    .map(|b| b.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
             })),
         }
     }
@@ -108,7 +112,11 @@ impl Scenario {
     /// Start (lat_rad, lon_rad, h_m).
     #[getter]
     fn start(&self) -> (f64, f64, f64) {
-        (self.scn.start.lat_rad, self.scn.start.lon_rad, self.scn.start.h_m)
+        (
+            self.scn.start.lat_rad,
+            self.scn.start.lon_rad,
+            self.scn.start.h_m,
+        )
     }
 
     fn __getnewargs__(&self) -> (String, String) {

@@ -42,7 +42,15 @@ impl Columns {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn push_row(&mut self, t: f64, lat: f64, lon: f64, h: f64, v: [f64; 3], c: &sdins_core::math::Mat3) {
+    fn push_row(
+        &mut self,
+        t: f64,
+        lat: f64,
+        lon: f64,
+        h: f64,
+        v: [f64; 3],
+        c: &sdins_core::math::Mat3,
+    ) {
         let e = euler_from_c_b_n(c);
         let q = Quat::from_dcm(c);
         self.t_s.push(t);
@@ -50,7 +58,8 @@ impl Columns {
         self.lon_rad.push(lon);
         self.h_m.push(h);
         self.v_ned_mps.extend_from_slice(&v);
-        self.euler_rad.extend_from_slice(&[e.roll_rad, e.pitch_rad, e.yaw_rad]);
+        self.euler_rad
+            .extend_from_slice(&[e.roll_rad, e.pitch_rad, e.yaw_rad]);
         self.q_b_n.extend_from_slice(&[q.w, q.x, q.y, q.z]);
     }
 }
@@ -79,18 +88,34 @@ fn generate(
     let init = gen.initial_state();
     let mut c = Columns::with_capacity(1 + n / every as usize, if imu { n } else { 0 });
     let v0 = init.v_n_mps;
-    c.push_row(0.0, init.lat_rad, init.lon_rad, init.h_m, [v0.x, v0.y, v0.z], &init.c_b_n);
+    c.push_row(
+        0.0,
+        init.lat_rad,
+        init.lon_rad,
+        init.h_m,
+        [v0.x, v0.y, v0.z],
+        &init.c_b_n,
+    );
     for (k, s) in gen.take(n).enumerate() {
         let s: TruthSample = s;
         if imu {
             let i = &s.inc;
             c.imu_t_s.push(s.t_s);
-            c.dtheta_rad.extend_from_slice(&[i.dtheta_b_rad.x, i.dtheta_b_rad.y, i.dtheta_b_rad.z]);
-            c.dv_mps.extend_from_slice(&[i.dv_b_mps.x, i.dv_b_mps.y, i.dv_b_mps.z]);
+            c.dtheta_rad
+                .extend_from_slice(&[i.dtheta_b_rad.x, i.dtheta_b_rad.y, i.dtheta_b_rad.z]);
+            c.dv_mps
+                .extend_from_slice(&[i.dv_b_mps.x, i.dv_b_mps.y, i.dv_b_mps.z]);
         }
-        if (k as u64 + 1).is_multiple_of(every) {
+        if (k as u64 + 1) % every == 0 {
             let v = s.v_n_mps;
-            c.push_row(s.t_s, s.lat_rad, s.lon_rad, s.h_m, [v.x, v.y, v.z], &s.c_b_n);
+            c.push_row(
+                s.t_s,
+                s.lat_rad,
+                s.lon_rad,
+                s.h_m,
+                [v.x, v.y, v.z],
+                &s.c_b_n,
+            );
         }
         if k % 65536 == 0 {
             cancel.check()?;
@@ -116,12 +141,16 @@ pub fn truth<'py>(
     }
     if let Some(u) = until_s {
         if !(u.is_finite() && u > 0.0) {
-            return Err(err(format!("until_s {u}: expected a positive number of seconds")));
+            return Err(err(format!(
+                "until_s {u}: expected a positive number of seconds"
+            )));
         }
     }
     let scn = &scenario.scn;
-    let c = interrupt::run(py, |tok| generate(scn, until_s, every, imu.unwrap_or(true), tok))?
-        .map_err(|_| err("interrupted"))?;
+    let c = interrupt::run(py, |tok| {
+        generate(scn, until_s, every, imu.unwrap_or(true), tok)
+    })?
+    .map_err(|_| err("interrupted"))?;
     let d = PyDict::new(py);
     d.set_item("dt_s", scn.imu.dt_s())?;
     d.set_item("t_s", vector(py, c.t_s))?;

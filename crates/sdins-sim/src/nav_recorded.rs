@@ -240,7 +240,17 @@ mod tests {
         assert_eq!(r.errors.len(), 5000);
         let tok = CancelToken::new();
         tok.cancel();
-        assert!(navigate(&spec, cfg.earth, cfg.dt_s, 0.0, &init, &incs, None, &tok, |_, _| {})
-            .is_err());
+        assert!(navigate(
+            &spec,
+            cfg.earth,
+            cfg.dt_s,
+            0.0,
+            &init,
+            &incs,
+            None,
+            &tok,
+            |_, _| {}
+        )
+        .is_err());
     }
 }

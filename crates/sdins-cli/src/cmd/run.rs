@@ -115,7 +115,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         return Err(CliError::bad("--algo: no algorithm given"));
     }
     let bad = |e: run_setup::OptionError| CliError::BadInput(e.to_string());
-    let hold = run_setup::vertical_hold(args.vertical.as_deref(), scn.nav.vertical_hold).map_err(bad)?;
+    let hold =
+        run_setup::vertical_hold(args.vertical.as_deref(), scn.nav.vertical_hold).map_err(bad)?;
     let n = algos[0].samples;
     let dt_u = scn.imu.dt_s() * n as f64;
     let every = run_setup::every_updates(args.every_s, dt_u).map_err(bad)?;
