@@ -101,8 +101,9 @@ def test_nav_over_imu_file_bit_identical(cli, tmp_path):
                          samples=3, t0_s=rec.t0_s - rec.dt_s)
     assert nav.updates == js["imu_samples"] // 3
     _, rows = read_csv(tmp_path / "n" / "nav_songlee.csv")
+    d2r = math.pi / 180.0  # `sdins nav` writes value_rad / (π / 180)
     got = np.column_stack(
-        [nav.t_s, nav.lat_rad * D, nav.lon_rad * D, nav.h_m, nav.v_ned_mps, nav.euler_rad * D]
+        [nav.t_s, nav.lat_rad / d2r, nav.lon_rad / d2r, nav.h_m, nav.v_ned_mps, nav.euler_rad / d2r]
     )
     assert np.array_equal(got, np.array(rows, dtype=float))
 

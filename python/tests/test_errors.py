@@ -41,7 +41,7 @@ def test_bad_scenario_file_same_message_as_cli(cli, tmp_path, text):
         (dict(samples=7), ["--samples", "7"]),
         (dict(coning="four_poly", samples=3), ["--coning", "four_poly", "--samples", "3"]),
         (dict(vertical="up"), ["--vertical", "up"]),
-        (dict(every_s=-1.0), ["--every-s", "-1"]),
+        (dict(every_s=-1.0), ["--every-s=-1"]),
     ],
 )
 def test_bad_run_options_same_message_as_cli(cli, tmp_path, kwargs, cli_args):
