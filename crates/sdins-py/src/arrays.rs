@@ -29,19 +29,20 @@ pub fn increments(
             "dtheta and dv: expected two (n, 3) arrays of the same n, got {a:?} and {b:?}"
         )));
     }
-    let (x, y) = (dtheta.as_array(), dv.as_array());
+    // the wrapper passes C-contiguous arrays: read them as flat row-major slices
+    let (x, y) = match (dtheta.as_slice(), dv.as_slice()) {
+        (Ok(x), Ok(y)) => (x, y),
+        _ => return Err(err("dtheta and dv: expected C-contiguous float64 arrays")),
+    };
     let mut out = Vec::with_capacity(a[0]);
-    for k in 0..a[0] {
-        let inc = Increment {
-            dtheta_b_rad: Vec3::new(x[[k, 0]], x[[k, 1]], x[[k, 2]]),
-            dv_b_mps: Vec3::new(y[[k, 0]], y[[k, 1]], y[[k, 2]]),
-        };
-        if !(inc.dtheta_b_rad.iter().all(|v| v.is_finite())
-            && inc.dv_b_mps.iter().all(|v| v.is_finite()))
-        {
+    for (k, (p, q)) in x.chunks_exact(3).zip(y.chunks_exact(3)).enumerate() {
+        if !(p.iter().all(|v| v.is_finite()) && q.iter().all(|v| v.is_finite())) {
             return Err(err(format!("dtheta/dv row {k}: not finite")));
         }
-        out.push(inc);
+        out.push(Increment {
+            dtheta_b_rad: Vec3::new(p[0], p[1], p[2]),
+            dv_b_mps: Vec3::new(q[0], q[1], q[2]),
+        });
     }
     Ok(out)
 }
