@@ -129,7 +129,7 @@ def navigate(
     yaw_deg`` as 9 numbers or the CLI's comma-separated string. ``algo``: savage,
     songlee, songlee-complete (default) or dualquat; ``samples``: IMU samples per update
     N (1..4, default 1; a trailing partial update is dropped); ``coning``: coning/sculling
-    set (default: polynomial set of N); ``earth``: wgs84 (default), wgs84-linear, psins,
+    set (default: 1prev for N = 1, else the polynomial set of N); ``earth``: wgs84 (default), wgs84-linear, psins,
     flat; ``vertical``: free (default; a held channel needs a reference, see ``run``);
     ``t0_s``: time of ``init`` [s] (default 0). Returns the state after every update.
     """
@@ -189,7 +189,7 @@ def allan(dtheta: Any, dv: Any, dt: float) -> AllanResult:
 def montecarlo(
     scenario: Union[Scenario, str],
     runs: int,
-    seed: int,
+    seed: Optional[int] = None,
     shard: Optional[Tuple[int, int]] = None,
     algo: Optional[str] = None,
     samples: Optional[int] = None,
@@ -201,7 +201,8 @@ def montecarlo(
     threads: Optional[int] = None,
 ) -> McState:
     """Compute shard ``shard = (i, n)`` (default: the whole job) of a Monte Carlo job of
-    ``runs`` runs with sensor-error ``seed`` (``sdins montecarlo --shard i/n``).
+    ``runs`` runs with sensor-error ``seed`` (default: the scenario's ``[imu] seed``)
+    (``sdins montecarlo --shard i/n``).
 
     ``algo`` (default songlee-complete), ``samples`` (default the scenario's N),
     ``grade`` (replaces the scenario's error model), ``every_s`` (epoch spacing, default

@@ -128,13 +128,13 @@ fn stats_dict<'py>(py: Python<'py>, st: &State) -> PyResult<Bound<'py, PyDict>> 
 
 /// Compute shard `shard = (i, n)` of a Monte Carlo job (see the wrapper's docstring).
 #[pyfunction]
-#[pyo3(signature = (scenario, runs, seed, shard=None, algo=None, samples=None, grade=None, every_s=None, until_s=None, vertical=None, block=None, threads=None))]
+#[pyo3(signature = (scenario, runs, seed=None, shard=None, algo=None, samples=None, grade=None, every_s=None, until_s=None, vertical=None, block=None, threads=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn montecarlo(
     py: Python<'_>,
     scenario: &Scenario,
     runs: u64,
-    seed: u64,
+    seed: Option<u64>,
     shard: Option<(u64, u64)>,
     algo: Option<String>,
     samples: Option<usize>,

@@ -8,6 +8,7 @@
 
 use crate::cancel::{CancelToken, Cancelled};
 use crate::imu_file::ImuData;
+use crate::initial::validate_initial_state;
 use crate::pipeline::{nav_error, NavError};
 use crate::truth::TruthSample;
 use crate::truth_file::c_b_n_from_psins;
@@ -55,28 +56,44 @@ pub fn initial_state(
                     data.dt_s
                 )));
             }
-            return Ok(InitialState {
+            let s = InitialState {
                 lat_rad: r.lat_rad,
                 lon_rad: r.lon_rad,
                 h_m: r.h_m,
                 v_n_mps: r.v_n_mps,
                 c_b_n: r.c_b_n,
-            });
+            };
+            validate_initial_state(&s).map_err(|e| {
+                NavInputError::Bad(format!(
+                    "{}: first row (the initial state): {e}",
+                    tp.display()
+                ))
+            })?;
+            return Ok(s);
         }
     }
     match &data.psins {
-        Some(h) => Ok(InitialState {
-            lat_rad: h.lat_deg * D2R,
-            lon_rad: h.lon_deg * D2R,
-            h_m: h.h_m,
-            // PSINS velocity is ENU
-            v_n_mps: Vec3::new(h.vel0_enu_mps[1], h.vel0_enu_mps[0], -h.vel0_enu_mps[2]),
-            c_b_n: c_b_n_from_psins(
-                h.att0_deg[0] * D2R,
-                h.att0_deg[1] * D2R,
-                h.att0_deg[2] * D2R,
-            ),
-        }),
+        Some(h) => {
+            let s = InitialState {
+                lat_rad: h.lat_deg * D2R,
+                lon_rad: h.lon_deg * D2R,
+                h_m: h.h_m,
+                // PSINS velocity is ENU
+                v_n_mps: Vec3::new(h.vel0_enu_mps[1], h.vel0_enu_mps[0], -h.vel0_enu_mps[2]),
+                c_b_n: c_b_n_from_psins(
+                    h.att0_deg[0] * D2R,
+                    h.att0_deg[1] * D2R,
+                    h.att0_deg[2] * D2R,
+                ),
+            };
+            validate_initial_state(&s).map_err(|e| {
+                NavInputError::Bad(format!(
+                    "{}: PSINS header (the initial state): {e}",
+                    imu_path.display()
+                ))
+            })?;
+            Ok(s)
+        }
         None => Err(NavInputError::Bad(
             "--init is required (no truth file or PSINS header to take it from)".into(),
         )),

@@ -42,7 +42,8 @@ pub struct AlgoChoice {
 }
 
 /// Build the algorithm list: names default to `nav.algos`, samples to `nav.samples`,
-/// the coning set to `nav.coning` or the polynomial set of N (coning.md).
+/// the coning set to `nav.coning`, else 1prev for N = 1 and the polynomial set of N
+/// otherwise ([`ConingSet::recommended_for`], coning.md).
 pub fn algorithms(c: &AlgoChoice, nav: &NavConfig) -> Result<Vec<AlgorithmSpec>, OptionError> {
     let n = c.samples.unwrap_or(nav.samples);
     if !(1..=4).contains(&n) {
@@ -58,7 +59,7 @@ pub fn algorithms(c: &AlgoChoice, nav: &NavConfig) -> Result<Vec<AlgorithmSpec>,
     };
     let coning_name = c.coning.clone().or_else(|| nav.coning.clone());
     let coning = match &coning_name {
-        None => ConingSet::default_for(n),
+        None => ConingSet::recommended_for(n),
         Some(name) => {
             let set = ConingSet::parse(name, n).ok_or_else(|| {
                 bad(format!(
@@ -166,8 +167,8 @@ pub fn apply_grade(scn: &mut Scenario, grade: &str) -> Result<(), OptionError> {
 pub struct McChoice {
     /// number of runs
     pub runs: u64,
-    /// seed of the sensor-error streams
-    pub seed: u64,
+    /// seed of the sensor-error streams (default: the scenario's `[imu] seed`)
+    pub seed: Option<u64>,
     /// algorithm name (default songlee-complete)
     pub algo: Option<String>,
     /// samples per update (default: the scenario's)
@@ -186,11 +187,12 @@ pub struct McChoice {
 pub fn mc_options(scn: &Scenario, c: &McChoice) -> Result<McOptions, OptionError> {
     let n = c.samples.unwrap_or(scn.nav.samples);
     let name = c.algo.as_deref().unwrap_or("songlee-complete");
-    let algo = AlgorithmSpec::from_name(name, n).ok_or_else(|| {
+    let mut algo = AlgorithmSpec::from_name(name, n).ok_or_else(|| {
         bad(format!(
             "--algo {name}: expected savage, songlee, songlee-complete or dualquat"
         ))
     })?;
+    algo.coning = ConingSet::recommended_for(n);
     if !(1..=4).contains(&n) {
         return Err(bad(format!("--samples {n}: expected 1..=4")));
     }
@@ -206,7 +208,7 @@ pub fn mc_options(scn: &Scenario, c: &McChoice) -> Result<McOptions, OptionError
     }
     Ok(McOptions {
         runs: c.runs,
-        seed: c.seed,
+        seed: c.seed.unwrap_or(scn.imu.seed),
         algo,
         every_s: c.every_s.unwrap_or(DEFAULT_MC_EVERY_S),
         until_s: c.until_s,

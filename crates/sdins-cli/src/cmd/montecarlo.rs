@@ -34,9 +34,10 @@ pub struct Args {
     /// number of runs N (all shards must use the same N)
     #[arg(long)]
     pub runs: u64,
-    /// seed of the sensor-error streams (replaces the scenario's [imu] seed)
+    /// seed of the sensor-error streams (default: the scenario's [imu] seed, itself 1 by
+    /// default; every shard of one job must use the same seed)
     #[arg(long)]
-    pub seed: u64,
+    pub seed: Option<u64>,
     /// algorithm: savage, songlee, songlee-complete, dualquat
     #[arg(long, default_value = "songlee-complete")]
     pub algo: String,

@@ -15,7 +15,7 @@ const D2R: f64 = std::f64::consts::PI / 180.0;
 /// Arguments of `sdins nav`.
 #[derive(clap::Args, Debug)]
 #[command(
-    after_help = "Examples:\n  sdins nav --imu imu.csv --init 37.5,127,0,0,340.29,0,0,0,90 --algo songlee\n  sdins nav --imu trj10ms_imu.csv --format psins-csv --earth psins --truth trj10ms_avp.csv --algo songlee-complete --samples 1"
+    after_help = "Examples:\n  sdins truth turn-90dps --out t && sdins nav --imu t/imu.csv --truth t/truth.csv --algo songlee --samples 3\n  sdins nav --imu trj10ms_imu.csv --format psins-csv --earth psins --truth trj10ms_avp.csv --init 34.246048,108.909664,380,0,0,0,0,0,0"
 )]
 pub struct Args {
     /// IMU file: sdins CSV, PSINS .imu, PSINS trj CSV (psins-csv), KF-GINS text, NaveGo CSV
@@ -34,7 +34,8 @@ pub struct Args {
     /// IMU samples per navigation update (1..=4)
     #[arg(long, default_value_t = 1)]
     pub samples: usize,
-    /// coning/sculling set (default: the polynomial set of N)
+    /// coning/sculling set (default: 1prev for one sample per update, else the polynomial
+    /// set of N; `none` switches the correction off)
     #[arg(long)]
     pub coning: Option<String>,
     /// earth model: wgs84, wgs84-linear (gravity γ(L)(1 − 2h/a), as pyins), psins, flat
@@ -126,6 +127,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )
     .map_err(io)?;
     let mut write_err = None;
+    let mut final_state = None;
+    // what was used, so that nobody has to guess a default
+    eprintln!(
+        "sdins nav: {} format {}, algorithm {}, N = {}, coning {}, earth {}",
+        args.imu.display(),
+        if format == ImuFormat::Auto {
+            format!("{} (detected)", data.format.name())
+        } else {
+            data.format.name().to_string()
+        },
+        spec.kind.name(),
+        spec.samples,
+        spec.coning.name(),
+        args.earth
+    );
     let rec = nav_recorded::navigate(
         &spec,
         earth,
@@ -136,6 +152,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         truth.as_deref(),
         &crate::progress::token(),
         |t, st| {
+            final_state = Some((t, *st));
             let e = st.euler();
             if let Err(err) = writeln!(
                 nav_file.writer(),
@@ -185,9 +202,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let last = errs.last();
     if args.json {
+        let state = final_state.map(|(t, st)| {
+            let e = st.euler();
+            serde_json::json!({
+                "t_s": t, "lat_deg": st.lat_rad / D2R, "lon_deg": st.lon_rad / D2R, "h_m": st.h_m,
+                "v_ned_mps": [st.v_n_mps.x, st.v_n_mps.y, st.v_n_mps.z],
+                "roll_deg": e.roll_rad / D2R, "pitch_deg": e.pitch_rad / D2R, "yaw_deg": e.yaw_rad / D2R,
+            })
+        });
         let v = serde_json::json!({
-            "algo": spec.kind.name(), "samples": spec.samples, "imu_samples": data.increments.len(),
-            "dt_s": data.dt_s, "wall_s": wall, "final": last,
+            "algo": spec.kind.name(), "samples": spec.samples, "coning": spec.coning.name(),
+            "earth": args.earth, "format": data.format.name(), "imu_samples": data.increments.len(),
+            "dt_s": data.dt_s, "wall_s": wall, "final": last, "final_state": state,
         });
         println!(
             "{}",
