@@ -5,7 +5,7 @@
    navigation-loop time the library measures inside the same call (`wall_s`) and
    `sdins nav --json` (`wall_s`) on the same samples written as imu.csv.
 2. Peak memory of `sdins.truth` on mach1-east (2.7 M samples), measured in a fresh
-   subprocess as the growth of the peak RSS (ru_maxrss) over the imported baseline.
+   subprocess as the growth of the peak RSS (VmHWM) over the imported baseline.
 
     python bench/python_bench.py [--sdins target/release/sdins] [--repeat 5]
 """
@@ -23,13 +23,17 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 MEM_SNIPPET = r"""
-import resource, sys, sdins
-base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+import sys, sdins
+def kib(key):
+    for line in open("/proc/self/status"):
+        if line.startswith(key):
+            return int(line.split()[1])
+base = kib("VmHWM:")
 kw = eval(sys.argv[1])
 t = sdins.truth("mach1-east", **kw)
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+peak = kib("VmHWM:")
 arrays = sum(getattr(t, k).nbytes for k in vars(t) if hasattr(getattr(t, k), "nbytes"))
-print(peak - base, arrays, len(t.imu_t_s), len(t))
+print(peak - base, arrays, len(t.imu_t_s), len(t), kib("VmRSS:") - base)
 """
 
 
@@ -77,9 +81,9 @@ def main():
     print("peak memory of sdins.truth('mach1-east', ...), fresh process:")
     for kw in ("{}", "{'every': 500}", "{'every': 500, 'imu': False}", "{'until_s': 600.0}"):
         r = subprocess.run([sys.executable, "-c", MEM_SNIPPET, kw], capture_output=True, text=True, check=True)
-        grow_kib, arrays, n_imu, rows = map(int, r.stdout.split())
+        grow_kib, arrays, n_imu, rows, rss_kib = map(int, r.stdout.split())
         print(f"  {kw:32} {n_imu:8d} IMU samples {rows:8d} rows: arrays {arrays / 2**20:7.1f} MiB, "
-              f"peak RSS growth {grow_kib / 1024:7.1f} MiB")
+              f"peak RSS (VmHWM) growth {grow_kib / 1024:7.1f} MiB, RSS after {rss_kib / 1024:7.1f} MiB")
 
 
 if __name__ == "__main__":
