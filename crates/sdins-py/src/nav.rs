@@ -156,9 +156,7 @@ pub fn navigate<'py>(
     let earth = run_setup::earth_by_name(earth.unwrap_or("wgs84")).map_err(err)?;
     let init = initial(init)?;
     // the recorded-navigation defaults of `sdins nav`: songlee-complete, N = 1
-    let nav = sdins_sim::scenario::Scenario::load("stationary")
-        .map_err(err)?
-        .nav;
+    let nav = run_setup::recorded_nav_defaults();
     let choice = AlgoChoice {
         algos: Some(algo.unwrap_or_else(|| "songlee-complete".into())),
         samples: Some(samples.unwrap_or(1)),

@@ -28,7 +28,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let init = gen.initial_state();
     let (mut dth, mut dv) = (Vec::new(), Vec::new());
     for s in gen.take(360_000) {
-        dth.extend_from_slice(&[s.inc.dtheta_b_rad.x, s.inc.dtheta_b_rad.y, s.inc.dtheta_b_rad.z]);
+        dth.extend_from_slice(&[
+            s.inc.dtheta_b_rad.x,
+            s.inc.dtheta_b_rad.y,
+            s.inc.dtheta_b_rad.z,
+        ]);
         dv.extend_from_slice(&[s.inc.dv_b_mps.x, s.inc.dv_b_mps.y, s.inc.dv_b_mps.z]);
     }
     let spec = AlgorithmSpec::from_name("songlee-complete", 3).ok_or("algorithm")?;
@@ -45,18 +49,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             })
             .collect();
         let n = incs.len() / 3;
-        let mut cols: [Vec<f64>; 7] = std::array::from_fn(|k| Vec::with_capacity(n * [1, 1, 1, 1, 3, 3, 4][k]));
-        let r = navigate(&spec, cfg.earth, cfg.dt_s, 0.0, &init, &incs, None, &CancelToken::new(), |t, s| {
-            let e = s.euler();
-            let q = s.q_b_n();
-            cols[0].push(t);
-            cols[1].push(s.lat_rad);
-            cols[2].push(s.lon_rad);
-            cols[3].push(s.h_m);
-            cols[4].extend_from_slice(&[s.v_n_mps.x, s.v_n_mps.y, s.v_n_mps.z]);
-            cols[5].extend_from_slice(&[e.roll_rad, e.pitch_rad, e.yaw_rad]);
-            cols[6].extend_from_slice(&[q.w, q.x, q.y, q.z]);
-        })
+        let mut cols: [Vec<f64>; 7] =
+            std::array::from_fn(|k| Vec::with_capacity(n * [1, 1, 1, 1, 3, 3, 4][k]));
+        let r = navigate(
+            &spec,
+            cfg.earth,
+            cfg.dt_s,
+            0.0,
+            &init,
+            &incs,
+            None,
+            &CancelToken::new(),
+            |t, s| {
+                let e = s.euler();
+                let q = s.q_b_n();
+                cols[0].push(t);
+                cols[1].push(s.lat_rad);
+                cols[2].push(s.lon_rad);
+                cols[3].push(s.h_m);
+                cols[4].extend_from_slice(&[s.v_n_mps.x, s.v_n_mps.y, s.v_n_mps.z]);
+                cols[5].extend_from_slice(&[e.roll_rad, e.pitch_rad, e.yaw_rad]);
+                cols[6].extend_from_slice(&[q.w, q.x, q.y, q.z]);
+            },
+        )
         .map_err(|_| "cancelled")?;
         times.push(t0.elapsed().as_secs_f64());
         loops.push(r.wall_s);

@@ -6,7 +6,7 @@
 
 use crate::imu_error::ImuErrorModel;
 use crate::montecarlo::McOptions;
-use crate::scenario::{NavConfig, Scenario};
+use crate::scenario::{EarthChoice, NavConfig, Scenario};
 use sdins_core::coning::ConingSet;
 use sdins_core::earth::EarthModel;
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AttitudeMode, RotVector};
@@ -39,6 +39,20 @@ pub struct AlgoChoice {
     pub rotvec: Option<String>,
     /// add the third-order rotation compensation
     pub rot3: bool,
+}
+
+/// The navigation defaults of a recorded run (`sdins nav`, Python `sdins.navigate`), where
+/// there is no scenario: songlee-complete, N = 1, the recommended coning set of N, WGS-84,
+/// free vertical channel.
+pub fn recorded_nav_defaults() -> NavConfig {
+    NavConfig {
+        samples: 1,
+        algos: vec!["songlee-complete".to_string()],
+        coning: None,
+        earth: EarthChoice::Wgs84,
+        vertical_hold: false,
+        substeps: 1,
+    }
 }
 
 /// Build the algorithm list: names default to `nav.algos`, samples to `nav.samples`,

@@ -4,8 +4,7 @@ use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_sim::imu_file::{read_imu_file, ImuFormat};
 use sdins_sim::nav_recorded;
-use sdins_sim::run_setup::{algorithms, earth_by_name, AlgoChoice};
-use sdins_sim::scenario::Scenario;
+use sdins_sim::run_setup::{self, algorithms, earth_by_name, AlgoChoice};
 use sdins_sim::truth_file::read_truth;
 use std::io::Write;
 use std::path::PathBuf;
@@ -86,14 +85,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &data,
     )
     .map_err(|e| CliError::BadInput(e.to_string()))?;
-    let dummy = Scenario::load("stationary")?;
     let choice = AlgoChoice {
         algos: Some(args.algo.clone()),
         samples: Some(args.samples),
         coning: args.coning.clone(),
         ..AlgoChoice::default()
     };
-    let specs = algorithms(&choice, &dummy.nav).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let specs = algorithms(&choice, &run_setup::recorded_nav_defaults())
+        .map_err(|e| CliError::BadInput(e.to_string()))?;
     let Some(spec) = specs.first().copied() else {
         return Err(CliError::bad("--algo: no algorithm given"));
     };
