@@ -272,6 +272,29 @@ pub fn fit(c: &AllanCurve) -> AllanFit {
     f
 }
 
+/// Allan curves and fits of the six channels, SI units (rad/s, m/s²).
+pub struct AllanReport {
+    /// one curve per channel
+    pub curves: Vec<AllanCurve>,
+    /// one fit per channel
+    pub fits: Vec<AllanFit>,
+}
+
+/// The six Allan curves and fits (gyro x, y, z, accelerometer x, y, z) of FRD
+/// increments with period `dt_s`: the rates are Δθ/δt and Δv/δt (IEEE Std 952).
+pub fn analyse(incs: &[sdins_core::coning::Increment], dt_s: f64) -> AllanReport {
+    let mut curves = Vec::with_capacity(6);
+    for ch in 0..6 {
+        let rate: Vec<f64> = incs
+            .iter()
+            .map(|i| if ch < 3 { i.dtheta_b_rad[ch] } else { i.dv_b_mps[ch - 3] } / dt_s)
+            .collect();
+        curves.push(allan_deviation(&rate, dt_s));
+    }
+    let fits = curves.iter().map(fit).collect();
+    AllanReport { curves, fits }
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {

@@ -11,7 +11,6 @@
 use crate::error::CliError;
 use crate::output::write_string;
 use plotters::prelude::*;
-use sdins_sim::allan::{allan_deviation, fit, AllanCurve, AllanFit};
 use sdins_sim::imu_error::{
     ARCSEC, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H, UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ,
 };
@@ -48,27 +47,7 @@ pub const CHANNELS: [&str; 6] = [
     "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
 ];
 
-/// Allan curves and fits of the six channels, SI units (rad/s, m/s²).
-pub struct AllanReport {
-    /// one curve per channel
-    pub curves: Vec<AllanCurve>,
-    /// one fit per channel
-    pub fits: Vec<AllanFit>,
-}
-
-/// Compute the six Allan curves and fits of FRD increments with period `dt_s`.
-pub fn analyse(incs: &[sdins_core::coning::Increment], dt_s: f64) -> AllanReport {
-    let mut curves = Vec::with_capacity(6);
-    for ch in 0..6 {
-        let rate: Vec<f64> = incs
-            .iter()
-            .map(|i| if ch < 3 { i.dtheta_b_rad[ch] } else { i.dv_b_mps[ch - 3] } / dt_s)
-            .collect();
-        curves.push(allan_deviation(&rate, dt_s));
-    }
-    let fits = curves.iter().map(fit).collect();
-    AllanReport { curves, fits }
-}
+pub use sdins_sim::allan::{analyse, AllanReport};
 
 fn file_error(e: ImuFileError) -> CliError {
     match e {

@@ -13,10 +13,10 @@
 use crate::error::CliError;
 use crate::output::write_string;
 use crate::progress::Progress;
-use sdins_core::nav::AlgorithmSpec;
 use sdins_sim::imu_error::ImuErrorModel;
 use sdins_sim::montecarlo::runner::shard_runs;
-use sdins_sim::montecarlo::{run_shard, McError, McOptions, McState, McStats, Shard};
+use sdins_sim::montecarlo::{run_shard, McError, McState, McStats, Shard};
+use sdins_sim::run_setup;
 use sdins_sim::scenario::Scenario;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -51,7 +51,7 @@ pub struct Args {
     #[arg(long)]
     pub shard: Option<String>,
     /// output epoch spacing [s]
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = run_setup::DEFAULT_MC_EVERY_S)]
     pub every_s: f64,
     /// stop after this time [s] (default: whole scenario)
     #[arg(long)]
@@ -254,10 +254,9 @@ pub fn print_summary(state: &McState, stats: &McStats, out: &Path) {
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let mut scn = Scenario::load(&args.scenario)?;
+    let bad = |e: run_setup::OptionError| CliError::BadInput(e.to_string());
     if let Some(g) = &args.grade {
-        scn.imu.model =
-            ImuErrorModel::preset(g).map_err(|e| CliError::bad(format!("--grade: {e}")))?;
-        scn.imu.grade = Some(g.clone());
+        run_setup::apply_grade(&mut scn, g).map_err(bad)?;
     }
     if scn.imu.model == ImuErrorModel::ideal() && !args.quiet {
         eprintln!(
@@ -265,43 +264,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
             scn.name
         );
     }
-    let n = args.samples.unwrap_or(scn.nav.samples);
-    let mut algo = AlgorithmSpec::from_name(&args.algo, n).ok_or_else(|| {
-        CliError::bad(format!(
-            "--algo {}: expected savage, songlee, songlee-complete or dualquat",
-            args.algo
-        ))
-    })?;
-    algo.coning = sdins_core::coning::ConingSet::recommended_for(n);
-    if !(1..=4).contains(&n) {
-        return Err(CliError::bad(format!("--samples {n}: expected 1..=4")));
-    }
-    let vertical_hold = match args.vertical.as_str() {
-        "hold" => true,
-        "free" => false,
-        o => {
-            return Err(CliError::bad(format!(
-                "--vertical {o}: expected hold or free"
-            )))
-        }
-    };
-    if let Some(u) = args.until_s {
-        if !(u.is_finite() && u > 0.0) {
-            return Err(CliError::bad(format!("--until-s {u}: expected > 0")));
-        }
-    }
+    let opts = run_setup::mc_options(
+        &scn,
+        &run_setup::McChoice {
+            runs: args.runs,
+            seed: args.seed,
+            algo: Some(args.algo.clone()),
+            samples: args.samples,
+            every_s: Some(args.every_s),
+            until_s: args.until_s,
+            vertical: Some(args.vertical.clone()),
+            block: Some(args.block),
+        },
+    )
+    .map_err(bad)?;
     let shard = match &args.shard {
         None => Shard::ALL,
         Some(s) => Shard::parse(s).map_err(|e| CliError::bad(format!("--shard: {e}")))?,
-    };
-    let opts = McOptions {
-        runs: args.runs,
-        seed: args.seed.unwrap_or(scn.imu.seed),
-        algo,
-        every_s: args.every_s,
-        until_s: args.until_s,
-        block: args.block,
-        vertical_hold,
     };
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(match args.shard {

@@ -1,16 +1,11 @@
 //! `sdins nav`: run one navigation algorithm over a recorded IMU file.
 
-use super::run::{algorithms, Args as RunArgs};
 use crate::error::CliError;
 use crate::output::AtomicFile;
-use sdins_core::earth::EarthModel;
-use sdins_core::math::Vec3;
-use sdins_core::nav::InitialState;
 use sdins_sim::imu_file::{read_imu_file, ImuFormat};
-use sdins_sim::initial::validate_initial_state;
-use sdins_sim::pipeline::{nav_error, navigate_recorded_timed, NavError};
-use sdins_sim::scenario::Scenario;
-use sdins_sim::truth_file::{c_b_n_from_psins, read_truth};
+use sdins_sim::nav_recorded;
+use sdins_sim::run_setup::{self, algorithms, earth_by_name, AlgoChoice};
+use sdins_sim::truth_file::read_truth;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -56,14 +51,8 @@ pub struct Args {
     pub json: bool,
 }
 
-fn parse_init(s: &str) -> Result<InitialState, CliError> {
-    sdins_sim::initial::parse_initial_state(s).map_err(CliError::BadInput)
-}
-
-/// Fail unless at least one reference time falls on a navigation update epoch
-/// `t0 + k N δt` (k = 1..=updates) within 0.1 δt: otherwise `--truth` would silently
-/// compare nothing (different time bases, another trajectory, a decimated file that
-/// misses every epoch).
+/// Fail unless a reference time falls on an update epoch (see
+/// [`sdins_sim::nav_recorded::check_time_bases`]).
 pub fn check_time_bases(
     truth: &[sdins_sim::truth::TruthSample],
     truth_path: &std::path::Path,
@@ -73,134 +62,37 @@ pub fn check_time_bases(
     samples: usize,
     n_samples: usize,
 ) -> Result<(), CliError> {
-    let upd = dt * samples.max(1) as f64;
-    let n_upd = n_samples / samples.max(1);
-    let tol = 0.1 * dt;
-    let matched = truth.iter().any(|r| {
-        let k = ((r.t_s - t0) / upd).round();
-        k >= 1.0 && k <= n_upd as f64 && (r.t_s - (t0 + k * upd)).abs() <= tol
-    });
-    if matched {
-        return Ok(());
-    }
-    let (first, last) = match (truth.first(), truth.last()) {
-        (Some(a), Some(b)) => (a.t_s, b.t_s),
-        _ => (f64::NAN, f64::NAN),
-    };
-    Err(CliError::bad(format!(
-        "{}: no time matches an update epoch of {}: the updates are at {} s + k·{} s up to {} s, the reference covers {} s to {} s (expected equal times within {} s; are the time bases the same?)",
-        truth_path.display(),
-        imu_path.display(),
-        t0,
-        upd,
-        t0 + n_upd as f64 * upd,
-        first,
-        last,
-        tol
-    )))
+    nav_recorded::check_time_bases(truth, truth_path, imu_path, t0, dt, samples, n_samples)
+        .map_err(|e| CliError::BadInput(e.to_string()))
 }
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let format: ImuFormat = args.format.parse().map_err(CliError::BadInput)?;
-    let earth = match args.earth.as_str() {
-        "wgs84" => EarthModel::WGS84,
-        "wgs84-linear" => EarthModel::WGS84_LINEAR_G,
-        "psins" => EarthModel::PSINS,
-        "flat" => EarthModel::flat(9.806_65),
-        o => {
-            return Err(CliError::bad(format!(
-                "--earth {o}: expected wgs84, wgs84-linear, psins or flat"
-            )))
-        }
-    };
+    let earth = earth_by_name(&args.earth).map_err(|e| CliError::BadInput(e.to_string()))?;
     let data = read_imu_file(&args.imu, format).map_err(|e| CliError::BadInput(e.to_string()))?;
     let truth = match &args.truth {
         Some(p) => Some(read_truth(p).map_err(|e| CliError::BadInput(e.to_string()))?),
         None => None,
     };
-    let init = match (&args.init, &truth, &data.psins) {
-        (Some(s), _, _) => parse_init(s)?,
-        (None, Some(tr), _) if !tr.is_empty() => {
-            // the state at the start of the first IMU sample: the truth's first row must be
-            // at that epoch, else the run would start from a wrong state
-            let r = &tr[0];
-            let t_start = data.t0_s - data.dt_s;
-            if (r.t_s - t_start).abs() > 0.1 * data.dt_s {
-                return Err(CliError::bad(format!(
-                    "{}: the first row (t = {} s) is not at the start of the first sample of {} (t = {} s, its first time stamp {} s minus the interval {} s): give --init",
-                    args.truth.as_deref().unwrap_or(std::path::Path::new("")).display(),
-                    r.t_s,
-                    args.imu.display(),
-                    t_start,
-                    data.t0_s,
-                    data.dt_s
-                )));
-            }
-            let s = InitialState {
-                lat_rad: r.lat_rad,
-                lon_rad: r.lon_rad,
-                h_m: r.h_m,
-                v_n_mps: r.v_n_mps,
-                c_b_n: r.c_b_n,
-            };
-            validate_initial_state(&s).map_err(|e| {
-                CliError::bad(format!(
-                    "{}: first row (the initial state): {e}",
-                    args.truth
-                        .as_deref()
-                        .unwrap_or(std::path::Path::new(""))
-                        .display()
-                ))
-            })?;
-            s
-        }
-        (None, _, Some(h)) => {
-            let s = InitialState {
-                lat_rad: h.lat_deg * D2R,
-                lon_rad: h.lon_deg * D2R,
-                h_m: h.h_m,
-                v_n_mps: Vec3::new(h.vel0_enu_mps[1], h.vel0_enu_mps[0], -h.vel0_enu_mps[2]),
-                c_b_n: c_b_n_from_psins(
-                    h.att0_deg[0] * D2R,
-                    h.att0_deg[1] * D2R,
-                    h.att0_deg[2] * D2R,
-                ),
-            };
-            validate_initial_state(&s).map_err(|e| {
-                CliError::bad(format!(
-                    "{}: PSINS header (the initial state): {e}",
-                    args.imu.display()
-                ))
-            })?;
-            s
-        }
-        _ => {
-            return Err(CliError::bad(
-                "--init is required (no truth file or PSINS header to take it from)",
-            ))
-        }
-    };
-    // reuse `run`'s algorithm parsing
-    let run_args = RunArgs {
-        scenario: String::new(),
-        algo: Some(args.algo.clone()),
+    let init = nav_recorded::initial_state(
+        args.init.as_deref(),
+        match (&args.truth, &truth) {
+            (Some(p), Some(t)) => Some((p.as_path(), t.as_slice())),
+            _ => None,
+        },
+        &args.imu,
+        &data,
+    )
+    .map_err(|e| CliError::BadInput(e.to_string()))?;
+    let choice = AlgoChoice {
+        algos: Some(args.algo.clone()),
         samples: Some(args.samples),
         coning: args.coning.clone(),
-        attitude: None,
-        rot3: false,
-        rotvec: None,
-        vertical: None,
-        out: None,
-        every_s: 1.0,
-        ideal: true,
-        run: 0,
-        plot_scale: crate::plot::PlotScale::Log,
-        json: false,
-        quiet: true,
+        ..AlgoChoice::default()
     };
-    let dummy = Scenario::load("stationary")?;
-    let specs = algorithms(&run_args, &dummy)?;
+    let specs = algorithms(&choice, &run_setup::recorded_nav_defaults())
+        .map_err(|e| CliError::BadInput(e.to_string()))?;
     let Some(spec) = specs.first().copied() else {
         return Err(CliError::bad("--algo: no algorithm given"));
     };
@@ -233,8 +125,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg"
     )
     .map_err(io)?;
-    let mut errs: Vec<NavError> = Vec::new();
-    let mut ti = 0usize;
     let mut write_err = None;
     let mut final_state = None;
     // what was used, so that nobody has to guess a default
@@ -251,39 +141,37 @@ pub fn run(args: Args) -> Result<(), CliError> {
         spec.coning.name(),
         args.earth
     );
-    let wall = navigate_recorded_timed(&spec, earth, data.dt_s, &init, &data.increments, |st| {
-        let t = t0 + st.t_s;
-        final_state = Some((t, *st));
-        let e = st.euler();
-        if let Err(err) = writeln!(
-            nav_file.writer(),
-            "{},{},{},{},{},{},{},{},{},{}",
-            t,
-            st.lat_rad / D2R,
-            st.lon_rad / D2R,
-            st.h_m,
-            st.v_n_mps.x,
-            st.v_n_mps.y,
-            st.v_n_mps.z,
-            e.roll_rad / D2R,
-            e.pitch_rad / D2R,
-            e.yaw_rad / D2R
-        ) {
-            write_err.get_or_insert(err);
-        }
-        if let Some(tr) = &truth {
-            while ti < tr.len() && tr[ti].t_s < t - 0.1 * data.dt_s {
-                ti += 1;
+    let rec = nav_recorded::navigate(
+        &spec,
+        earth,
+        data.dt_s,
+        t0,
+        &init,
+        &data.increments,
+        truth.as_deref(),
+        &crate::progress::token(),
+        |t, st| {
+            final_state = Some((t, *st));
+            let e = st.euler();
+            if let Err(err) = writeln!(
+                nav_file.writer(),
+                "{},{},{},{},{},{},{},{},{},{}",
+                t,
+                st.lat_rad / D2R,
+                st.lon_rad / D2R,
+                st.h_m,
+                st.v_n_mps.x,
+                st.v_n_mps.y,
+                st.v_n_mps.z,
+                e.roll_rad / D2R,
+                e.pitch_rad / D2R,
+                e.yaw_rad / D2R
+            ) {
+                write_err.get_or_insert(err);
             }
-            if let Some(r) = tr.get(ti) {
-                if (r.t_s - t).abs() <= 0.1 * data.dt_s {
-                    let mut e = nav_error(&earth, st, r);
-                    e.t_s = t;
-                    errs.push(e);
-                }
-            }
-        }
-    });
+        },
+    )?;
+    let (wall, errs) = (rec.wall_s, rec.errors);
     if let Some(e) = write_err {
         return Err(io(e));
     }

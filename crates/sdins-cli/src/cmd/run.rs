@@ -4,9 +4,9 @@ use crate::error::CliError;
 use crate::output::AtomicFile;
 use crate::plot::PlotScale;
 use crate::progress::Progress;
-use sdins_core::coning::ConingSet;
-use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AttitudeMode, RotVector};
+use sdins_core::nav::AlgorithmSpec;
 use sdins_sim::pipeline::{run_cancellable as run_pipeline, RunOptions, RunSummary};
+use sdins_sim::run_setup::{self, AlgoChoice};
 use sdins_sim::scenario::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
@@ -46,7 +46,7 @@ pub struct Args {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// output epoch spacing in seconds for the CSV files (default 1 s)
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = run_setup::DEFAULT_EVERY_S)]
     pub every_s: f64,
     /// ignore the scenario's IMU error model (ideal sensors)
     #[arg(long)]
@@ -67,77 +67,15 @@ pub struct Args {
 
 /// Build the algorithm list from the arguments.
 pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, CliError> {
-    let n = args.samples.unwrap_or(scn.nav.samples);
-    if !(1..=4).contains(&n) {
-        return Err(CliError::bad(format!(
-            "--samples {n}: expected 1, 2, 3 or 4"
-        )));
-    }
-    let names: Vec<String> = match &args.algo {
-        Some(s) => s
-            .split(',')
-            .map(|x| x.trim().to_string())
-            .filter(|x| !x.is_empty())
-            .collect(),
-        None => scn.nav.algos.clone(),
+    let choice = AlgoChoice {
+        algos: args.algo.clone(),
+        samples: args.samples,
+        coning: args.coning.clone(),
+        attitude: args.attitude.clone(),
+        rotvec: args.rotvec.clone(),
+        rot3: args.rot3,
     };
-    let coning_name = args.coning.clone().or_else(|| scn.nav.coning.clone());
-    let coning = match &coning_name {
-        None => ConingSet::recommended_for(n),
-        Some(c) => {
-            let set = ConingSet::parse(c, n).ok_or_else(|| {
-                CliError::bad(format!(
-                    "--coning {c}: unknown set (expected none, 1prev, two, three_poly, three_opt, four_poly, four_opt, polynomial, optimal)"
-                ))
-            })?;
-            if !set.accepts(n) {
-                return Err(CliError::bad(format!(
-                    "--coning {c}: the set is for {} samples, but --samples is {n}",
-                    set.samples()
-                )));
-            }
-            set
-        }
-    };
-    let attitude = match args.attitude.as_deref() {
-        None => None,
-        Some("transport") => Some(AttitudeMode::Transport),
-        Some("five") => Some(AttitudeMode::Five),
-        Some("savage") => Some(AttitudeMode::Savage),
-        Some(o) => {
-            return Err(CliError::bad(format!(
-                "--attitude {o}: expected transport, five or savage"
-            )))
-        }
-    };
-    let rot_vector = match args.rotvec.as_deref() {
-        None => None,
-        Some("theta") => Some(RotVector::Theta),
-        Some("phi") => Some(RotVector::Phi),
-        Some(o) => {
-            return Err(CliError::bad(format!(
-                "--rotvec {o}: expected theta or phi"
-            )))
-        }
-    };
-    names
-        .iter()
-        .map(|name| {
-            let kind = AlgorithmKind::from_name(name).ok_or_else(|| {
-                CliError::bad(format!(
-                    "--algo: unknown algorithm `{name}` (expected savage, songlee, songlee-complete, dualquat)"
-                ))
-            })?;
-            let mut spec = AlgorithmSpec::new(kind, n);
-            spec.coning = coning;
-            spec.attitude = attitude;
-            spec.rot_vector = rot_vector;
-            if args.rot3 {
-                spec.rot3 = Some(true);
-            }
-            Ok(spec)
-        })
-        .collect()
+    run_setup::algorithms(&choice, &scn.nav).map_err(|e| CliError::BadInput(e.to_string()))
 }
 
 /// Error-norm time series of one algorithm, at the output epochs:
@@ -178,25 +116,12 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     if algos.is_empty() {
         return Err(CliError::bad("--algo: no algorithm given"));
     }
-    let hold = match args.vertical.as_deref() {
-        None => scn.nav.vertical_hold,
-        Some("free") => false,
-        Some("hold") => true,
-        Some(o) => {
-            return Err(CliError::bad(format!(
-                "--vertical {o}: expected free or hold"
-            )))
-        }
-    };
-    if !(args.every_s.is_finite() && args.every_s > 0.0) {
-        return Err(CliError::bad(format!(
-            "--every-s {}: expected a positive number of seconds",
-            args.every_s
-        )));
-    }
+    let bad = |e: run_setup::OptionError| CliError::BadInput(e.to_string());
+    let hold =
+        run_setup::vertical_hold(args.vertical.as_deref(), scn.nav.vertical_hold).map_err(bad)?;
     let n = algos[0].samples;
     let dt_u = scn.imu.dt_s() * n as f64;
-    let every = ((args.every_s / dt_u).round() as u64).max(1);
+    let every = run_setup::every_updates(args.every_s, dt_u).map_err(bad)?;
     let out = args
         .out
         .clone()

@@ -1,0 +1,141 @@
+//! `sdins.Scenario` and `sdins.scenarios()`: the scenario files of docs/scenarios.md.
+
+use crate::error::err;
+use pyo3::prelude::*;
+use sdins_sim::scenario::{builtin, Scenario as Scn, BUILTINS};
+use std::path::Path;
+
+/// A scenario: trajectory, start, IMU and navigation settings (docs/scenarios.md).
+/// Picklable (it carries its TOML text).
+#[pyclass(module = "sdins", frozen)]
+pub struct Scenario {
+    pub(crate) scn: Scn,
+    text: String,
+    label: String,
+}
+
+impl Scenario {
+    fn parse(text: &str, label: &str) -> PyResult<Self> {
+        Ok(Scenario {
+            scn: Scn::from_toml(text, label).map_err(err)?,
+            text: text.to_string(),
+            label: label.to_string(),
+        })
+    }
+}
+
+#[pymethods]
+impl Scenario {
+    /// Parse scenario TOML; `file` names it in error messages (default `<string>`).
+    #[new]
+    #[pyo3(signature = (text, file=None))]
+    fn new(text: &str, file: Option<&str>) -> PyResult<Self> {
+        Scenario::parse(text, file.unwrap_or("<string>"))
+    }
+
+    /// A built-in scenario by name (see `sdins.scenarios()`).
+    #[staticmethod]
+    fn builtin(name: &str) -> PyResult<Self> {
+        match builtin(name) {
+            Some(b) => Scenario::parse(b.toml, &format!("<built-in {}>", b.name)),
+            None => Err(err(sdins_sim::scenario::ScenarioError::Unknown {
+                name: name.to_string(),
+                known: BUILTINS
+                    .iter()
+                    .map(|b| b.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })),
+        }
+    }
+
+    /// Parse scenario TOML text; `file` names it in error messages.
+    #[staticmethod]
+    #[pyo3(signature = (text, file=None))]
+    fn from_toml(text: &str, file: Option<&str>) -> PyResult<Self> {
+        Scenario::parse(text, file.unwrap_or("<string>"))
+    }
+
+    /// Read a scenario file (errors name `path:line:column`).
+    #[staticmethod]
+    fn from_file(path: std::path::PathBuf) -> PyResult<Self> {
+        let scn = Scn::from_file(Path::new(&path)).map_err(err)?;
+        let text = std::fs::read_to_string(&path).map_err(err)?;
+        Ok(Scenario {
+            scn,
+            text,
+            label: path.display().to_string(),
+        })
+    }
+
+    /// The scenario as TOML text (the text it was read from).
+    fn to_toml(&self) -> String {
+        self.text.clone()
+    }
+
+    /// Scenario name.
+    #[getter]
+    fn name(&self) -> String {
+        self.scn.name.clone()
+    }
+
+    /// Duration [s].
+    #[getter]
+    fn duration_s(&self) -> f64 {
+        self.scn.duration_s()
+    }
+
+    /// IMU sample interval δt [s].
+    #[getter]
+    fn dt_s(&self) -> f64 {
+        self.scn.imu.dt_s()
+    }
+
+    /// IMU samples per navigation update N.
+    #[getter]
+    fn samples(&self) -> usize {
+        self.scn.nav.samples
+    }
+
+    /// The scenario's default algorithms.
+    #[getter]
+    fn algos(&self) -> Vec<String> {
+        self.scn.nav.algos.clone()
+    }
+
+    /// Earth model name.
+    #[getter]
+    fn earth(&self) -> &'static str {
+        self.scn.nav.earth.name()
+    }
+
+    /// Start (lat_rad, lon_rad, h_m).
+    #[getter]
+    fn start(&self) -> (f64, f64, f64) {
+        (
+            self.scn.start.lat_rad,
+            self.scn.start.lon_rad,
+            self.scn.start.h_m,
+        )
+    }
+
+    fn __getnewargs__(&self) -> (String, String) {
+        (self.text.clone(), self.label.clone())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scenario({:?}, {} s, {} Hz IMU, N = {})",
+            self.scn.name,
+            self.scn.duration_s(),
+            1.0 / self.scn.imu.dt_s(),
+            self.scn.nav.samples
+        )
+    }
+}
+
+/// The built-in scenarios: a list of (name, summary).
+#[pyfunction]
+pub fn scenarios() -> Vec<(&'static str, &'static str)> {
+    BUILTINS.iter().map(|b| (b.name, b.summary)).collect()
+}

@@ -1,0 +1,225 @@
+"""sdins: exact strapdown inertial navigation simulation and navigation algorithms.
+
+Every function calls the same Rust library function as the ``sdins`` command of the
+same name, so numbers are identical to the CLI's ``--json``/CSV output. Arrays are
+float64 numpy arrays (no per-sample Python objects). Frames: NED navigation frame,
+FRD body frame, Hamilton scalar-first quaternions ``q_b_n`` (docs/conventions.md).
+Every optional parameter defaults to ``None`` = the library's default. Bad input raises
+:class:`SdinsError` (a ``ValueError``) with the CLI's located message; long calls
+release the GIL and stop on KeyboardInterrupt.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _sdins
+from ._results import (
+    AlgorithmRun,
+    AllanResult,
+    Errors,
+    ImuRecord,
+    McStatistics,
+    Navigation,
+    RunResult,
+    Truth,
+)
+from ._sdins import McState, Scenario, SdinsError
+
+__version__: str = _sdins.__version__
+
+__all__ = [
+    "SdinsError",
+    "Scenario",
+    "McState",
+    "Truth",
+    "Navigation",
+    "Errors",
+    "AlgorithmRun",
+    "RunResult",
+    "McStatistics",
+    "ImuRecord",
+    "AllanResult",
+    "scenarios",
+    "truth",
+    "corrupt",
+    "navigate",
+    "run",
+    "read_imu",
+    "allan",
+    "montecarlo",
+    "merge",
+]
+
+
+def _f64x3(name: str, a: Any) -> np.ndarray:
+    arr = np.ascontiguousarray(a, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise SdinsError(f"{name}: expected an (n, 3) array, got shape {arr.shape}")
+    return arr
+
+
+def _scenario(s: Union[Scenario, str]) -> Scenario:
+    if isinstance(s, Scenario):
+        return s
+    if isinstance(s, str):
+        return Scenario.builtin(s)
+    raise SdinsError(f"scenario: expected sdins.Scenario or a built-in name, got {type(s).__name__}")
+
+
+def scenarios() -> List[Tuple[str, str]]:
+    """The built-in scenarios (the papers' cases): a list of ``(name, summary)``."""
+    return list(_sdins.scenarios())
+
+
+def truth(
+    scenario: Union[Scenario, str],
+    until_s: Optional[float] = None,
+    every: Optional[int] = None,
+    imu: Optional[bool] = None,
+) -> Truth:
+    """Exact truth trajectory and IMU increments of ``scenario``.
+
+    ``until_s``: stop after this time [s] (default: the whole scenario). ``every``: keep
+    every N-th trajectory row (default 1; row 0, the initial state, is always kept; the
+    IMU increments are never decimated). ``imu``: also return the increments (default
+    True; ``False`` saves 48 bytes per sample). Same numbers as ``sdins truth``.
+    """
+    return Truth(_sdins.truth(_scenario(scenario), until_s, every, imu))
+
+
+def corrupt(
+    dtheta: Any,
+    dv: Any,
+    dt: float,
+    grade: Optional[str] = None,
+    errors: Optional[Dict[str, Any]] = None,
+    seed: Optional[int] = None,
+    run: Optional[int] = None,
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Corrupt exact increments ``dtheta`` [rad] and ``dv`` [m/s] ((n, 3), body FRD,
+    sample interval ``dt`` [s]) with realisation ``run`` (default 0) of an IMU error model.
+
+    ``grade``: a preset (marine, aviation, intermediate, tactical, consumer); ``errors``:
+    keys of a scenario's ``[imu.errors]`` table with units in the names (e.g.
+    ``{"gyro_bias_dph": [0.01]*3}``, docs/scenarios.md), applied over ``grade`` if both are
+    given. ``seed`` defaults to the scenario default 1. Returns ``(dtheta, dv)``.
+    """
+    return _sdins.corrupt(_f64x3("dtheta", dtheta), _f64x3("dv", dv), float(dt), grade, errors, seed, run)
+
+
+def navigate(
+    dtheta: Any,
+    dv: Any,
+    dt: float,
+    init: Union[str, Sequence[float]],
+    algo: Optional[str] = None,
+    samples: Optional[int] = None,
+    coning: Optional[str] = None,
+    earth: Optional[str] = None,
+    vertical: Optional[str] = None,
+    t0_s: Optional[float] = None,
+) -> Navigation:
+    """Navigate recorded increments with one algorithm (``sdins nav``).
+
+    ``dtheta`` [rad], ``dv`` [m/s]: (n, 3) body FRD increments at interval ``dt`` [s].
+    ``init``: ``lat_deg, lon_deg, h_m, v_n_mps, v_e_mps, v_d_mps, roll_deg, pitch_deg,
+    yaw_deg`` as 9 numbers or the CLI's comma-separated string. ``algo``: savage,
+    songlee, songlee-complete (default) or dualquat; ``samples``: IMU samples per update
+    N (1..4, default 1; a trailing partial update is dropped); ``coning``: coning/sculling
+    set (default: 1prev for N = 1, else the polynomial set of N); ``earth``: wgs84 (default), wgs84-linear, psins,
+    flat; ``vertical``: free (default; a held channel needs a reference, see ``run``);
+    ``t0_s``: time of ``init`` [s] (default 0). Returns the state after every update.
+    """
+    return Navigation(
+        _sdins.navigate(
+            _f64x3("dtheta", dtheta), _f64x3("dv", dv), float(dt), init,
+            algo, samples, coning, earth, vertical, t0_s,
+        )
+    )
+
+
+def run(
+    scenario: Union[Scenario, str],
+    algos: Optional[Union[str, Sequence[str]]] = None,
+    samples: Optional[int] = None,
+    coning: Optional[str] = None,
+    attitude: Optional[str] = None,
+    rotvec: Optional[str] = None,
+    rot3: Optional[bool] = None,
+    vertical: Optional[str] = None,
+    every_s: Optional[float] = None,
+    until_s: Optional[float] = None,
+    ideal: Optional[bool] = None,
+    run: Optional[int] = None,
+) -> RunResult:
+    """Run the scenario's exact truth through algorithms side by side (``sdins run``).
+
+    ``algos``: names (list or comma-separated; default: the scenario's); ``samples``
+    (default: the scenario's N), ``coning``, ``attitude`` (transport, five, savage),
+    ``rotvec`` (theta, phi), ``rot3``: as the CLI options; ``vertical``: free or hold
+    (default: the scenario's); ``every_s``: output epoch spacing [s] (default 1);
+    ``until_s``: stop time [s]; ``ideal``: ignore the scenario's IMU error model;
+    ``run``: sensor-error realisation (default 0). Returns a dict algo → AlgorithmRun
+    with the errors against the truth at the output epochs (the CLI's err_*.csv) and
+    the final and maximum errors (its ``--json``).
+    """
+    d = _sdins.run(
+        _scenario(scenario), algos, samples, coning, attitude, rotvec, rot3,
+        vertical, every_s, until_s, ideal, run,
+    )
+    return RunResult((k, AlgorithmRun(v)) for k, v in d.items())
+
+
+def read_imu(path: Any, format: Optional[str] = "auto") -> ImuRecord:
+    """Read an IMU file: sdins CSV, PSINS ``.imu`` (psins) or trj CSV (psins-csv),
+    KF-GINS text (kfgins), NaveGo CSV (navego); ``format="auto"`` detects it
+    (docs/imu-files.md). Increments are converted to body FRD."""
+    return ImuRecord(_sdins.read_imu(str(path), format))
+
+
+def allan(dtheta: Any, dv: Any, dt: float) -> AllanResult:
+    """Overlapping Allan deviation of the six channels (rates Δθ/δt, Δv/δt) and the
+    IEEE Std 952 noise fits, SI units (``sdins allan``)."""
+    return AllanResult(_sdins.allan(_f64x3("dtheta", dtheta), _f64x3("dv", dv), float(dt)))
+
+
+def montecarlo(
+    scenario: Union[Scenario, str],
+    runs: int,
+    seed: Optional[int] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    algo: Optional[str] = None,
+    samples: Optional[int] = None,
+    grade: Optional[str] = None,
+    every_s: Optional[float] = None,
+    until_s: Optional[float] = None,
+    vertical: Optional[str] = None,
+    block: Optional[int] = None,
+    threads: Optional[int] = None,
+) -> McState:
+    """Compute shard ``shard = (i, n)`` (default: the whole job) of a Monte Carlo job of
+    ``runs`` runs with sensor-error ``seed`` (default: the scenario's ``[imu] seed``)
+    (``sdins montecarlo --shard i/n``).
+
+    ``algo`` (default songlee-complete), ``samples`` (default the scenario's N),
+    ``grade`` (replaces the scenario's error model), ``every_s`` (epoch spacing, default
+    10 s), ``until_s``, ``vertical`` (hold (default) or free), ``block`` (runs per block,
+    default 16; every shard must use the same), ``threads`` (default: rayon's pool, all
+    cores). Returns a picklable :class:`McState`; merge shards with :func:`merge` in any
+    order: the statistics equal a single run's bit for bit.
+    """
+    return _sdins.montecarlo(
+        _scenario(scenario), runs, seed,
+        None if shard is None else (int(shard[0]), int(shard[1])),
+        algo, samples, grade, every_s, until_s, vertical, block, threads,
+    )
+
+
+def merge(states: Iterable[McState], allow_partial: Optional[bool] = None) -> McStatistics:
+    """Merge Monte Carlo shard states exactly (any order) and return the statistics
+    (``sdins merge``). Missing blocks are an error unless ``allow_partial=True``."""
+    merged, stats = _sdins.merge(list(states), allow_partial)
+    return McStatistics(stats, merged)
