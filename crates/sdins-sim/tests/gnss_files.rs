@@ -1,0 +1,79 @@
+//! The GNSS readers and NaveGo parameter parsers on the real files in `../shared/data`
+//! (skipped with a printed reason when the folder is absent).
+#![allow(clippy::unwrap_used)]
+
+use sdins_sim::gnss_file::{
+    clip_to_imu_span, imu_span_s, read_gnss_file, to_imu_time, GnssFormat, GnssReadOptions,
+    ImuClock, TimeBase,
+};
+use sdins_sim::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::navego_params::{read_navego_gnss_params, read_navego_imu_params};
+use std::path::{Path, PathBuf};
+
+fn data(sub: &str) -> Option<PathBuf> {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(sub);
+    if d.is_dir() {
+        Some(d)
+    } else {
+        println!("skipped: {} not found", d.display());
+        None
+    }
+}
+
+#[test]
+fn navego_params_files() {
+    let Some(d) = data("csv/navego") else { return };
+    let i1 = read_navego_imu_params(&d.join("imu1_params.txt")).unwrap();
+    let i2 = read_navego_imu_params(&d.join("imu2_params.txt")).unwrap();
+    // ADIS16405 (imu1): 3 °/s and 50 mg static biases, 2 °/√h ARW, 0.2 m/s/√h VRW, as
+    // NaveGo's example defines them in those units
+    let d2r = std::f64::consts::PI / 180.0;
+    for a in 0..3 {
+        assert!((i1.gb_sta_rps[a] - 3.0 * d2r).abs() < 1e-15);
+        assert!((i1.ab_sta_mps2[a] - 0.050 * 9.80665).abs() < 1e-15);
+        assert!((i1.arw_rad_per_sqrt_s[a] - 2.0 * d2r / 60.0).abs() < 1e-15);
+        assert!((i1.vrw_mps_per_sqrt_s[a] - 0.2 / 60.0).abs() < 1e-15);
+        assert_eq!(i1.gb_corr_s[a], 100.0);
+    }
+    assert_eq!(i1.ini_align_rpy_rad, [0.0, 0.0, -15.0 * d2r]);
+    assert!((i1.ini_align_err_rpy_rad[2] - 2.0 * d2r).abs() < 1e-15);
+    assert!(i2.gb_sta_rps[0] < i1.gb_sta_rps[0]);
+    assert!(i1.other.contains_key("m_std"));
+    let g = read_navego_gnss_params(&d.join("gnss_params.txt")).unwrap();
+    assert_eq!(g.stdm_ned_m, [5.0, 5.0, 10.0]);
+    assert_eq!(g.larm_frd_m, [0.0; 3]);
+    assert_eq!(g.freq_hz, 5.0);
+    assert!((g.stdv_ned_mps[0] - 0.0514444).abs() < 1e-15);
+}
+
+#[test]
+fn navego_gnss_csv() {
+    let Some(d) = data("csv/navego") else { return };
+    let path = d.join("gnss.csv");
+    let g = read_gnss_file(&path, GnssFormat::Auto, &GnssReadOptions::default()).unwrap();
+    assert_eq!(g.format, GnssFormat::NaveGo);
+    assert_eq!(g.time_base, TimeBase::FileSeconds);
+    // 5 Hz from 0 to 437.2 s
+    assert_eq!(g.fixes.len(), 2187);
+    assert_eq!(g.fixes[0].t_s, 0.0);
+    assert!((g.fixes[2186].t_s - 437.2).abs() < 1e-9);
+    assert!((g.fixes[0].lat_rad.to_degrees() + 32.83).abs() < 0.01);
+    assert_eq!(g.fixes[0].pos_cov_ned_m2[(2, 2)], 100.0);
+    assert!(g.report.warnings.is_empty());
+    // all fixes inside the 200 Hz IMU record
+    let imu = read_imu_file(&d.join("imu1.csv"), ImuFormat::Auto).unwrap();
+    let (a, b) = imu_span_s(&imu);
+    let m = to_imu_time(&path, &g, ImuClock::SameAsGnss).unwrap();
+    let c = clip_to_imu_span(&path, &m, a, b).unwrap();
+    println!(
+        "navego: {} fixes, IMU span {a}..{b} s, kept {}, before {}, after {}",
+        g.fixes.len(),
+        c.fixes.len(),
+        c.before,
+        c.after
+    );
+    assert_eq!(c.fixes.len() + c.before + c.after, 2187);
+    assert!(c.after <= 1);
+}
