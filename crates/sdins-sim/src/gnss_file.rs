@@ -250,6 +250,31 @@ pub enum GnssFileError {
         /// fields found
         found: usize,
     },
+    /// The last line (no final newline) ends in a number with fewer decimals than the
+    /// same column on the line before: cut inside that number.
+    #[error("{}:{line}:{column}: truncated last line: `{text}` has fewer decimals than the {expected_decimals} of this column on the line before, and the file has no final newline", file.display())]
+    CutNumber {
+        /// the file
+        file: PathBuf,
+        /// 1-based line
+        line: usize,
+        /// 1-based character column
+        column: usize,
+        /// the number as cut
+        text: String,
+        /// decimals on the line before
+        expected_decimals: usize,
+    },
+    /// The quality filter left no fix.
+    #[error("{}: all {skipped} fixes have a quality flag Q outside 1..={max_q}", file.display())]
+    AllFiltered {
+        /// the file
+        file: PathBuf,
+        /// rows dropped
+        skipped: usize,
+        /// the filter
+        max_q: u8,
+    },
     /// Wrong number of fields.
     #[error("{}:{line}:{column}: expected {expected} fields, found {found}", file.display())]
     ColumnCount {

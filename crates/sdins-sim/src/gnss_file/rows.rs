@@ -255,6 +255,43 @@ impl Ctx<'_> {
     }
 }
 
+/// Digits after the decimal point (`None` without a point or with an exponent).
+fn decimals(s: &str) -> Option<usize> {
+    if s.contains(['e', 'E']) {
+        return None;
+    }
+    s.find('.').map(|k| s.len() - k - 1)
+}
+
+/// Fixed-decimal text formats (KF-GINS, RTKLIB print every column with a fixed number of
+/// decimals): a last line without final newline whose field has fewer decimals than the same
+/// field on the line before was cut inside that number.
+pub(crate) fn check_cut_number(
+    ctx: &Ctx<'_>,
+    prev: &[Field<'_>],
+    last: Line<'_>,
+    fields: &[Field<'_>],
+    unterminated: bool,
+) -> Result<(), GnssFileError> {
+    if !unterminated {
+        return Ok(());
+    }
+    for (p, f) in prev.iter().zip(fields) {
+        if let (Some(dp), Some(df)) = (decimals(p.text), decimals(f.text)) {
+            if df < dp {
+                return Err(GnssFileError::CutNumber {
+                    file: ctx.f(),
+                    line: last.no,
+                    column: f.column,
+                    text: f.text.to_string(),
+                    expected_decimals: dp,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Wrap a longitude [rad] into (−π, π].
 pub(crate) fn wrap_lon_rad(lon: f64) -> f64 {
     use std::f64::consts::PI;
