@@ -21,7 +21,6 @@
 mod gps_time;
 mod kfgins;
 mod navego;
-#[allow(dead_code)]
 mod rows;
 mod rtklib;
 mod sdins_csv;

@@ -77,3 +77,28 @@ fn navego_gnss_csv() {
     assert_eq!(c.fixes.len() + c.before + c.after, 2187);
     assert!(c.after <= 1);
 }
+
+#[test]
+fn kfgins_gnss_text() {
+    let Some(d) = data("kfgins") else { return };
+    let path = d.join("GNSS-RTK.txt");
+    let g = read_gnss_file(&path, GnssFormat::Auto, &GnssReadOptions::default()).unwrap();
+    assert_eq!(g.format, GnssFormat::KfGins);
+    assert_eq!(g.time_base, TimeBase::GpsSecondsOfWeek);
+    // 1 Hz from 456250 to 459662 s of week
+    let n = g.fixes.len();
+    assert_eq!(g.fixes[0].t_s, 456_250.0);
+    assert_eq!(g.fixes[n - 1].t_s, 459_662.0);
+    assert_eq!(n, 3413);
+    assert!((g.fixes[0].lat_rad.to_degrees() - 30.4447858054).abs() < 1e-10);
+    assert!((g.fixes[0].pos_cov_ned_m2[(0, 0)] - 1e-4).abs() < 1e-18);
+    println!(
+        "kfgins: {n} fixes, {}",
+        g.report.detection.as_deref().unwrap_or("")
+    );
+    // the same fixes on a KF-GINS IMU clock (seconds of week): an IMU record of 456300 ..
+    // 456400 s keeps 101 fixes
+    let m = to_imu_time(&path, &g, ImuClock::GpsSecondsOfWeek).unwrap();
+    let c = clip_to_imu_span(&path, &m, 456_300.0, 456_400.0).unwrap();
+    assert_eq!((c.before, c.fixes.len(), c.after), (50, 101, n - 151));
+}

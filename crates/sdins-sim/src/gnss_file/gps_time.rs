@@ -42,7 +42,6 @@ pub(crate) fn days_from_civil(y: i32, m: u32, d: u32) -> i64 {
 }
 
 /// Days in a month.
-#[allow(dead_code)]
 pub(crate) fn days_in_month(y: i32, m: u32) -> u32 {
     match m {
         1 | 3 | 5 | 7 | 8 | 10 | 12 => 31,

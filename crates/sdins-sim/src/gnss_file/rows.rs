@@ -255,12 +255,12 @@ impl Ctx<'_> {
     }
 }
 
-/// Digits after the decimal point (`None` without a point or with an exponent).
+/// Digits after the decimal point (0 without a point; `None` with an exponent).
 fn decimals(s: &str) -> Option<usize> {
     if s.contains(['e', 'E']) {
         return None;
     }
-    s.find('.').map(|k| s.len() - k - 1)
+    Some(s.find('.').map_or(0, |k| s.len() - k - 1))
 }
 
 /// Fixed-decimal text formats (KF-GINS, RTKLIB print every column with a fixed number of

@@ -230,3 +230,33 @@ fn span_and_time_mapping() {
         Err(GnssFileError::TimeBaseMismatch { .. })
     ));
 }
+
+#[test]
+fn detection_refuses_when_ambiguous() {
+    let o = GnssReadOptions::default();
+    // 7 numbers near lat 0.5, lon 0.3: KF-GINS degrees or headerless NaveGo radians
+    let t = "100.0 0.5 0.3 10.0 1.0 1.0 2.0\n101.0 0.5 0.3 10.0 1.0 1.0 2.0\n";
+    let e = parse_gnss_str(Path::new("g.txt"), t, GnssFormat::Auto, &o).unwrap_err();
+    match &e {
+        GnssFileError::Ambiguous {
+            candidates, line, ..
+        } => {
+            assert_eq!(candidates, &vec!["kfgins", "navego"]);
+            assert_eq!(*line, 1);
+        }
+        _ => panic!("{e}"),
+    }
+    assert!(e.to_string().contains("candidates: kfgins, navego"), "{e}");
+    // given explicitly, either reads
+    assert!(parse_gnss_str(Path::new("g.txt"), t, GnssFormat::KfGins, &o).is_ok());
+    // unknown content
+    let e = parse_gnss_str(Path::new("g.txt"), "a;b\n", GnssFormat::Auto, &o).unwrap_err();
+    assert!(
+        matches!(e, GnssFileError::UnknownFormat { line: 1, .. }),
+        "{e}"
+    );
+    let e = parse_gnss_str(Path::new("g.txt"), "", GnssFormat::Auto, &o).unwrap_err();
+    assert!(matches!(e, GnssFileError::Empty { .. }), "{e}");
+    assert_eq!("rtklib".parse::<GnssFormat>(), Ok(GnssFormat::Rtklib));
+    assert!("x".parse::<GnssFormat>().is_err());
+}
