@@ -261,10 +261,13 @@ fn input_classes() {
     );
     // BOM accepted; headerless accepted with warnings
     assert_eq!(
-        rt(&format!("\u{feff}{}", file("GPST", std::slice::from_ref(&ok))))
-            .unwrap()
-            .fixes
-            .len(),
+        rt(&format!(
+            "\u{feff}{}",
+            file("GPST", std::slice::from_ref(&ok))
+        ))
+        .unwrap()
+        .fixes
+        .len(),
         1
     );
     let d = rt(&ok).unwrap();
