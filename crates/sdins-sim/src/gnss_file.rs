@@ -14,7 +14,7 @@
 //! Checks (each a located [`GnssFileError`], file:line:column and field): empty file,
 //! header without data, wrong field count, a short last line without final newline
 //! (truncated), non-numeric or non-finite fields, |latitude| > 90°, heights outside
-//! [`H_RANGE_M`], σ ≤ 0 or > [`MAX_SIGMA_M`], speeds beyond [`MAX_SPEED_MPS`], a
+//! [`H_RANGE_M`], σ below [`MIN_SIGMA_M`] (σ ≤ 0) or above [`MAX_SIGMA_M`], speeds beyond [`MAX_SPEED_MPS`], a
 //! non-positive-definite covariance, time not strictly increasing. A UTF-8 byte-order mark
 //! is accepted (and skipped).
 
@@ -39,6 +39,9 @@ use std::str::FromStr;
 pub const H_RANGE_M: (f64, f64) = (-1000.0, 100_000.0);
 /// Largest accepted position or velocity standard deviation [m, m/s].
 pub const MAX_SIGMA_M: f64 = 1.0e6;
+/// Smallest accepted position or velocity standard deviation [m, m/s] (1 µm: below any
+/// receiver's claim, and σ² stays far from underflow).
+pub const MIN_SIGMA_M: f64 = 1.0e-6;
 /// Largest accepted velocity component [m/s].
 pub const MAX_SPEED_MPS: f64 = 1.0e4;
 

@@ -13,7 +13,7 @@
 //! [rad, rad, m].
 //!
 //! Validation: every value finite; standard deviations, noise densities and biases' σ ≥ 0;
-//! correlation times and rates > 0; `ini_align` within |roll| ≤ π, |pitch| ≤ π/2,
+//! correlation times and rates > 0; GNSS `stdm`/`stdv` in [1e-6, 1e6]; `ini_align` within |roll| ≤ π, |pitch| ≤ π/2,
 //! |yaw| ≤ 2π. Each failure is a [`ParamsError`] with file:line:column and the field name.
 //! Fields the parser does not know are kept in `other` (name → values) rather than refused.
 
@@ -217,6 +217,8 @@ enum Range {
     Positive,
     /// any finite value
     Any,
+    /// a measurement σ in [1e-6, 1e6] (the GNSS readers' range)
+    Sigma,
     /// ini_align: |roll| ≤ π, |pitch| ≤ π/2, |yaw| ≤ 2π
     Attitude,
 }
@@ -234,6 +236,10 @@ impl Fields<'_> {
                 Range::NonNegative => (v >= 0.0, "a value >= 0".to_string()),
                 Range::Positive => (v > 0.0, "a value > 0".to_string()),
                 Range::Any => (true, String::new()),
+                Range::Sigma => (
+                    (1e-6..=1e6).contains(&v),
+                    "a value in [1e-6, 1e6]".to_string(),
+                ),
                 Range::Attitude => {
                     let lim = [PI, PI / 2.0, 2.0 * PI][i.min(2)];
                     let axis = ["roll", "pitch", "yaw"][i.min(2)];
@@ -345,8 +351,8 @@ pub fn parse_navego_gnss_params(file: &Path, text: &str) -> Result<NavegoGnssPar
         map: parse_entries(file, text)?,
     };
     use Range::*;
-    let stdm: [f64; 3] = f.take("stdm", "position sigma [lat lon h], m", Positive)?;
-    let stdv: [f64; 3] = f.take("stdv", "velocity sigma [N E D], m/s", Positive)?;
+    let stdm: [f64; 3] = f.take("stdm", "position sigma [lat lon h], m", Sigma)?;
+    let stdv: [f64; 3] = f.take("stdv", "velocity sigma [N E D], m/s", Sigma)?;
     let p = NavegoGnssParams {
         stdm_ned_m: stdm,
         stdv_ned_mps: stdv,

@@ -102,3 +102,70 @@ fn kfgins_gnss_text() {
     let c = clip_to_imu_span(&path, &m, 456_300.0, 456_400.0).unwrap();
     assert_eq!((c.before, c.fixes.len(), c.after), (50, 101, n - 151));
 }
+
+/// NaveGo's fixes against its reference trajectory: the errors must have the σ that
+/// `gnss_params.txt` states (5, 5, 10 m and 0.0514 m/s), which checks the reader's units
+/// (radians, NED, σ order). Sample σ of n = 2187 draws: relative standard error 1/√(2n)
+/// = 1.5 %; the band is ±5 standard errors (7.6 %). The noise is white, so the mean must be
+/// within 5 σ/√n.
+#[test]
+fn navego_fixes_have_the_stated_noise() {
+    let Some(d) = data("csv/navego") else { return };
+    let g = read_gnss_file(
+        &d.join("gnss.csv"),
+        GnssFormat::NaveGo,
+        &GnssReadOptions::default(),
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(d.join("ref.csv")).unwrap();
+    let refs: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    // WGS-84 radii of curvature (Groves eq. 2.105, 2.106)
+    let (a, e2) = (6_378_137.0, 6.694_379_990_14e-3);
+    let mut err: Vec<[f64; 6]> = Vec::new();
+    for f in &g.fixes {
+        let k = refs.partition_point(|r| r[0] < f.t_s - 1e-6);
+        let r = &refs[k];
+        assert!((r[0] - f.t_s).abs() < 1e-6, "no reference row at {}", f.t_s);
+        let s2 = r[1].sin().powi(2);
+        let rn = a * (1.0 - e2) / (1.0 - e2 * s2).powf(1.5);
+        let re = a / (1.0 - e2 * s2).sqrt();
+        let (v, _) = f.vel.unwrap();
+        err.push([
+            (f.lat_rad - r[1]) * (rn + r[3]),
+            (f.lon_rad - r[2]) * (re + r[3]) * r[1].cos(),
+            -(f.h_m - r[3]),
+            v[0] - r[4],
+            v[1] - r[5],
+            v[2] - r[6],
+        ]);
+    }
+    let n = err.len() as f64;
+    let sig = [
+        g.fixes[0].pos_cov_ned_m2[(0, 0)].sqrt(),
+        g.fixes[0].pos_cov_ned_m2[(1, 1)].sqrt(),
+        g.fixes[0].pos_cov_ned_m2[(2, 2)].sqrt(),
+        g.fixes[0].vel.unwrap().1[(0, 0)].sqrt(),
+        g.fixes[0].vel.unwrap().1[(1, 1)].sqrt(),
+        g.fixes[0].vel.unwrap().1[(2, 2)].sqrt(),
+    ];
+    for i in 0..6 {
+        let mean = err.iter().map(|e| e[i]).sum::<f64>() / n;
+        let sd = (err.iter().map(|e| (e[i] - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        println!(
+            "axis {i}: mean {mean:.4}, sample σ {sd:.4}, stated σ {:.4}",
+            sig[i]
+        );
+        assert!(
+            mean.abs() < 5.0 * sig[i] / n.sqrt(),
+            "axis {i}: mean {mean}"
+        );
+        assert!(
+            (sd / sig[i] - 1.0).abs() < 5.0 / (2.0 * n).sqrt(),
+            "axis {i}: σ {sd}"
+        );
+    }
+}

@@ -1,7 +1,7 @@
 //! Line splitting with character columns, number parsing and the value checks shared by
 //! every GNSS reader (each failure is a located [`GnssFileError`]).
 
-use super::{GnssFileError, H_RANGE_M, MAX_SIGMA_M, MAX_SPEED_MPS};
+use super::{GnssFileError, H_RANGE_M, MAX_SIGMA_M, MAX_SPEED_MPS, MIN_SIGMA_M};
 use std::path::{Path, PathBuf};
 
 /// One field of a line: its text and 1-based character column.
@@ -171,7 +171,7 @@ impl Ctx<'_> {
         )
     }
 
-    /// A standard deviation: > 0 and ≤ [`MAX_SIGMA_M`].
+    /// A standard deviation in [[`MIN_SIGMA_M`], [`MAX_SIGMA_M`]].
     pub fn sigma(&self, line: usize, fld: Field<'_>, name: &str) -> Result<f64, GnssFileError> {
         let v = self.num(line, fld, name)?;
         self.range(
@@ -179,8 +179,8 @@ impl Ctx<'_> {
             fld,
             name,
             v,
-            v > 0.0 && v <= MAX_SIGMA_M,
-            &format!("a standard deviation > 0 and <= {MAX_SIGMA_M:e}"),
+            (MIN_SIGMA_M..=MAX_SIGMA_M).contains(&v),
+            &format!("a standard deviation in [{MIN_SIGMA_M:e}, {MAX_SIGMA_M:e}]"),
         )
     }
 
