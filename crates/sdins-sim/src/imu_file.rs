@@ -482,7 +482,7 @@ pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuDa
 
 /// Mean specific force along body z over the record [g], in the file's own axes.
 fn mean_fz_g(incs: &[Increment], dt_s: f64) -> f64 {
-    if incs.is_empty() || !(dt_s > 0.0) {
+    if incs.is_empty() || dt_s.is_nan() || dt_s <= 0.0 {
         return 0.0;
     }
     let s: f64 = incs.iter().map(|i| i.dv_b_mps[2]).sum();
