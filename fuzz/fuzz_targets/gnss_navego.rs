@@ -7,7 +7,11 @@ use sdins_sim::navego_params::parse_navego_gnss_params;
 
 fuzz_target!(|data: &[u8]| {
     let all = String::from_utf8_lossy(data);
-    let (params, text) = all.split_once("---\n").unwrap_or(("stdm = [5, 5, 10]\nstdv = [0.05, 0.05, 0.05]\nfreq = [5]\n", &all));
+    let all: &str = &all;
+    let (params, text) = all.split_once("---\n").unwrap_or((
+        "stdm = [5, 5, 10]\nstdv = [0.05, 0.05, 0.05]\nfreq = [5]\n",
+        all,
+    ));
     let Ok(p) = parse_navego_gnss_params(Path::new("gnss_params.txt"), params) else {
         return;
     };
