@@ -35,6 +35,12 @@ pub const MAX_DTHETA_RAD: f64 = core::f64::consts::PI;
 pub const MAX_SPECIFIC_FORCE_G: f64 = 1000.0;
 /// Largest accepted relative deviation of a sample interval from the median.
 pub const DT_TOLERANCE: f64 = 0.01;
+/// Accepted sample interval range [s]: 1 MHz to 1 Hz (a strapdown IMU record outside it is
+/// a wrong time unit or a corrupt file).
+pub const DT_RANGE_S: (f64, f64) = (1.0e-6, 1.0);
+/// |mean specific force along z| [g] above which auto-detection tells an FRD (z down:
+/// f_z ≈ −g) from an RFU (z up: f_z ≈ +g) increment CSV with the same header.
+pub const GRAVITY_SIGN_THRESHOLD_G: f64 = 0.5;
 /// Gravity used for the |f| limit [m/s²].
 const G0: f64 = 9.80665;
 /// One arcsecond [rad].
@@ -180,6 +186,10 @@ pub struct ImuData {
     pub increments: Vec<Increment>,
     /// PSINS `.imu` header, if that was the format
     pub psins: Option<PsinsHeader>,
+    /// how auto-detection picked the format (`None` when the format was given)
+    pub detection: Option<String>,
+    /// notes that did not stop reading (for example a last line without final newline)
+    pub warnings: Vec<String>,
 }
 
 /// Why a file could not be read.
@@ -332,6 +342,45 @@ pub enum ImuFileError {
         /// the limit
         limit: f64,
     },
+    /// More than one format fits the content.
+    #[error("{}:{line}: ambiguous IMU format: {why}; candidates: {}; give --format", file.display(), candidates.join(", "))]
+    Ambiguous {
+        /// the file
+        file: PathBuf,
+        /// the line looked at
+        line: usize,
+        /// the formats that fit
+        candidates: Vec<&'static str>,
+        /// why
+        why: String,
+    },
+    /// The sample interval is outside [`DT_RANGE_S`].
+    #[error("{}:{line}: column 1 (time): sample interval {dt_s:e} s, expected {min_s:e} .. {max_s} s", file.display())]
+    IntervalOutOfRange {
+        /// the file
+        file: PathBuf,
+        /// 1-based line (the header line for PSINS `Ts`)
+        line: usize,
+        /// the interval [s]
+        dt_s: f64,
+        /// lower limit [s]
+        min_s: f64,
+        /// upper limit [s]
+        max_s: f64,
+    },
+    /// The last line (no final newline) ends in a number with fewer decimals than the same
+    /// column on the line before (fixed-decimal KF-GINS text): cut inside that number.
+    #[error("{}:{line}: column {column}: truncated last line: `{text}` has fewer decimals than the line before and the file has no final newline", file.display())]
+    CutNumber {
+        /// the file
+        file: PathBuf,
+        /// 1-based line
+        line: usize,
+        /// 1-based field number
+        column: usize,
+        /// the number as cut
+        text: String,
+    },
     /// A header value is out of range (non-positive sample interval, …).
     #[error("{}:{line}: column {column} ({name}): {what}", file.display())]
     BadValue {
@@ -360,6 +409,8 @@ pub fn read_imu_file(path: &Path, format: ImuFormat) -> Result<ImuData, ImuFileE
 
 /// Parse the text of an IMU file; `file` is only used in error messages.
 pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuData, ImuFileError> {
+    // a UTF-8 byte-order mark is accepted and skipped
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let p = Parser {
         file,
         ends_with_newline: text.ends_with('\n'),
@@ -370,6 +421,7 @@ pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuDa
             file: file.to_path_buf(),
         });
     };
+    let given = format;
     let format = match format {
         ImuFormat::Auto => detect(file, first_no, first)?,
         // `psins` names the conventions (RFU body): a PSINS trajectory exported as CSV with
@@ -377,13 +429,64 @@ pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuDa
         ImuFormat::Psins if first.trim_start().starts_with("t_s,") => ImuFormat::PsinsCsv,
         f => f,
     };
-    match format {
-        ImuFormat::Psins => p.psins(),
-        ImuFormat::KfGins => p.kfgins(),
+    let mut data = match format {
+        ImuFormat::Psins => p.psins()?,
+        ImuFormat::KfGins => p.kfgins()?,
         ImuFormat::Sdins | ImuFormat::PsinsCsv | ImuFormat::NaveGo | ImuFormat::Auto => {
-            p.csv(format)
+            p.csv(format)?
         }
+    };
+    if given == ImuFormat::Auto {
+        let why = match data.format {
+            ImuFormat::Psins => "a `%` PSINS header".to_string(),
+            ImuFormat::KfGins => "7 numbers per line without header (KF-GINS)".to_string(),
+            ImuFormat::NaveGo => "the NaveGo CSV header".to_string(),
+            _ if header_fields(first) == SDINS_RATE_HEADER => {
+                "the sdins rate CSV header".to_string()
+            }
+            _ => {
+                // the increment header is shared by sdins (FRD) and PSINS trj CSVs (RFU):
+                // gravity's sign on z decides (FRD z down: f_z ≈ −g; RFU z up: f_z ≈ +g)
+                let fz = mean_fz_g(&data.increments, data.dt_s);
+                let (f, w) = if fz < -GRAVITY_SIGN_THRESHOLD_G {
+                    (ImuFormat::Sdins, "FRD: z down")
+                } else if fz > GRAVITY_SIGN_THRESHOLD_G {
+                    (ImuFormat::PsinsCsv, "RFU: z up")
+                } else {
+                    return Err(ImuFileError::Ambiguous {
+                        file: file.to_path_buf(),
+                        line: first_no,
+                        candidates: vec!["sdins", "psins-csv"],
+                        why: format!(
+                            "the increment header is used by sdins (FRD) and PSINS trajectory CSVs (RFU), and the mean specific force along z, {fz:.3} g, is within ±{GRAVITY_SIGN_THRESHOLD_G} g, so gravity does not tell them apart"
+                        ),
+                    });
+                };
+                if f == ImuFormat::PsinsCsv {
+                    data = p.csv(ImuFormat::PsinsCsv)?;
+                }
+                format!(
+                    "the increment CSV header and a mean specific force along z of {fz:.3} g ({w})"
+                )
+            }
+        };
+        data.detection = Some(format!("read as `{}`: {why}", data.format));
     }
+    if !p.ends_with_newline {
+        data.warnings.push(
+            "the file does not end with a newline: its last line may have been cut inside its last number".into(),
+        );
+    }
+    Ok(data)
+}
+
+/// Mean specific force along body z over the record [g], in the file's own axes.
+fn mean_fz_g(incs: &[Increment], dt_s: f64) -> f64 {
+    if incs.is_empty() || dt_s.is_nan() || dt_s <= 0.0 {
+        return 0.0;
+    }
+    let s: f64 = incs.iter().map(|i| i.dv_b_mps[2]).sum();
+    s / (incs.len() as f64 * dt_s * G0)
 }
 
 /// Non-blank lines with their 1-based numbers (trailing `\r` removed).
@@ -496,6 +599,37 @@ impl Parser<'_> {
         Ok(out)
     }
 
+    /// Fixed-decimal text (KF-GINS prints every column with the same decimals): a last line
+    /// without final newline with fewer decimals in a field than the line before was cut.
+    fn check_cut_number(&self) -> Result<(), ImuFileError> {
+        let n = self.lines.len();
+        if self.ends_with_newline || n < 2 {
+            return Ok(());
+        }
+        let dec = |s: &str| {
+            if s.contains(['e', 'E']) {
+                None
+            } else {
+                Some(s.find('.').map_or(0, |k| s.len() - k - 1))
+            }
+        };
+        let (line, last) = self.lines[n - 1];
+        let prev = split_fields(self.lines[n - 2].1);
+        for (c, (a, b)) in prev.iter().zip(split_fields(last)).enumerate() {
+            if let (Some(da), Some(db)) = (dec(a), dec(b)) {
+                if db < da {
+                    return Err(ImuFileError::CutNumber {
+                        file: self.f(),
+                        line,
+                        column: c + 1,
+                        text: b.to_string(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Line number of data row `k` when the data starts at `lines[from]`.
     fn line_of(&self, from: usize, k: usize) -> usize {
         self.lines.get(from + k).map_or(0, |l| l.0)
@@ -535,7 +669,17 @@ impl Parser<'_> {
             }
         }
         // the mean interval: more accurate than the median of rounded differences
-        Ok((t[0], (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64))
+        let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+        if !(DT_RANGE_S.0..=DT_RANGE_S.1).contains(&dt) {
+            return Err(ImuFileError::IntervalOutOfRange {
+                file: self.f(),
+                line: self.line_of(from, 1),
+                dt_s: dt,
+                min_s: DT_RANGE_S.0,
+                max_s: DT_RANGE_S.1,
+            });
+        }
+        Ok((t[0], dt))
     }
 
     /// Magnitude checks on one converted sample.
@@ -654,10 +798,13 @@ impl Parser<'_> {
             t0_s: t0,
             increments: incs,
             psins: None,
+            detection: None,
+            warnings: Vec::new(),
         })
     }
 
     fn kfgins(&self) -> Result<ImuData, ImuFileError> {
+        self.check_cut_number()?;
         let (v, t0, dt) = self.timed(0, &KFGINS_NAMES)?;
         let mut incs = Vec::with_capacity(v.len());
         for (k, [g, f]) in v.into_iter().enumerate() {
@@ -671,6 +818,8 @@ impl Parser<'_> {
             t0_s: t0,
             increments: incs,
             psins: None,
+            detection: None,
+            warnings: Vec::new(),
         })
     }
 
@@ -773,6 +922,15 @@ impl Parser<'_> {
             gyro_weight_arcsec: [hdr[2][0], hdr[2][1], hdr[2][2]],
             accel_weight_ugs: [hdr[2][3], hdr[2][4], hdr[2][5]],
         };
+        if !(DT_RANGE_S.0..=DT_RANGE_S.1).contains(&header.ts_s) {
+            return Err(ImuFileError::IntervalOutOfRange {
+                file: self.f(),
+                line: l2,
+                dt_s: header.ts_s,
+                min_s: DT_RANGE_S.0,
+                max_s: DT_RANGE_S.1,
+            });
+        }
         let from = start + 3;
         if from >= self.lines.len() {
             return Err(ImuFileError::NoData {
@@ -798,6 +956,8 @@ impl Parser<'_> {
             t0_s: header.t0_s + dt,
             increments: incs,
             psins: Some(header),
+            detection: None,
+            warnings: Vec::new(),
         })
     }
 }
@@ -1053,5 +1213,104 @@ mod tests {
         );
         assert_eq!("psins-csv".parse::<ImuFormat>(), Ok(ImuFormat::PsinsCsv));
         assert!("foo".parse::<ImuFormat>().is_err());
+    }
+
+    #[test]
+    fn intervals_bom_cut_lines_and_detection() {
+        // absurd sample intervals: a 1e298 s step (regular, so only the range catches it)
+        let t = format!(
+            "{INC_H}0,1e-4,2e-4,3e-4,0.01,0.02,-0.098\n1e298,1e-4,2e-4,3e-4,0.01,0.02,-0.098\n2e298,1e-4,2e-4,3e-4,0.01,0.02,-0.098\n"
+        );
+        let e = err(&t, ImuFormat::Auto);
+        assert!(
+            matches!(e, ImuFileError::IntervalOutOfRange { line: 3, .. }),
+            "{e}"
+        );
+        assert!(e.to_string().contains("sample interval 1e298 s"), "{e}");
+        let t = "100 1e-5 2e-5 3e-5 0.001 0.002 -0.049\n100.0000000001 1e-5 2e-5 3e-5 0.001 0.002 -0.049\n";
+        assert!(matches!(
+            err(t, ImuFormat::KfGins),
+            ImuFileError::IntervalOutOfRange { .. }
+        ));
+        let e = err(
+            "% x\n0 0 0 0 0 0\n34 108 380 0 1e300 9.78\n0.1 0.1 0.1 125 125 125\n1 2 3 4 5 6\n",
+            ImuFormat::Psins,
+        );
+        assert!(
+            matches!(e, ImuFileError::IntervalOutOfRange { line: 3, .. }),
+            "{e}"
+        );
+        // byte-order mark accepted
+        let d = parse(&format!("\u{feff}{INC_H}{}", good_rows(3)), ImuFormat::Auto).unwrap();
+        assert_eq!(d.increments.len(), 3);
+        // last line cut inside its last number, no final newline: KF-GINS (fixed decimals)
+        let kf = "100.000 1.0e-5 2e-5 3e-5 0.00100 0.00200 -0.04900\n100.005 1e-5 2e-5 3e-5 0.00100 0.00200 -0.049";
+        let e = err(kf, ImuFormat::Auto);
+        assert!(
+            matches!(
+                e,
+                ImuFileError::CutNumber {
+                    line: 2,
+                    column: 7,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // ... and in the middle of the line: too few fields
+        let e = err(
+            &format!("{INC_H}{}0.04,1e-4,2e", good_rows(3)),
+            ImuFormat::Auto,
+        );
+        assert!(
+            matches!(
+                e,
+                ImuFileError::Truncated {
+                    line: 5,
+                    found: 3,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // a complete last line without newline: read, with a warning
+        let t = format!("{INC_H}{}", good_rows(3));
+        let d = parse(t.trim_end(), ImuFormat::Auto).unwrap();
+        assert_eq!((d.increments.len(), d.warnings.len()), (3, 1));
+        // detection reported; the increment header shared by sdins (FRD) and PSINS CSV (RFU)
+        let d = parse(&t, ImuFormat::Auto).unwrap();
+        assert_eq!(d.format, ImuFormat::Sdins);
+        assert!(
+            d.detection.as_deref().unwrap().contains("FRD"),
+            "{:?}",
+            d.detection
+        );
+        assert_eq!(parse(&t, ImuFormat::Sdins).unwrap().detection, None);
+        // a PSINS trajectory CSV (z up: +g) is read as psins-csv, not as FRD
+        let rfu: String = (0..5)
+            .map(|k| format!("{},1e-4,2e-4,3e-4,0.01,0.02,0.098\n", 0.01 * (k + 1) as f64))
+            .collect();
+        let d = parse(&format!("{INC_H}{rfu}"), ImuFormat::Auto).unwrap();
+        assert_eq!(d.format, ImuFormat::PsinsCsv);
+        assert_eq!(d.increments[0].dv_b_mps, Vec3::new(0.02, 0.01, -0.098));
+        // no gravity on z (free fall, or z horizontal): refused, candidates listed
+        let zero: String = (0..5)
+            .map(|k| format!("{},1e-4,2e-4,3e-4,0.01,0.02,0.0\n", 0.01 * (k + 1) as f64))
+            .collect();
+        let e = err(&format!("{INC_H}{zero}"), ImuFormat::Auto);
+        match &e {
+            ImuFileError::Ambiguous {
+                candidates,
+                line: 1,
+                ..
+            } => {
+                assert_eq!(candidates, &vec!["sdins", "psins-csv"])
+            }
+            _ => panic!("{e}"),
+        }
+        assert!(
+            e.to_string().contains("candidates: sdins, psins-csv"),
+            "{e}"
+        );
     }
 }

@@ -53,10 +53,15 @@ pub fn c_b_n_from_psins(pitch: f64, roll: f64, yaw: f64) -> Mat3 {
 pub const MAX_LAT_DEG: f64 = 90.0;
 /// Accepted height range [m] (the same as the scenario parser's).
 pub const H_RANGE_M: (f64, f64) = (-1000.0, 100_000.0);
+/// Largest accepted step between two reference rows [s] (a larger step is a wrong time
+/// unit or a corrupt file; comparisons interpolate between rows).
+pub const MAX_TRUTH_STEP_S: f64 = 60.0;
 
 /// Parse the rows of a reference-trajectory CSV: the header must start with `expect`;
 /// every row needs at least `expect.len()` finite numbers and a strictly increasing time.
 fn parse_rows(path: &Path, text: &str, expect: &[&str]) -> Result<Vec<Vec<f64>>, TruthFileError> {
+    // a UTF-8 byte-order mark is accepted and skipped
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
@@ -151,6 +156,16 @@ fn parse_rows(path: &Path, text: &str, expect: &[&str]) -> Result<Vec<Vec<f64>>,
                     ln + 1,
                     col(0),
                     format!("expected a time after {prev} s, found {} s", r[0]),
+                ));
+            }
+            if r[0] - prev > MAX_TRUTH_STEP_S {
+                return Err(bad(
+                    ln + 1,
+                    col(0),
+                    format!(
+                        "step of {:e} s from the row before, expected at most {MAX_TRUTH_STEP_S} s",
+                        r[0] - prev
+                    ),
                 ));
             }
         }
@@ -294,6 +309,7 @@ pub fn read_psins_avp(path: &Path) -> Result<Vec<TruthSample>, TruthFileError> {
 
 /// Parse either format, told apart by the header (`pitch_rad` → PSINS avp).
 pub fn parse_truth_str(path: &Path, text: &str) -> Result<Vec<TruthSample>, TruthFileError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     if text
         .lines()
         .find(|l| !l.trim().is_empty() && !l.starts_with('#'))

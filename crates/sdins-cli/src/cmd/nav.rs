@@ -213,12 +213,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "algo": spec.kind.name(), "samples": spec.samples, "coning": spec.coning.name(),
             "earth": args.earth, "format": data.format.name(), "imu_samples": data.increments.len(),
             "dt_s": data.dt_s, "wall_s": wall, "final": last, "final_state": state,
+            "imu_detection": data.detection, "imu_warnings": data.warnings,
         });
         println!(
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?
         );
     } else {
+        if let Some(why) = &data.detection {
+            println!("{}: {why}", args.imu.display());
+        }
+        for w in &data.warnings {
+            println!("{}: warning: {w}", args.imu.display());
+        }
         println!(
             "{}: {} samples at {} s, {} updates in {:.3} s (navigation only)",
             spec.kind.name(),
