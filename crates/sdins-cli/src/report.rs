@@ -68,6 +68,32 @@ impl Report {
         Ok(())
     }
 
+    /// Write `dir/stem.svg` and `dir/stem.png` and embed the SVG with a caption.
+    pub fn figure_file(
+        &mut self,
+        fig: &Figure,
+        dir: &Path,
+        stem: &str,
+        caption: &str,
+    ) -> Result<(), CliError> {
+        let svg = fig.save(dir, stem)?;
+        self.svg(&svg, &format!("{caption} ({stem}.svg, {stem}.png)"));
+        Ok(())
+    }
+
+    /// Write `dir/stem.svg` and `dir/stem.png` of a bar chart and embed the SVG.
+    pub fn bars_file(
+        &mut self,
+        b: &crate::plot::Bars,
+        dir: &Path,
+        stem: &str,
+        caption: &str,
+    ) -> Result<(), CliError> {
+        let svg = b.save(dir, stem)?;
+        self.svg(&svg, &format!("{caption} ({stem}.svg, {stem}.png)"));
+        Ok(())
+    }
+
     /// An inline SVG bar chart with a caption.
     pub fn bars(&mut self, b: &crate::plot::Bars, caption: &str) -> Result<(), CliError> {
         self.svg(&b.svg()?, caption);

@@ -404,7 +404,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         {
             write_string(&dir.join("align_history.csv"), &hist)?;
             if rows.len() >= 2 {
-                svgs = Some(write_plots(dir, &rows)?);
+                let tb = inp.true_bias.map(|(ba, bg)| {
+                    let a = |v: Vec3, u: f64| [v.x / u, v.y / u, v.z / u];
+                    (a(ba, UG), a(bg, DPH))
+                });
+                svgs = Some(write_plots(dir, &rows, tb)?);
             } else {
                 eprintln!(
                     "note: {} Kalman cycle(s): too short for the alignment plots",

@@ -340,7 +340,7 @@ fn write_folder(
     env: &[EnvelopePoint],
     budget: &[BudgetRow],
 ) -> Result<(), CliError> {
-    use crate::plot::{Bars, Figure, Panel, Series};
+    use crate::plot::{Band, Bars, Figure, Panel, Series};
     // time histories: closed form and linear model on the linear model's grid (≤ 400 points)
     let stride = (env.len() / 400).max(1);
     let pts: Vec<(f64, StationarySolution, &EnvelopePoint)> = env
@@ -366,21 +366,29 @@ fn write_folder(
     }
     crate::output::write_string(&out.join("errors.csv"), &csv)?;
     let h = |t: f64| t / 3600.0;
-    let line = |name: &str, f: &dyn Fn(&(f64, StationarySolution, &EnvelopePoint)) -> f64| Series {
-        name: name.to_string(),
-        points: pts.iter().map(|p| (h(p.0), f(p))).collect(),
+    let line = |name: &str, f: &dyn Fn(&(f64, StationarySolution, &EnvelopePoint)) -> f64| {
+        Series::line(name, pts.iter().map(|p| (h(p.0), f(p))).collect())
     };
     let panel = |axis: usize, title: &str| Panel {
         title: title.to_string(),
         x_label: "time [h]".into(),
         y_label: "position error [m]".into(),
-        log_y: false,
+        bands: vec![Band {
+            name: "linear model ± 1σ".into(),
+            color_of: "linear model".into(),
+            points: pts
+                .iter()
+                .map(|p| {
+                    let s = p.2.sigma_p_m[axis];
+                    (h(p.0), p.2.dp_n_m[axis] - s, p.2.dp_n_m[axis] + s)
+                })
+                .collect(),
+        }],
         series: vec![
             line("closed form", &|p| p.1.dp_n[axis]),
             line("linear model", &|p| p.2.dp_n_m[axis]),
-            line("+1σ", &|p| p.2.sigma_p_m[axis]),
-            line("−1σ", &|p| -p.2.sigma_p_m[axis]),
         ],
+        ..Panel::default()
     };
     let fig = Figure {
         panels: vec![
@@ -390,7 +398,6 @@ fn write_folder(
         cols: 2,
         size: (1200, 450),
     };
-    fig.png(&out.join("errors.png"))?;
     let bars = Bars {
         title: format!(
             "error budget: horizontal position error at {:.3} h",
@@ -403,7 +410,6 @@ fn write_folder(
             .collect(),
         size: (900, 420),
     };
-    bars.png(&out.join("budget.png"))?;
 
     let mut rep = crate::report::Report::new("sdins errors");
     rep.para(&format!(
@@ -449,9 +455,11 @@ fn write_folder(
         ],
         &rows,
     );
-    rep.figure(
+    rep.figure_file(
         &fig,
-        "Position error vs time: closed form (spec §4.3), 15-state linear model, and its 1σ envelope (biases as 1σ uncertainty plus the grade's noise). Also errors.png.",
+        out,
+        "errors",
+        "Position error vs time: closed form (spec §4.3), 15-state linear model, and its 1σ envelope (biases as 1σ uncertainty plus the grade's noise).",
     )?;
     let brows: Vec<Vec<String>> = budget
         .iter()
@@ -467,9 +475,11 @@ fn write_folder(
         .collect();
     rep.heading("Error budget");
     rep.table(&["source", "value", "δN [m]", "δE [m]", "|δp| [m]"], &brows);
-    rep.bars(
+    rep.bars_file(
         &bars,
-        "Each source alone through the closed form at the final time (the closed form is linear: the rows add up as vectors to the all-sources error). Also budget.png.",
+        out,
+        "budget",
+        "Each source alone through the closed form at the final time (the closed form is linear: the rows add up as vectors to the all-sources error).",
     )?;
     rep.write(&out.join("report.html"))?;
 

@@ -142,10 +142,6 @@ pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, Cli
 /// (t, horizontal position, |down position|, velocity norm, attitude norm).
 pub type ErrSeries = Vec<(f64, f64, f64, f64, f64)>;
 
-/// Per-axis errors of one algorithm at the output epochs: (t, [attitude N, E, D \[rad\],
-/// velocity N, E, D \[m/s\], position N, E, D \[m\]]).
-pub type NedSeries = Vec<(f64, [f64; 9])>;
-
 /// Everything a run produced.
 pub struct Outcome {
     /// the scenario
@@ -156,10 +152,90 @@ pub struct Outcome {
     pub out: PathBuf,
     /// per-algorithm error time series
     pub series: Vec<ErrSeries>,
-    /// per-algorithm per-axis error time series
-    pub ned: Vec<NedSeries>,
     /// y scale of the per-axis figure
     pub plot_scale: PlotScale,
+    /// full-rate data for the figures, min/max-decimated per pixel column
+    pub plot: PlotData,
+}
+
+/// Columns of the full-rate figure data (at least the pixel width of any panel).
+pub const PLOT_COLUMNS: usize = 2000;
+
+/// Channels of [`PlotData::errors`]: the four error norms of [`ErrSeries`], then the nine
+/// per-axis errors in display units (attitude μrad, velocity m/s,
+/// position m), as absolute values when the plot scale is logarithmic.
+const ERR_CHANNELS: usize = 13;
+
+/// Full-rate (every navigation update) figure data of a run, decimated online with
+/// min/max per column ([`crate::plot::MinMaxColumns`]) so that short manoeuvres show.
+pub struct PlotData {
+    /// per algorithm: [`ERR_CHANNELS`] channels
+    pub errors: Vec<crate::plot::MinMaxColumns>,
+    /// truth height [m], roll, pitch, yaw (unwrapped) [deg]
+    pub trajectory: crate::plot::MinMaxColumns,
+    /// truth ground track (east, north) [m] from the start, one point per column
+    pub track_en_m: Vec<(f64, f64)>,
+    track_col: Option<usize>,
+    t_end_s: f64,
+    lat0_lon0: Option<(f64, f64)>,
+    yaw_prev_deg: Option<f64>,
+    yaw_turns: f64,
+}
+
+impl PlotData {
+    fn new(n_algos: usize, t_end_s: f64) -> Self {
+        let cols = crate::plot::MinMaxColumns::new(0.0, t_end_s, PLOT_COLUMNS, ERR_CHANNELS);
+        Self {
+            errors: vec![cols; n_algos],
+            trajectory: crate::plot::MinMaxColumns::new(0.0, t_end_s, PLOT_COLUMNS, 4),
+            track_en_m: Vec::new(),
+            track_col: None,
+            t_end_s,
+            lat0_lon0: None,
+            yaw_prev_deg: None,
+            yaw_turns: 0.0,
+        }
+    }
+
+    /// Record the truth at one update: ground track relative to the first sample on the
+    /// local tangent plane, `δN = δL (R_M + h)`, `δE = δλ (R_N + h) cos L` (the position
+    /// error convention of docs/conventions.md), height and Euler angles.
+    fn push_truth(
+        &mut self,
+        earth: &sdins_core::earth::EarthModel,
+        tr: &sdins_sim::truth::TruthSample,
+    ) {
+        let d = 180.0 / std::f64::consts::PI;
+        let (lat0, lon0) = *self.lat0_lon0.get_or_insert((tr.lat_rad, tr.lon_rad));
+        let col = ((tr.t_s / self.t_end_s.max(1e-300)) * PLOT_COLUMNS as f64).floor() as usize;
+        if self.track_col != Some(col) {
+            self.track_col = Some(col);
+            let r = earth.radii(tr.lat_rad);
+            let n = (tr.lat_rad - lat0) * (r.r_m_m + tr.h_m);
+            let e = (tr.lon_rad - lon0) * (r.r_n_m + tr.h_m) * tr.lat_rad.cos();
+            self.track_en_m.push((e, n));
+        }
+        let eu = sdins_core::math::euler_from_c_b_n(&tr.c_b_n);
+        let yaw = eu.yaw_rad * d;
+        if let Some(prev) = self.yaw_prev_deg {
+            let jump = yaw - prev;
+            if jump > 180.0 {
+                self.yaw_turns -= 1.0;
+            } else if jump < -180.0 {
+                self.yaw_turns += 1.0;
+            }
+        }
+        self.yaw_prev_deg = Some(yaw);
+        self.trajectory.push(
+            tr.t_s,
+            &[
+                tr.h_m,
+                eu.roll_rad * d,
+                eu.pitch_rad * d,
+                yaw + 360.0 * self.yaw_turns,
+            ],
+        );
+    }
 }
 
 /// Run and return the summaries (used by `demo` too).
@@ -224,12 +300,16 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let mut bar = Progress::new(total, "navigate", args.quiet);
     let mut io_error = None;
     let mut series: Vec<ErrSeries> = vec![Vec::new(); algos.len()];
-    let mut ned: Vec<NedSeries> = vec![Vec::new(); algos.len()];
+    let mut plot = PlotData::new(algos.len(), scn.duration_s());
+    let log = args.plot_scale == PlotScale::Log;
+    let earth = scn.nav.earth.model();
+    let mut updates = vec![0_u64; algos.len()];
     let d = 180.0 / std::f64::consts::PI;
+    // the figures take every update; the CSV files and the series every `every`
     let opts = RunOptions {
         algos: algos.clone(),
         vertical_hold: hold,
-        every,
+        every: 1,
         until_s: None,
         sensor_run: if args.ideal { None } else { Some(args.run) },
     };
@@ -237,7 +317,31 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         &scn,
         &opts,
         &crate::progress::token(),
-        |i, st, _tr, e| {
+        |i, st, tr, e| {
+            let (p, v, a, u) = (
+                e.pos_err_ned_m,
+                e.vel_err_ned_mps,
+                e.att_err_rad,
+                e.euler_err_rad,
+            );
+            let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            let norms = [p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)];
+            let mut ch = [0.0; ERR_CHANNELS];
+            ch[..4].copy_from_slice(&norms);
+            for k in 0..3 {
+                let f = |x: f64| if log { x.abs() } else { x };
+                ch[4 + k] = f(a[k] * 1e6);
+                ch[7 + k] = f(v[k]);
+                ch[10 + k] = f(p[k]);
+            }
+            plot.errors[i].push(e.t_s, &ch);
+            if i == 0 {
+                plot.push_truth(&earth, tr);
+            }
+            updates[i] += 1;
+            if !(updates[i] % every == 0 || updates[i] == total) {
+                return;
+            }
             let eu = st.euler();
             let r1 = writeln!(
                 nav_files[i].writer(),
@@ -253,18 +357,7 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
                 eu.pitch_rad * d,
                 eu.yaw_rad * d
             );
-            let (p, v, a, u) = (
-                e.pos_err_ned_m,
-                e.vel_err_ned_mps,
-                e.att_err_rad,
-                e.euler_err_rad,
-            );
-            let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-            series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
-            ned[i].push((
-                e.t_s,
-                [a[0], a[1], a[2], v[0], v[1], v[2], p[0], p[1], p[2]],
-            ));
+            series[i].push((e.t_s, norms[0], norms[1], norms[2], norms[3]));
             let r2 = writeln!(
                 err_files[i].writer(),
                 "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
@@ -303,8 +396,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         sums: summaries,
         out,
         series,
-        ned,
         plot_scale: args.plot_scale,
+        plot,
     };
     write_report(&outcome)?;
     Ok(outcome)
@@ -328,10 +421,12 @@ fn write_run_toml(out: &std::path::Path, scn: &Scenario, args: &Args) -> Result<
     crate::report::write_run_toml(out, t)
 }
 
-/// The error figure of a run: log-scale error norms per algorithm.
+/// The error figure of a run: log-scale error norms per algorithm, from every
+/// navigation update (min/max per pixel column). Attitude in μrad, the unit of
+/// free-inertial attitude errors in every report.
 pub fn error_figure(o: &Outcome) -> crate::plot::Figure {
     use crate::plot::{Figure, Panel, Series};
-    let panel = |title: &str, unit: &str, k: usize| Panel {
+    let panel = |title: &str, unit: &str, k: usize, scale: f64| Panel {
         title: title.to_string(),
         x_label: "time [s]".into(),
         y_label: unit.to_string(),
@@ -339,41 +434,44 @@ pub fn error_figure(o: &Outcome) -> crate::plot::Figure {
         series: o
             .sums
             .iter()
-            .zip(&o.series)
-            .map(|(s, ser)| Series {
-                name: s.algo.clone(),
-                points: ser.iter().map(|r| (r.0, [r.1, r.2, r.3, r.4][k])).collect(),
+            .zip(&o.plot.errors)
+            .map(|(s, cols)| {
+                Series::line(
+                    s.algo.clone(),
+                    cols.series(k)
+                        .into_iter()
+                        .map(|(t, y)| (t, y * scale))
+                        .collect(),
+                )
             })
             .collect(),
+        ..Panel::default()
     };
     Figure {
         panels: vec![
-            panel("horizontal position error", "|δN, δE| [m]", 0),
-            panel("vertical position error", "|δD| [m]", 1),
-            panel("velocity error", "|δv| [m/s]", 2),
-            panel("attitude error", "|ε| [rad]", 3),
+            panel("horizontal position error", "|δN, δE| [m]", 0, 1.0),
+            panel("vertical position error", "|δD| [m]", 1, 1.0),
+            panel("velocity error", "|δv| [m/s]", 2, 1.0),
+            panel("attitude error", "|ε| [μrad]", 3, 1e6),
         ],
         cols: 2,
         size: (1400, 900),
     }
 }
 
-/// Arc seconds per radian.
-const ARCSEC_PER_RAD: f64 = 180.0 * 3600.0 / std::f64::consts::PI;
-
-/// The per-axis error figure of a run (`errors_ned.png`): attitude (arcsec), velocity
-/// (m/s) and position (m) error, N/E/D, one line per algorithm. On a log scale the
-/// absolute value is drawn.
+/// The per-axis error figure of a run (`errors_ned`): attitude (μrad), velocity (m/s)
+/// and position (m) error, N/E/D, one line per algorithm, from every navigation update
+/// (min/max per pixel column). On a log scale the absolute value is drawn.
 pub fn ned_figure(o: &Outcome) -> crate::plot::Figure {
     use crate::plot::{Figure, Panel, Series};
     let log = o.plot_scale == PlotScale::Log;
     let groups = [
-        ("attitude error", "ε", "arcsec", ARCSEC_PER_RAD, 0),
-        ("velocity error", "δv", "m/s", 1.0, 3),
-        ("position error", "δp", "m", 1.0, 6),
+        ("attitude error", "ε", "μrad", 4),
+        ("velocity error", "δv", "m/s", 7),
+        ("position error", "δp", "m", 10),
     ];
     let mut panels = Vec::new();
-    for (what, sym, unit, scale, first) in groups {
+    for (what, sym, unit, first) in groups {
         for (k, axis) in ["N", "E", "D"].iter().enumerate() {
             let y_label = if log {
                 format!("|{sym}_{axis}| [{unit}]")
@@ -388,18 +486,10 @@ pub fn ned_figure(o: &Outcome) -> crate::plot::Figure {
                 series: o
                     .sums
                     .iter()
-                    .zip(&o.ned)
-                    .map(|(s, ser)| Series {
-                        name: s.algo.clone(),
-                        points: ser
-                            .iter()
-                            .map(|(t, v)| {
-                                let y = v[first + k] * scale;
-                                (*t, if log { y.abs() } else { y })
-                            })
-                            .collect(),
-                    })
+                    .zip(&o.plot.errors)
+                    .map(|(s, cols)| Series::line(s.algo.clone(), cols.series(first + k)))
                     .collect(),
+                ..Panel::default()
             });
         }
     }
@@ -407,6 +497,45 @@ pub fn ned_figure(o: &Outcome) -> crate::plot::Figure {
         panels,
         cols: 3,
         size: (1500, 1150),
+    }
+}
+
+/// The trajectory of a run (`trajectory`): ground track north over east from the start
+/// (equal scales), height, and roll, pitch, yaw of the truth versus time (every update,
+/// min/max per pixel column; yaw unwrapped).
+pub fn trajectory_figure(o: &Outcome) -> crate::plot::Figure {
+    use crate::plot::{Figure, Panel, Series};
+    let tr = &o.plot.trajectory;
+    let time = |title: &str, y: &str, series: Vec<Series>| Panel {
+        title: title.into(),
+        x_label: "time [s]".into(),
+        y_label: y.into(),
+        series,
+        ..Panel::default()
+    };
+    Figure {
+        panels: vec![
+            Panel {
+                title: "ground track".into(),
+                x_label: "east [m]".into(),
+                y_label: "north [m]".into(),
+                equal_axes: true,
+                series: vec![Series::line("truth", o.plot.track_en_m.clone())],
+                ..Panel::default()
+            },
+            time("height", "h [m]", vec![Series::line("truth", tr.series(0))]),
+            time(
+                "attitude",
+                "angle [°]",
+                vec![
+                    Series::line("roll", tr.series(1)),
+                    Series::line("pitch", tr.series(2)),
+                    Series::line("yaw", tr.series(3)),
+                ],
+            ),
+        ],
+        cols: 3,
+        size: (1500, 480),
     }
 }
 
@@ -420,8 +549,8 @@ pub fn summary_rows(sums: &[RunSummary]) -> Vec<Vec<String>> {
                 e.pos_err_ned_m
                     .iter()
                     .chain(&e.vel_err_ned_mps)
-                    .chain(&e.att_err_rad)
-                    .map(|x| format!("{x:.3e}")),
+                    .map(|x| format!("{x:.3e}"))
+                    .chain(e.att_err_rad.iter().map(|x| format!("{:.3e}", x * 1e6))),
             );
             r.push(format!(
                 "{:.1}",
@@ -441,9 +570,9 @@ pub const SUMMARY_HEADER: [&str; 11] = [
     "vel N [m/s]",
     "vel E [m/s]",
     "vel D [m/s]",
-    "att N [rad]",
-    "att E [rad]",
-    "att D [rad]",
+    "att N [μrad]",
+    "att E [μrad]",
+    "att D [μrad]",
     "time [ns/update]",
 ];
 
@@ -459,17 +588,24 @@ fn write_report(o: &Outcome) -> Result<(), CliError> {
         o.sums.first().map_or(0.0, |s| s.final_err.t_s)
     ));
     r.table(&SUMMARY_HEADER, &summary_rows(&o.sums));
-    let fig = error_figure(o);
-    r.figure(
-        &fig,
-        "Error norms against the exact truth (log scale), one line per algorithm.",
+    r.figure_file(
+        &trajectory_figure(o),
+        &o.out,
+        "trajectory",
+        "Trajectory (truth): ground track from the start, height, and roll, pitch, yaw.",
     )?;
-    fig.png(&o.out.join("errors.png"))?;
-    let ned = ned_figure(o);
-    r.figure(
-        &ned,
+    r.figure_file(
+        &error_figure(o),
+        &o.out,
+        "errors",
+        "Error norms against the exact truth (log scale), one line per algorithm, every navigation update (min/max per pixel column).",
+    )?;
+    r.figure_file(
+        &ned_figure(o),
+        &o.out,
+        "errors_ned",
         &format!(
-            "Errors per NED axis against the exact truth ({}), one line per algorithm: attitude ε (arcsec), velocity (m/s), position (m). Also errors_ned.png.",
+            "Errors per NED axis against the exact truth ({}), one line per algorithm, every navigation update: attitude ε (μrad), velocity (m/s), position (m).",
             if o.plot_scale == PlotScale::Log {
                 "log scale of the absolute value"
             } else {
@@ -477,7 +613,6 @@ fn write_report(o: &Outcome) -> Result<(), CliError> {
             }
         ),
     )?;
-    ned.png(&o.out.join("errors_ned.png"))?;
     let bars = Bars {
         title: "navigation time per update".into(),
         y_label: "time [ns/update]".into(),
@@ -488,8 +623,10 @@ fn write_report(o: &Outcome) -> Result<(), CliError> {
             .collect(),
         size: (900, 400),
     };
-    r.bars(
+    r.bars_file(
         &bars,
+        &o.out,
+        "timing",
         "Wall time of each algorithm's navigation loop (truth generation excluded), this machine.",
     )?;
     r.write(&o.out.join("report.html"))
