@@ -139,6 +139,9 @@ pub struct Panel {
     pub y_fit_from_x: Option<f64>,
     /// equal metres per pixel on both axes (ground tracks)
     pub equal_axes: bool,
+    /// smallest y span of a linear axis (e.g. 1 m for a height that stays constant up to
+    /// rounding), so that noise at the 1e-13 level is not blown up to the full panel
+    pub min_y_span: f64,
     /// shaded bands, drawn under the lines
     pub bands: Vec<Band>,
     /// the lines
@@ -166,6 +169,26 @@ const COLORS: [RGBColor; 8] = [
     RGBColor(0x17, 0xbe, 0xcf),
     RGBColor(0x7f, 0x7f, 0x7f),
 ];
+
+/// Color key of legend-only entries that explain a style (e.g. "shaded: ±3σ") rather
+/// than name a quantity: drawn in grey, they take no palette color.
+pub const STYLE_KEY: &str = "\u{0}style";
+
+/// A legend-only entry in grey explaining what shaded bands mean.
+pub fn band_note(label: &str) -> Band {
+    Band {
+        name: label.into(),
+        color_of: STYLE_KEY.into(),
+        points: Vec::new(),
+    }
+}
+
+/// A legend-only entry in grey explaining what dashed lines mean.
+pub fn dashed_note(label: &str) -> Series {
+    Series::dashed(label, Vec::new()).colored_as(STYLE_KEY)
+}
+
+const GREY: RGBColor = RGBColor(0x70, 0x70, 0x70);
 
 /// Tick label font size [px].
 const LABEL_PX: u32 = 14;
@@ -427,6 +450,9 @@ impl Legend {
     }
 
     fn color(&mut self, name: &str) -> RGBColor {
+        if name == STYLE_KEY {
+            return GREY;
+        }
         let i = match self.names.iter().position(|n| n == name) {
             Some(i) => i,
             None => {
@@ -438,6 +464,9 @@ impl Legend {
     }
 
     fn color_of(&self, name: &str) -> RGBColor {
+        if name == STYLE_KEY {
+            return GREY;
+        }
         let i = self.names.iter().position(|n| n == name).unwrap_or(0);
         COLORS[i % COLORS.len()]
     }
@@ -584,6 +613,9 @@ fn bounds(p: &Panel) -> Option<(f64, f64, f64, f64)> {
     if p.log_y {
         y0 /= 1.6;
         y1 *= 1.6;
+    } else if y1 - y0 < p.min_y_span {
+        let c = 0.5 * (y0 + y1);
+        (y0, y1) = (c - 0.5 * p.min_y_span, c + 0.5 * p.min_y_span);
     } else {
         let span = y1 - y0;
         let pad = if span > 0.0 {

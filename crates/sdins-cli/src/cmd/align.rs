@@ -566,11 +566,11 @@ fn write_report(
         r.heading("Convergence");
         r.svg(
             att,
-            "Attitude error φ against the truth (solid, scenarios) with the filter's ±3σ bounds (dashed), μrad; also align_attitude.png.",
+            "Attitude error φ against the truth (solid, scenarios) with the filter's ±3σ bounds (shaded), μrad (align_attitude.svg, align_attitude.png).",
         );
         r.svg(
             bias,
-            "Bias estimates (solid) with ±3σ (dashed), body axes; also align_bias.png.",
+            "Bias estimates (solid) with ±3σ (shaded) and, for scenarios, the true bias (dashed), body axes (align_bias.svg, align_bias.png).",
         );
     }
     r.write(&dir.join("report.html"))

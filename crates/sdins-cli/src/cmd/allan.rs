@@ -321,12 +321,11 @@ pub fn figure(r: &AllanReport) -> crate::plot::Figure {
                 series.push(Series::points(name.clone(), pts, bars));
                 if let Some(f) = r.fits.get(c) {
                     for l in fit_lines(cv, f, unit) {
-                        series.push(
-                            Series::dashed(format!("{name} fits"), l).colored_as(name.clone()),
-                        );
+                        series.push(Series::dashed(String::new(), l).colored_as(name.clone()));
                     }
                 }
             }
+            series.push(crate::plot::dashed_note("fitted noise terms"));
             Panel {
                 title: title.into(),
                 x_label: "cluster time τ [s]".into(),

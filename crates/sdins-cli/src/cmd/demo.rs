@@ -206,31 +206,31 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .position(|s| s.algo == algo)
             .and_then(|i| o.series.get(i))
             .and_then(|s| s.iter().find(|p| (p.0 - 8.0).abs() <= 0.003))
-            .map_or(f64::NAN, |p| p.4)
+            .map_or(f64::NAN, |p| p.4 * 1e6) // μrad
     };
     let att_rows = vec![
         vec![
             "Song–Lee, transport attitude (S1 eq. 6)".into(),
             format!("{:.3e}", at8(&a2, "songlee")),
-            "8.30e−10".into(),
-            "≈ 1e−10".into(),
+            "8.30e−4".into(),
+            "≈ 1e−4".into(),
         ],
         vec![
             "Song–Lee velocity + (5)-method attitude".into(),
             format!("{:.3e}", at8(&a2five, "songlee")),
-            "2.99e−7".into(),
-            "0.3e−6".into(),
+            "0.299".into(),
+            "0.3".into(),
         ],
         vec![
             "Song–Lee complete".into(),
             format!("{:.3e}", at8(&a2, "songlee-complete")),
-            "6.7e−12 (SL + rot3)".into(),
+            "6.7e−6 (SL + rot3)".into(),
             "".into(),
         ],
         vec![
             "dual quaternion".into(),
             format!("{:.3e}", at8(&a2, "dualquat")),
-            "6.5e−14".into(),
+            "6.5e−8".into(),
             "".into(),
         ],
         vec![
@@ -251,9 +251,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &mut r,
         "2. 90°/s turn from east to south at Mach 1",
         &a2,
-        &["attitude option", "|ε| at 8 s [rad] (sdins)", "spec", "S1"],
+        &["attitude option", "|ε| at 8 s [μrad] (sdins)", "spec", "S1"],
         &att_rows,
-        "The transport-matrix attitude (S1 eq. 6) keeps the attitude error at the end of the turn near 1e-9 rad; the (5)-method reproduces S1's 0.3 μrad. Position errors during the turn are the trapezoid rule's transient (ΔT²/12)(a(t) − a(t0)), which vanishes when the turn ends.",
+        "The transport-matrix attitude (S1 eq. 6) keeps the attitude error at the end of the turn near 1e-3 μrad; the (5)-method reproduces S1's 0.3 μrad. Position errors during the turn are the trapezoid rule's transient (ΔT²/12)(a(t) − a(t0)), which vanishes when the turn ends.",
     )?;
 
     // 3. dual-quaternion paper case

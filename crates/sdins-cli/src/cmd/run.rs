@@ -506,10 +506,11 @@ pub fn ned_figure(o: &Outcome) -> crate::plot::Figure {
 pub fn trajectory_figure(o: &Outcome) -> crate::plot::Figure {
     use crate::plot::{Figure, Panel, Series};
     let tr = &o.plot.trajectory;
-    let time = |title: &str, y: &str, series: Vec<Series>| Panel {
+    let time = |title: &str, y: &str, min_y_span: f64, series: Vec<Series>| Panel {
         title: title.into(),
         x_label: "time [s]".into(),
         y_label: y.into(),
+        min_y_span,
         series,
         ..Panel::default()
     };
@@ -523,10 +524,16 @@ pub fn trajectory_figure(o: &Outcome) -> crate::plot::Figure {
                 series: vec![Series::line("truth", o.plot.track_en_m.clone())],
                 ..Panel::default()
             },
-            time("height", "h [m]", vec![Series::line("truth", tr.series(0))]),
+            time(
+                "height",
+                "h [m]",
+                2.0,
+                vec![Series::line("truth", tr.series(0))],
+            ),
             time(
                 "attitude",
                 "angle [°]",
+                2.0,
                 vec![
                     Series::line("roll", tr.series(1)),
                     Series::line("pitch", tr.series(2)),
