@@ -133,6 +133,22 @@ C_alg C_true<sup>T</sup> = I + [ε×]; position error δN = δL(R<sub>M</sub>+h)
     }
 }
 
+/// What in `html` would make a report depend on anything outside itself: scripts, links,
+/// frames, objects, `src`/`href` attributes, CSS `url(` and `@import`. Empty for a
+/// self-contained report. (The SVG namespace `xmlns="http://www.w3.org/2000/svg"` is a
+/// name, not a resource, and is allowed.)
+pub fn external_resources(html: &str) -> Vec<String> {
+    let lower = html.to_ascii_lowercase();
+    [
+        "<script", "<link", "<iframe", "<object", "<embed", "<img", " src=", " href=",
+        "xlink:href", "url(", "@import",
+    ]
+    .iter()
+    .filter(|n| lower.contains(*n))
+    .map(|n| n.to_string())
+    .collect()
+}
+
 /// The git commit sdins was built from, if known at build time.
 pub fn git_commit() -> &'static str {
     option_env!("SDINS_GIT_COMMIT").unwrap_or("unknown")
@@ -163,4 +179,38 @@ pub fn write_run_toml(dir: &Path, fields: toml::Table) -> Result<(), CliError> {
     t.extend(fields);
     let text = toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?;
     crate::output::write_string(&dir.join("run.toml"), &text)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::plot::{Band, Figure, Panel, Series};
+
+    #[test]
+    fn reports_have_no_script_or_external_resource() {
+        let mut r = Report::new("t <script>");
+        r.para("a & b <script>alert(1)</script>");
+        r.table(&["x"], &[vec!["<link href=x>".into()]]);
+        let fig = Figure {
+            panels: vec![Panel {
+                series: vec![Series::line("a", vec![(0.0, 1.0), (1.0, 2.0)])],
+                bands: vec![Band {
+                    name: "b".into(),
+                    color_of: "a".into(),
+                    points: vec![(0.0, 0.0, 2.0), (1.0, 1.0, 3.0)],
+                }],
+                ..Panel::default()
+            }],
+            cols: 1,
+            size: (400, 300),
+        };
+        r.figure(&fig, "caption").unwrap();
+        let html = r.html();
+        assert!(html.contains("<svg"));
+        assert_eq!(external_resources(&html), Vec::<String>::new());
+        // the check itself finds what it looks for
+        assert_eq!(external_resources("<img src=\"x.png\">").len(), 2);
+        assert_eq!(external_resources("<script>").len(), 1);
+    }
 }
