@@ -129,7 +129,9 @@ C_alg C_true<sup>T</sup> = I + [ε×]; position error δN = δL(R<sub>M</sub>+h)
 
     /// Write the report atomically.
     pub fn write(&self, dest: &Path) -> Result<(), CliError> {
-        crate::output::write_string(dest, &self.html())
+        let html = self.html();
+        debug_assert!(external_resources(&html).is_empty(), "a report must be self-contained");
+        crate::output::write_string(dest, &html)
     }
 }
 

@@ -35,6 +35,7 @@ pub fn run_args(scenario: &str, algo: &str, out: PathBuf, quiet: bool) -> RunArg
         rotvec: None,
         vertical: None,
         out: Some(out),
+        until_s: None,
         every_s: 1.0,
         ideal: false,
         run: 0,

@@ -1,4 +1,4 @@
-//! `sdins errors`: analytic INS error propagation (issue 6, analytic part).
+//! `sdins errors`: analytic INS error propagation.
 //!
 //! Prints the full stationary closed form (spec `alignment_and_errors.md` §4.3) for a
 //! set of NED sensor biases, next to the 15-state linear model's deterministic error and

@@ -171,6 +171,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         rotvec: None,
         vertical: None,
         out: None,
+        until_s: None,
         every_s: 1.0,
         ideal: true,
         run: 0,

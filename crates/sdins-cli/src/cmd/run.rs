@@ -6,7 +6,8 @@ use crate::plot::PlotScale;
 use crate::progress::Progress;
 use sdins_core::coning::ConingSet;
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AttitudeMode, RotVector};
-use sdins_sim::pipeline::{run_cancellable as run_pipeline, RunOptions, RunSummary};
+use sdins_core::nav::NavState;
+use sdins_sim::pipeline::{run_cancellable as run_pipeline, NavError, RunOptions, RunSummary};
 use sdins_sim::scenario::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
@@ -43,6 +44,9 @@ pub struct Args {
     /// output folder (default ./sdins-out/run-<scenario>)
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// stop after this many seconds of the scenario (default: its whole duration)
+    #[arg(long)]
+    pub until_s: Option<f64>,
     /// output epoch spacing in seconds for the CSV files (default 1 s)
     #[arg(long, default_value_t = 1.0)]
     pub every_s: f64,
@@ -268,6 +272,16 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
             args.every_s
         )));
     }
+    if let Some(t) = args.until_s {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(CliError::bad(format!(
+                "--until-s {t}: expected a positive number of seconds"
+            )));
+        }
+    }
+    let t_end_s = args
+        .until_s
+        .map_or(scn.duration_s(), |t| t.min(scn.duration_s()));
     let n = algos[0].samples;
     let dt_u = scn.imu.dt_s() * n as f64;
     let every = ((args.every_s / dt_u).round() as u64).max(1);
@@ -296,21 +310,66 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         nav_files.push(nf);
         err_files.push(ef);
     }
-    let total = (scn.duration_s() / dt_u).round() as u64;
+    let total = (t_end_s / dt_u).round() as u64; // for the progress bar
     let mut bar = Progress::new(total, "navigate", args.quiet);
     let mut io_error = None;
     let mut series: Vec<ErrSeries> = vec![Vec::new(); algos.len()];
-    let mut plot = PlotData::new(algos.len(), scn.duration_s());
+    let mut plot = PlotData::new(algos.len(), t_end_s);
     let log = args.plot_scale == PlotScale::Log;
     let earth = scn.nav.earth.model();
     let mut updates = vec![0_u64; algos.len()];
+    let mut pending: Vec<Option<(NavState, NavError)>> = vec![None; algos.len()];
     let d = 180.0 / std::f64::consts::PI;
+    // one CSV row of each file and one point of the epoch series
+    let mut write_epoch = |i: usize, st: &NavState, e: &NavError| -> std::io::Result<()> {
+        let (p, v, a, u) = (
+            e.pos_err_ned_m,
+            e.vel_err_ned_mps,
+            e.att_err_rad,
+            e.euler_err_rad,
+        );
+        let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
+        let eu = st.euler();
+        writeln!(
+            nav_files[i].writer(),
+            "{},{},{},{},{},{},{},{},{},{}",
+            e.t_s,
+            st.lat_rad * d,
+            st.lon_rad * d,
+            st.h_m,
+            st.v_n_mps.x,
+            st.v_n_mps.y,
+            st.v_n_mps.z,
+            eu.roll_rad * d,
+            eu.pitch_rad * d,
+            eu.yaw_rad * d
+        )?;
+        writeln!(
+            err_files[i].writer(),
+            "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            e.t_s,
+            p[0],
+            p[1],
+            p[2],
+            v[0],
+            v[1],
+            v[2],
+            a[0],
+            a[1],
+            a[2],
+            e.height_err_m,
+            u[0],
+            u[1],
+            u[2]
+        )
+    };
     // the figures take every update; the CSV files and the series every `every`
     let opts = RunOptions {
         algos: algos.clone(),
         vertical_hold: hold,
         every: 1,
-        until_s: None,
+        until_s: args.until_s,
         sensor_run: if args.ideal { None } else { Some(args.run) },
     };
     let summaries = run_pipeline(
@@ -318,12 +377,7 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         &opts,
         &crate::progress::token(),
         |i, st, tr, e| {
-            let (p, v, a, u) = (
-                e.pos_err_ned_m,
-                e.vel_err_ned_mps,
-                e.att_err_rad,
-                e.euler_err_rad,
-            );
+            let (p, v, a) = (e.pos_err_ned_m, e.vel_err_ned_mps, e.att_err_rad);
             let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
             let norms = [p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)];
             let mut ch = [0.0; ERR_CHANNELS];
@@ -339,50 +393,27 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
                 plot.push_truth(&earth, tr);
             }
             updates[i] += 1;
-            if !(updates[i] % every == 0 || updates[i] == total) {
-                return;
-            }
-            let eu = st.euler();
-            let r1 = writeln!(
-                nav_files[i].writer(),
-                "{},{},{},{},{},{},{},{},{},{}",
-                e.t_s,
-                st.lat_rad * d,
-                st.lon_rad * d,
-                st.h_m,
-                st.v_n_mps.x,
-                st.v_n_mps.y,
-                st.v_n_mps.z,
-                eu.roll_rad * d,
-                eu.pitch_rad * d,
-                eu.yaw_rad * d
-            );
-            series[i].push((e.t_s, norms[0], norms[1], norms[2], norms[3]));
-            let r2 = writeln!(
-                err_files[i].writer(),
-                "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-                e.t_s,
-                p[0],
-                p[1],
-                p[2],
-                v[0],
-                v[1],
-                v[2],
-                a[0],
-                a[1],
-                a[2],
-                e.height_err_m,
-                u[0],
-                u[1],
-                u[2]
-            );
-            if let Err(err) = r1.and(r2) {
-                io_error.get_or_insert(err);
+            if updates[i] % every == 0 {
+                pending[i] = None;
+                if let Err(err) = write_epoch(i, st, e) {
+                    io_error.get_or_insert(err);
+                }
+            } else {
+                // the last update is an output epoch too: written after the run
+                pending[i] = Some((*st, *e));
             }
         },
         |done, _| bar.set(done),
     );
     bar.finish();
+    for (i, p) in pending.iter().enumerate() {
+        if let Some((st, e)) = p {
+            if let Err(err) = write_epoch(i, st, e) {
+                io_error.get_or_insert(err);
+            }
+        }
+    }
+    drop(write_epoch);
     if let Some(source) = io_error {
         return Err(CliError::Io { path: out, source });
     }
