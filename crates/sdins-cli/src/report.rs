@@ -130,25 +130,42 @@ C_alg C_true<sup>T</sup> = I + [ε×]; position error δN = δL(R<sub>M</sub>+h)
     /// Write the report atomically.
     pub fn write(&self, dest: &Path) -> Result<(), CliError> {
         let html = self.html();
-        debug_assert!(external_resources(&html).is_empty(), "a report must be self-contained");
+        debug_assert!(
+            external_resources(&html).is_empty(),
+            "a report must be self-contained"
+        );
         crate::output::write_string(dest, &html)
     }
 }
 
-/// What in `html` would make a report depend on anything outside itself: scripts, links,
-/// frames, objects, `src`/`href` attributes, CSS `url(` and `@import`. Empty for a
+/// What in `html` would make a report depend on anything outside itself: script, link,
+/// frame, object, embed or img elements, `src`/`href` attributes (looked for inside
+/// tags; text is escaped, so it holds no raw `<`), CSS `url(` and `@import`. Empty for a
 /// self-contained report. (The SVG namespace `xmlns="http://www.w3.org/2000/svg"` is a
 /// name, not a resource, and is allowed.)
 pub fn external_resources(html: &str) -> Vec<String> {
     let lower = html.to_ascii_lowercase();
-    [
-        "<script", "<link", "<iframe", "<object", "<embed", "<img", " src=", " href=",
-        "xlink:href", "url(", "@import",
-    ]
-    .iter()
-    .filter(|n| lower.contains(*n))
-    .map(|n| n.to_string())
-    .collect()
+    let mut found = Vec::new();
+    for tag in lower.split('<').skip(1).filter_map(|t| t.split('>').next()) {
+        let name = tag
+            .split(|c: char| c.is_whitespace() || c == '/')
+            .next()
+            .unwrap_or("");
+        if ["script", "link", "iframe", "object", "embed", "img"].contains(&name) {
+            found.push(format!("<{name}>"));
+        }
+        for attr in [" src=", " href=", "xlink:href="] {
+            if tag.contains(attr) {
+                found.push(attr.trim().to_string());
+            }
+        }
+    }
+    for css in ["url(", "@import"] {
+        if lower.contains(css) {
+            found.push(css.to_string());
+        }
+    }
+    found
 }
 
 /// The git commit sdins was built from, if known at build time.
@@ -213,6 +230,8 @@ mod tests {
         assert_eq!(external_resources(&html), Vec::<String>::new());
         // the check itself finds what it looks for
         assert_eq!(external_resources("<img src=\"x.png\">").len(), 2);
-        assert_eq!(external_resources("<script>").len(), 1);
+        assert_eq!(external_resources("<p><script>x</script>").len(), 1);
+        assert_eq!(external_resources("<a href=\"https://x\">x</a>").len(), 1);
+        assert!(external_resources("<p>a &lt;link href=x&gt;</p>").is_empty());
     }
 }

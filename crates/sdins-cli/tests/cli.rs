@@ -162,7 +162,10 @@ fn truth_writes_both_files_and_run_json_shape() {
     }
     let html = std::fs::read_to_string(d.join("report.html")).unwrap();
     assert!(html.contains("|ε_N| [μrad]"), "log-scale per-axis labels");
-    assert!(html.contains("ground track") && html.contains("north [m]"), "trajectory");
+    assert!(
+        html.contains("ground track") && html.contains("north [m]"),
+        "trajectory"
+    );
     assert_self_contained(&html);
     let (code, _, err) = sdins(&[
         "run",
@@ -582,8 +585,17 @@ fn signal_stops_cleanly(signal: &str, code: i32) {
 fn assert_self_contained(html: &str) {
     let lower = html.to_ascii_lowercase();
     for bad in [
-        "<script", "<link", "<iframe", "<object", "<embed", "<img", " src=", " href=",
-        "xlink:href", "url(", "@import",
+        "<script",
+        "<link",
+        "<iframe",
+        "<object",
+        "<embed",
+        "<img",
+        " src=",
+        " href=",
+        "xlink:href",
+        "url(",
+        "@import",
     ] {
         assert!(!lower.contains(bad), "report contains {bad}");
     }

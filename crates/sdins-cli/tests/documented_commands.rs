@@ -155,7 +155,8 @@ fn is_synopsis(cmd: &str) -> bool {
         || cmd.split_whitespace().any(|t| {
             !t.starts_with('$')
                 && t.chars().any(|c| c.is_ascii_uppercase())
-                && t.chars().all(|c| c.is_ascii_uppercase() || c == '_' || c == '.')
+                && t.chars()
+                    .all(|c| c.is_ascii_uppercase() || c == '_' || c == '.')
         })
 }
 
@@ -392,8 +393,11 @@ fn every_documented_command_runs() {
     let work = tmp.join("repo");
     std::fs::create_dir_all(&work).unwrap();
     if data.is_some() {
-        std::os::unix::fs::symlink(root.join("../shared").canonicalize().unwrap(), tmp.join("shared"))
-            .unwrap();
+        std::os::unix::fs::symlink(
+            root.join("../shared").canonicalize().unwrap(),
+            tmp.join("shared"),
+        )
+        .unwrap();
     }
 
     let t_all = Instant::now();
@@ -429,7 +433,14 @@ fn every_documented_command_runs() {
             failures.push(format!(
                 "{}: `{cmd}` failed or took more than {PER_COMMAND_S} s ({s:.1} s):\n{}",
                 d.source,
-                text.lines().rev().take(15).collect::<Vec<_>>().into_iter().rev().collect::<Vec<_>>().join("\n")
+                text.lines()
+                    .rev()
+                    .take(15)
+                    .collect::<Vec<_>>()
+                    .into_iter()
+                    .rev()
+                    .collect::<Vec<_>>()
+                    .join("\n")
             ));
         }
     }

@@ -210,7 +210,7 @@ fn load(args: &Args) -> Result<Input, CliError> {
             })?;
             if !(lat.is_finite() && lat.abs() <= 80.0) {
                 return Err(CliError::bad(format!(
-                    "--lat {lat}: expected a latitude within ±80° (spec §1.3)"
+                    "--lat {lat}: expected a latitude within ±80° (docs/theory/alignment.md)"
                 )));
             }
             let h = args.h.unwrap_or(h_hdr);
@@ -720,7 +720,7 @@ pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "Observability (spec §2.4 procedure: columns scaled by D, unit rows, σ_i > 1e-9 σ_1), latitude {lat_deg}°"
+        "Observability (docs/theory/alignment.md; procedure: columns scaled by D, unit rows, σ_i > 1e-9 σ_1), latitude {lat_deg}°"
     );
     let f1 = [f_matrix(&site, BiasFrame::Ned, &Mat3::identity())];
     let o3 = analyze(&f1, &h_zupt(), &scale12(), 1e-9);
@@ -750,7 +750,7 @@ pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     );
     let _ = writeln!(
         s,
-        "\nStripped observability matrix, body-frame bias states (spec §3.1):\n"
+        "\nStripped observability matrix, body-frame bias states (docs/theory/alignment.md):\n"
     );
     let _ = writeln!(
         s,

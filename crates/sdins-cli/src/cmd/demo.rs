@@ -100,7 +100,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut r = Report::new("sdins demo: the papers' comparisons reproduced against exact truth");
 
     // 1. Song–Lee Table 1
-    println!("== 1. Song-Lee Table 1: Mach 1 due east, 90 min, 2 ms samples, 6 ms updates (spec §7.2) ==");
+    println!("== 1. Song-Lee Table 1: Mach 1 due east, 90 min, 2 ms samples, 6 ms updates (docs/validation.md) ==");
     let a1 = execute_full(&run_args(
         "mach1-east",
         ALL,
@@ -185,7 +185,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )?;
 
     // 2. 90°/s turn
-    println!("\n== 2. 90 deg/s turn from east to south at Mach 1 (spec §7.3) ==");
+    println!("\n== 2. 90 deg/s turn from east to south at Mach 1 (docs/validation.md) ==");
     // every update is an output epoch here, so that the end of the turn (the update
     // nearest t = 8 s; 8 s is not a multiple of ΔT = 6 ms) is in the series
     let mut a2_args = run_args("turn-90dps", ALL, out.join("turn-90dps"), args.quiet);
@@ -258,7 +258,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )?;
 
     // 3. dual-quaternion paper case
-    println!("\n== 3. Dual-quaternion paper case: stationary, accelerate, S-turn, 1 Hz coning, 100 Hz IMU, 2 samples (spec §7.5) ==");
+    println!("\n== 3. Dual-quaternion paper case: stationary, accelerate, S-turn, 1 Hz coning, 100 Hz IMU, 2 samples (docs/validation.md) ==");
     let b = execute_full(&run_args("dq-paper", ALL, out.join("dq-paper"), args.quiet))?;
     print_table(&b.scn, &b.sums);
     let mut timing = String::new();
@@ -322,7 +322,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )?;
 
     // 4. alignment
-    println!("\n== 4. Initial alignment: 37.5N, roll/pitch/yaw 2/-3/40 deg, aviation-grade IMU (alignment spec §6) ==");
+    println!("\n== 4. Initial alignment: 37.5N, roll/pitch/yaw 2/-3/40 deg, aviation-grade IMU (docs/theory/alignment.md) ==");
     let align_rows = alignment_summary()?;
     for row in &align_rows {
         println!(
@@ -339,7 +339,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
     // 5. Schuler share (spec §4.4)
     println!(
-        "\n== 5. Schuler share of the position error by sensor grade ([P2] Table 1, spec §4.4) =="
+        "\n== 5. Schuler share of the position error by sensor grade ([P2] Table 1, docs/theory/error-analysis.md) =="
     );
     let share = schuler_share_table_p2();
     let share_rows: Vec<Vec<String>> = share
@@ -360,7 +360,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     }
     r.heading("5. Schuler share of the position error by sensor grade");
-    r.para("The share of the Schuler oscillation in the bias-driven position error at the paper's evaluation time (spec §4.4 reconstruction of [P2] Table 1).");
+    r.para("The share of the Schuler oscillation in the bias-driven position error at the paper's evaluation time (our reconstruction of [P2] Table 1, docs/theory/error-analysis.md).");
     r.table(
         &[
             "grade",

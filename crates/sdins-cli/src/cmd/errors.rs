@@ -293,7 +293,7 @@ pub struct BudgetRow {
     pub dp_ne_m: [f64; 2],
 }
 
-/// Error budget at `t_s`: the closed form (spec §4.3) with one nonzero bias component at a
+/// Error budget at `t_s`: the closed form (docs/theory/error-analysis.md) with one nonzero bias component at a
 /// time. The closed form is linear in the errors, so the rows add up (as vectors) to the
 /// all-sources error.
 pub fn error_budget(
@@ -459,7 +459,7 @@ fn write_folder(
         &fig,
         out,
         "errors",
-        "Position error vs time: closed form (spec §4.3), 15-state linear model, and its 1σ envelope (biases as 1σ uncertainty plus the grade's noise).",
+        "Position error vs time: closed form (docs/theory/error-analysis.md), 15-state linear model, and its 1σ envelope (biases as 1σ uncertainty plus the grade's noise).",
     )?;
     let brows: Vec<Vec<String>> = budget
         .iter()
@@ -515,7 +515,7 @@ fn print_table(r: &Report<'_>) {
             .unwrap_or_default()
     );
     println!(
-        "closed = spec §4.3 closed form; nonlin = nonlinear INS (body = NED, spherical earth R0/g, 20 Hz, songlee-complete, vertical held);\nlinear = 15-state model (same biases); 1σ = covariance with the biases as 1σ"
+        "closed = closed form of docs/theory/error-analysis.md; nonlin = nonlinear INS (body = NED, spherical earth R0/g, 20 Hz, songlee-complete, vertical held);\nlinear = 15-state model (same biases); 1σ = covariance with the biases as 1σ"
     );
     println!(
         "{:>6} | {:>10} {:>10} | {:>10} {:>10} | {:>10} {:>10} | {:>9} {:>9} | {:>9} {:>9} {:>9}",
@@ -565,7 +565,7 @@ fn print_share(json: bool) -> Result<(), CliError> {
         return Ok(());
     }
     println!(
-        "Schuler share (spec §4.4 reconstruction of [P2] Table 1): t* = {T_STAR_S} s, L = 37.5°, R0 = 6371 km, g = 9.80665"
+        "Schuler share (reconstruction of [P2] Table 1, docs/theory/error-analysis.md): t* = {T_STAR_S} s, L = 37.5°, R0 = 6371 km, g = 9.80665"
     );
     println!(
         "{:>13} {:>10} {:>10} {:>10} {:>14}",
