@@ -61,10 +61,12 @@ const RULES: &[Rule] = &[
     rule("SLURM", Skip("a line of a SLURM batch script")),
     // 90-minute scenarios: the first minute shows that the command works
     rule("sdins run ", AppendUnless("--until-s", " --until-s 60")),
-    rule("sdins montecarlo ", Replace("--runs 1000", "--runs 4")),
-    rule("sdins montecarlo ", Replace("--runs 100 ", "--runs 4 ")),
-    rule("sdins montecarlo ", Replace("--until-s 600", "--until-s 60")),
-    rule("sdins montecarlo ", AppendUnless("--until-s", " --until-s 60")),
+    // Monte Carlo: runs come in blocks of 16 and every shard needs one, so 128 runs
+    // serve up to 8 shards; 10 s of each run
+    rule("sdins montecarlo ", Replace("--runs 1000", "--runs 128")),
+    rule("sdins montecarlo ", Replace("--runs 100 ", "--runs 16 ")),
+    rule("sdins montecarlo ", Replace("--until-s 600", "--until-s 10")),
+    rule("sdins montecarlo ", AppendUnless("--until-s", " --until-s 10")),
     // inputs the examples assume
     rule(
         "my.toml",
@@ -76,11 +78,11 @@ const RULES: &[Rule] = &[
     ),
     rule(
         "sdins merge mc/shard0 mc/shard1 mc/shard2 mc/shard3 ",
-        Before("rm -rf mc && for i in 0 1 2 3; do sdins montecarlo mach1-east --runs 4 --seed 1 --until-s 30 --shard $i/4 --out mc/shard$i --quiet; done"),
+        Before("rm -rf mc && for i in 0 1 2 3; do sdins montecarlo mach1-east --runs 64 --seed 1 --until-s 5 --shard $i/4 --out mc/shard$i --quiet; done"),
     ),
     rule(
         "sdins merge mc/shard{0..7}",
-        Before("rm -rf mc && for i in 0 1 2 3 4 5 6 7; do sdins montecarlo mach1-east --grade aviation --runs 8 --seed 1 --until-s 30 --shard $i/8 --out mc/shard$i --quiet; done"),
+        Before("rm -rf mc && for i in 0 1 2 3 4 5 6 7; do sdins montecarlo mach1-east --grade aviation --runs 128 --seed 1 --until-s 5 --shard $i/8 --out mc/shard$i --quiet; done"),
     ),
     // files of ../shared/data named without their folder in the --help examples
     rule(

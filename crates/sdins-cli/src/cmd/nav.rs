@@ -18,7 +18,7 @@ const D2R: f64 = std::f64::consts::PI / 180.0;
 /// Arguments of `sdins nav`.
 #[derive(clap::Args, Debug)]
 #[command(
-    after_help = "Examples:\n  sdins nav --imu imu.csv --init 37.5,127,0,0,340.29,0,0,0,90 --algo songlee\n  sdins nav --imu trj10ms_imu.csv --format psins-csv --earth psins --truth trj10ms_avp.csv --algo songlee-complete --samples 1"
+    after_help = "Examples:\n  sdins nav --imu imu.csv --init 37.5,127,0,0,340.29,0,0,0,90 --algo songlee\n  sdins nav --imu trj10ms_imu.csv --format psins --earth psins --truth trj10ms_avp.csv --algo songlee-complete --samples 1 --coning 1prev --init 34.24604799999999,108.90966400000002,380,0,0,0,0,0,0"
 )]
 pub struct Args {
     /// IMU file: sdins CSV, PSINS .imu, PSINS trj CSV (psins-csv), KF-GINS text, NaveGo CSV
