@@ -46,6 +46,7 @@
 pub mod align;
 pub mod allan;
 pub mod cancel;
+pub mod envelope;
 pub mod error_analysis;
 pub mod gnss_fix;
 pub mod imu_error;

@@ -42,7 +42,12 @@ fn channels(e: &NavError) -> [f64; N_CHANNELS] {
 }
 
 /// One realisation: the errors at every output epoch.
-pub fn run_one(scn: &Scenario, opts: &McOptions, every: u64, run: u64) -> Vec<NavError> {
+pub fn run_one(
+    scn: &Scenario,
+    opts: &McOptions,
+    every: u64,
+    run: u64,
+) -> Result<Vec<NavError>, McError> {
     let ropts = RunOptions {
         algos: vec![opts.algo],
         vertical_hold: opts.vertical_hold,
@@ -51,8 +56,9 @@ pub fn run_one(scn: &Scenario, opts: &McOptions, every: u64, run: u64) -> Vec<Na
         sensor_run: Some(run),
     };
     let mut out = Vec::new();
-    run_pipeline(scn, &ropts, |_, _, _, e| out.push(*e), |_, _| {});
-    out
+    run_pipeline(scn, &ropts, |_, _, _, e| out.push(*e), |_, _| {})
+        .map_err(|e| McError::Config(e.to_string()))?;
+    Ok(out)
 }
 
 /// The job identity and the per-run scenario (seed replaced).
@@ -69,11 +75,12 @@ pub fn job(scn: &Scenario, opts: &McOptions) -> Result<(McJob, Scenario), McErro
             opts.every_s
         )));
     }
-    if !(1..=4).contains(&opts.algo.samples) {
-        return Err(McError::Config(format!(
-            "{} samples per update: expected 1..=4",
-            opts.algo.samples
-        )));
+    crate::pipeline::check_algorithms(std::slice::from_ref(&opts.algo))
+        .map_err(|e| McError::Config(e.to_string()))?;
+    if let Some(u) = opts.until_s {
+        if !(u.is_finite() && u > 0.0) {
+            return Err(McError::Config(format!("until_s = {u}: expected > 0")));
+        }
     }
     scn.imu
         .model
@@ -156,7 +163,7 @@ pub fn run_shard(
                 }
                 let errs = match &cache {
                     Some(c) => c.run(&s.imu.model, s.imu.seed, r, &opts.algo, opts.vertical_hold),
-                    None => run_one(&s, opts, job.every, r),
+                    None => run_one(&s, opts, job.every, r)?,
                 };
                 if times.is_empty() {
                     times = errs.iter().map(|e| e.t_s).collect();
@@ -346,7 +353,7 @@ duration_s = 60.0
                 ..o.clone()
             };
             for r in [0, 5] {
-                let a = run_one(&s, &o, job.every, r);
+                let a = run_one(&s, &o, job.every, r).unwrap();
                 let c = cache.run(&s.imu.model, s.imu.seed, r, &o.algo, hold);
                 assert_eq!(a.len(), 5);
                 assert_eq!(a, c);
