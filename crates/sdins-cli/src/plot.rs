@@ -275,6 +275,9 @@ fn nice_step(span: f64, n: usize) -> f64 {
     k * p
 }
 
+/// (x, y) of the minimum and (x, y) of the maximum of one column.
+type MinMax = ((f64, f64), (f64, f64));
+
 /// Online min/max-per-column decimation of one or more channels sharing an x axis: the
 /// x range `[x0, x1]` is cut into `cols` columns and each column keeps, per channel, the
 /// sample with the smallest and the one with the largest y. Drawing the kept points in
@@ -287,7 +290,7 @@ pub struct MinMaxColumns {
     cols: usize,
     channels: usize,
     /// per column and channel: ((x, y) of the minimum, (x, y) of the maximum)
-    cells: Vec<Option<((f64, f64), (f64, f64))>>,
+    cells: Vec<Option<MinMax>>,
 }
 
 impl MinMaxColumns {

@@ -96,7 +96,8 @@ fn attitude_panels(rows: &[HistRow]) -> Vec<Panel> {
 
 fn bias_panels(rows: &[HistRow], truth: Option<TrueBias>) -> Vec<Panel> {
     type Pick = fn(&HistRow) -> ([f64; 3], [f64; 3]);
-    let specs: [(&str, &str, &str, Pick, Option<[f64; 3]>); 2] = [
+    type Spec<'a> = (&'a str, &'a str, &'a str, Pick, Option<[f64; 3]>);
+    let specs: [Spec; 2] = [
         (
             "Accelerometer bias estimates (body)",
             "accelerometer bias [μg]",

@@ -304,6 +304,7 @@ pub fn figure(r: &AllanReport) -> crate::plot::Figure {
                 (UG, "Allan deviation [μg]", "Accelerometers")
             };
             let mut series = Vec::new();
+            #[allow(clippy::needless_range_loop)] // c indexes curves, fits and names alike
             for c in 3 * p..3 * p + 3 {
                 let cv = &r.curves[c];
                 let dt = cv.tau_s.first().copied().unwrap_or(1.0);

@@ -415,7 +415,6 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
             }
         }
     }
-    drop(write_epoch);
     if let Some(source) = io_error {
         return Err(CliError::Io { path: out, source });
     }
