@@ -29,7 +29,7 @@
 //!     sensor_run: None,    // ideal sensors: the errors are the algorithms' own
 //! };
 //! let mut epochs = 0;
-//! let sums = run(&scn, &opts, |_algo, _state, _truth, _err| epochs += 1, |_, _| {});
+//! let sums = run(&scn, &opts, |_algo, _state, _truth, _err| epochs += 1, |_, _| {})?;
 //! assert!(epochs > 0);
 //! let pos = |i: usize| {
 //!     let p = sums[i].final_err.pos_err_ned_m;
