@@ -68,6 +68,32 @@ impl Report {
         Ok(())
     }
 
+    /// Write `dir/stem.svg` and `dir/stem.png` and embed the SVG with a caption.
+    pub fn figure_file(
+        &mut self,
+        fig: &Figure,
+        dir: &Path,
+        stem: &str,
+        caption: &str,
+    ) -> Result<(), CliError> {
+        let svg = fig.save(dir, stem)?;
+        self.svg(&svg, &format!("{caption} ({stem}.svg, {stem}.png)"));
+        Ok(())
+    }
+
+    /// Write `dir/stem.svg` and `dir/stem.png` of a bar chart and embed the SVG.
+    pub fn bars_file(
+        &mut self,
+        b: &crate::plot::Bars,
+        dir: &Path,
+        stem: &str,
+        caption: &str,
+    ) -> Result<(), CliError> {
+        let svg = b.save(dir, stem)?;
+        self.svg(&svg, &format!("{caption} ({stem}.svg, {stem}.png)"));
+        Ok(())
+    }
+
     /// An inline SVG bar chart with a caption.
     pub fn bars(&mut self, b: &crate::plot::Bars, caption: &str) -> Result<(), CliError> {
         self.svg(&b.svg()?, caption);
@@ -103,8 +129,43 @@ C_alg C_true<sup>T</sup> = I + [ε×]; position error δN = δL(R<sub>M</sub>+h)
 
     /// Write the report atomically.
     pub fn write(&self, dest: &Path) -> Result<(), CliError> {
-        crate::output::write_string(dest, &self.html())
+        let html = self.html();
+        debug_assert!(
+            external_resources(&html).is_empty(),
+            "a report must be self-contained"
+        );
+        crate::output::write_string(dest, &html)
     }
+}
+
+/// What in `html` would make a report depend on anything outside itself: script, link,
+/// frame, object, embed or img elements, `src`/`href` attributes (looked for inside
+/// tags; text is escaped, so it holds no raw `<`), CSS `url(` and `@import`. Empty for a
+/// self-contained report. (The SVG namespace `xmlns="http://www.w3.org/2000/svg"` is a
+/// name, not a resource, and is allowed.)
+pub fn external_resources(html: &str) -> Vec<String> {
+    let lower = html.to_ascii_lowercase();
+    let mut found = Vec::new();
+    for tag in lower.split('<').skip(1).filter_map(|t| t.split('>').next()) {
+        let name = tag
+            .split(|c: char| c.is_whitespace() || c == '/')
+            .next()
+            .unwrap_or("");
+        if ["script", "link", "iframe", "object", "embed", "img"].contains(&name) {
+            found.push(format!("<{name}>"));
+        }
+        for attr in [" src=", " href=", "xlink:href="] {
+            if tag.contains(attr) {
+                found.push(attr.trim().to_string());
+            }
+        }
+    }
+    for css in ["url(", "@import"] {
+        if lower.contains(css) {
+            found.push(css.to_string());
+        }
+    }
+    found
 }
 
 /// The git commit sdins was built from, if known at build time.
@@ -137,4 +198,40 @@ pub fn write_run_toml(dir: &Path, fields: toml::Table) -> Result<(), CliError> {
     t.extend(fields);
     let text = toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?;
     crate::output::write_string(&dir.join("run.toml"), &text)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::plot::{Band, Figure, Panel, Series};
+
+    #[test]
+    fn reports_have_no_script_or_external_resource() {
+        let mut r = Report::new("t <script>");
+        r.para("a & b <script>alert(1)</script>");
+        r.table(&["x"], &[vec!["<link href=x>".into()]]);
+        let fig = Figure {
+            panels: vec![Panel {
+                series: vec![Series::line("a", vec![(0.0, 1.0), (1.0, 2.0)])],
+                bands: vec![Band {
+                    name: "b".into(),
+                    color_of: "a".into(),
+                    points: vec![(0.0, 0.0, 2.0), (1.0, 1.0, 3.0)],
+                }],
+                ..Panel::default()
+            }],
+            cols: 1,
+            size: (400, 300),
+        };
+        r.figure(&fig, "caption").unwrap();
+        let html = r.html();
+        assert!(html.contains("<svg"));
+        assert_eq!(external_resources(&html), Vec::<String>::new());
+        // the check itself finds what it looks for
+        assert_eq!(external_resources("<img src=\"x.png\">").len(), 2);
+        assert_eq!(external_resources("<p><script>x</script>").len(), 1);
+        assert_eq!(external_resources("<a href=\"https://x\">x</a>").len(), 1);
+        assert!(external_resources("<p>a &lt;link href=x&gt;</p>").is_empty());
+    }
 }

@@ -91,6 +91,12 @@ fn align_fine_writes_plots() {
         html.contains("<svg") && html.contains("roll"),
         "report.html"
     );
+    let lower = html.to_ascii_lowercase();
+    for bad in [
+        "<script", "<link", "<img", " src=", " href=", "url(", "@import",
+    ] {
+        assert!(!lower.contains(bad), "report.html contains {bad}");
+    }
     let t: toml::Table = std::fs::read_to_string(d.join("run.toml"))
         .unwrap()
         .parse()

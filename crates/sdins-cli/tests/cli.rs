@@ -147,11 +147,26 @@ fn truth_writes_both_files_and_run_json_shape() {
     assert!(r["final"]["height_err_m"].is_number() && r["wall_s"].is_number());
     assert!(d.join("nav_songlee.csv").exists() && d.join("err_dualquat.csv").exists());
     // per-axis error figure, log (default) and linear; reproduction record
-    for f in ["report.html", "errors.png", "errors_ned.png", "run.toml"] {
+    for f in [
+        "report.html",
+        "errors.png",
+        "errors.svg",
+        "errors_ned.png",
+        "errors_ned.svg",
+        "trajectory.png",
+        "trajectory.svg",
+        "timing.png",
+        "run.toml",
+    ] {
         assert!(d.join(f).is_file(), "{f}");
     }
     let html = std::fs::read_to_string(d.join("report.html")).unwrap();
-    assert!(html.contains("|ε_N| [arcsec]"), "log-scale per-axis labels");
+    assert!(html.contains("|ε_N| [μrad]"), "log-scale per-axis labels");
+    assert!(
+        html.contains("ground track") && html.contains("north [m]"),
+        "trajectory"
+    );
+    assert_self_contained(&html);
     let (code, _, err) = sdins(&[
         "run",
         p.to_str().unwrap(),
@@ -165,7 +180,7 @@ fn truth_writes_both_files_and_run_json_shape() {
     ]);
     assert_eq!(code, 0, "{err}");
     let html = std::fs::read_to_string(d.join("report.html")).unwrap();
-    assert!(html.contains("ε_N [arcsec]") && !html.contains("|ε_N|"));
+    assert!(html.contains("ε_N [μrad]") && !html.contains("|ε_N|"));
     let (code, _, err) = sdins(&["run", p.to_str().unwrap(), "--plot-scale", "cubic"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("plot-scale"), "{err}");
@@ -564,6 +579,26 @@ fn signal_stops_cleanly(signal: &str, code: i32) {
         .map(|e| e.unwrap().file_name())
         .collect();
     assert!(left.is_empty(), "left behind: {left:?}");
+}
+
+/// A report must not load anything: no script, no link, no external image or style.
+fn assert_self_contained(html: &str) {
+    let lower = html.to_ascii_lowercase();
+    for bad in [
+        "<script",
+        "<link",
+        "<iframe",
+        "<object",
+        "<embed",
+        "<img",
+        " src=",
+        " href=",
+        "xlink:href",
+        "url(",
+        "@import",
+    ] {
+        assert!(!lower.contains(bad), "report contains {bad}");
+    }
 }
 
 /// One initial-state validator for every source: a PSINS header with latitude 95° and a

@@ -23,6 +23,12 @@ fn demo_report_complete_and_consistent_with_run() {
     let (code, out, err) = sdins(&["demo", "--out", d.to_str().unwrap(), "--quiet"]);
     assert_eq!(code, 0, "{err}");
     let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    let lower = html.to_ascii_lowercase();
+    for bad in [
+        "<script", "<link", "<img", " src=", " href=", "url(", "@import",
+    ] {
+        assert!(!lower.contains(bad), "report.html contains {bad}");
+    }
     for needle in [
         "1. Song–Lee Table 1",
         "2. 90°/s turn",

@@ -1,4 +1,4 @@
-//! Alignment experiments (issue 5): exact static / turntable truth, sensor corruption,
+//! Alignment experiments: exact static / turntable truth, sensor corruption,
 //! and runners for coarse, fine, multi-heading (Algorithms A and B) alignment on top of
 //! [`sdins_core::align`]. See spec `alignment_and_errors.md` §1–§3 and §6.
 //!

@@ -1,4 +1,4 @@
-//! Error propagation against nonlinear simulation (issue 6): spec
+//! Error propagation against nonlinear simulation: spec
 //! `alignment_and_errors.md` §6 T9 (24 h free-running INS vs the §4.3 closed form), the
 //! linear model vs the nonlinear error over 1800 s, and the covariance propagation vs
 //! Monte Carlo σ.

@@ -1,4 +1,4 @@
-//! External-data acceptance of the mechanizations (issue 3): PSINS trajectories with the
+//! External-data acceptance of the mechanizations: PSINS trajectories with the
 //! PSINS constant set, the smsfusion coning/sculling fixture (flat earth), and real MEMS
 //! data from the BROAD data set. Files are read in place from `../shared/data`; the tests
 //! skip with a printed reason only when that folder is absent.

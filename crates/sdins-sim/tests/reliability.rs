@@ -1,4 +1,4 @@
-//! Numerical reliability (issue 9): poles, the antimeridian, quaternion normalisation,
+//! Numerical reliability: poles, the antimeridian, quaternion normalisation,
 //! 72 h stationary runs against the closed form, and a stationary property test.
 #![allow(clippy::unwrap_used)]
 mod common;

@@ -1,4 +1,4 @@
-//! Truth generator acceptance (issue 2): closed forms, refinement, external PSINS data.
+//! Truth generator acceptance: closed forms, refinement, external PSINS data.
 #![allow(clippy::unwrap_used)]
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Vec3};

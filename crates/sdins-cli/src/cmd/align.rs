@@ -230,7 +230,7 @@ fn load(args: &Args) -> Result<Input, CliError> {
             })?;
             if !(lat.is_finite() && lat.abs() <= 80.0) {
                 return Err(CliError::bad(format!(
-                    "--lat {lat}: expected a latitude within ±80° (spec §1.3)"
+                    "--lat {lat}: expected a latitude within ±80° (docs/theory/alignment.md)"
                 )));
             }
             let h = args.h.unwrap_or(h_hdr);
@@ -451,7 +451,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         {
             write_string(&dir.join("align_history.csv"), &hist)?;
             if rows.len() >= 2 {
-                svgs = Some(write_plots(dir, &rows)?);
+                let tb = inp.true_bias.map(|(ba, bg)| {
+                    let a = |v: Vec3, u: f64| [v.x / u, v.y / u, v.z / u];
+                    (a(ba, UG), a(bg, DPH))
+                });
+                svgs = Some(write_plots(dir, &rows, tb)?);
             } else {
                 eprintln!(
                     "note: {} Kalman cycle(s): too short for the alignment plots",
@@ -609,11 +613,11 @@ fn write_report(
         r.heading("Convergence");
         r.svg(
             att,
-            "Attitude error φ against the truth (solid, scenarios) with the filter's ±3σ bounds (dashed), μrad; also align_attitude.png.",
+            "Attitude error φ against the truth (solid, scenarios) with the filter's ±3σ bounds (shaded), μrad (align_attitude.svg, align_attitude.png).",
         );
         r.svg(
             bias,
-            "Bias estimates (solid) with ±3σ (dashed), body axes; also align_bias.png.",
+            "Bias estimates (solid) with ±3σ (shaded) and, for scenarios, the true bias (dashed), body axes (align_bias.svg, align_bias.png).",
         );
     }
     r.write(&dir.join("report.html"))
@@ -764,7 +768,7 @@ pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "Observability (spec §2.4 procedure: columns scaled by D, unit rows, σ_i > 1e-9 σ_1), latitude {lat_deg}°"
+        "Observability (docs/theory/alignment.md; procedure: columns scaled by D, unit rows, σ_i > 1e-9 σ_1), latitude {lat_deg}°"
     );
     let f1 = [f_matrix(&site, BiasFrame::Ned, &Mat3::identity())];
     let o3 = analyze(&f1, &h_zupt(), &scale12(), 1e-9);
@@ -794,7 +798,7 @@ pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     );
     let _ = writeln!(
         s,
-        "\nStripped observability matrix, body-frame bias states (spec §3.1):\n"
+        "\nStripped observability matrix, body-frame bias states (docs/theory/alignment.md):\n"
     );
     let _ = writeln!(
         s,

@@ -10,7 +10,7 @@
 
 use crate::error::CliError;
 use crate::output::write_string;
-use plotters::prelude::*;
+use sdins_sim::allan::{AllanCurve, AllanFit};
 use sdins_sim::imu_error::{
     ARCSEC, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H, UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ,
 };
@@ -223,98 +223,116 @@ pub fn csv(r: &AllanReport) -> String {
     s
 }
 
-const SIZE: (u32, u32) = (1400, 560);
+const SIZE: (u32, u32) = (1400, 600);
 
-use crate::plot::register_font;
-
-fn draw<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    r: &AllanReport,
-) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let panels = root.split_evenly((1, 2));
-    let colors = [RED, GREEN, BLUE];
-    for (p, area) in panels.iter().enumerate() {
-        let (unit, ylabel, title) = if p == 0 {
-            (DPH, "Allan deviation [°/h]", "Gyroscopes")
-        } else {
-            (UG, "Allan deviation [μg]", "Accelerometers")
-        };
-        let chans = 3 * p..3 * p + 3;
-        let pts = |c: usize| -> Vec<(f64, f64)> {
-            let cv = &r.curves[c];
-            cv.tau_s
-                .iter()
-                .zip(&cv.adev)
-                .filter(|(_, s)| **s > 0.0)
-                .map(|(t, s)| (*t, s / unit))
-                .collect()
-        };
-        let all: Vec<(f64, f64)> = chans.clone().flat_map(&pts).collect();
-        if all.is_empty() {
-            continue;
-        }
-        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for (x, y) in &all {
-            x0 = x0.min(*x);
-            x1 = x1.max(*x);
-            y0 = y0.min(*y);
-            y1 = y1.max(*y);
-        }
-        let mut chart = ChartBuilder::on(area)
-            .caption(title, ("sans-serif", 22))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(80)
-            .build_cartesian_2d(
-                (x0 * 0.8..x1 * 1.25).log_scale(),
-                (y0 * 0.7..y1 * 1.4).log_scale(),
-            )
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("cluster time τ [s]")
-            .y_desc(ylabel)
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 16))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for (k, c) in chans.enumerate() {
-            let color = colors[k];
-            chart
-                .draw_series(LineSeries::new(pts(c), color.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label(CHANNELS[c])
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-        }
-        chart
-            .configure_series_labels()
-            .label_font(("sans-serif", 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| e.to_string())?;
+/// Relative 1σ uncertainty of an Allan deviation estimated from `k` independent
+/// clusters, `1/√(2(k − 1))` (IEEE Std 952-1997 Annex C, eq. C.2; El-Sheimy, Hou & Niu
+/// 2008, eq. 9); `k = N/m` with `N = count + 2m − 1` samples and cluster size `m`.
+pub fn relative_sigma(count: usize, m: f64) -> f64 {
+    let n = count as f64 + 2.0 * m - 1.0;
+    let k = n / m.max(1.0);
+    if k > 1.0 {
+        1.0 / (2.0 * (k - 1.0)).sqrt()
+    } else {
+        f64::INFINITY
     }
-    root.present().map_err(|e| e.to_string())
+}
+
+/// The fitted lines of one channel over their fit ranges (three times wider on both
+/// sides, within the curve): white noise `σ = N/√τ`, bias instability
+/// `σ = 0.664 B`, rate random walk `σ = K √(τ/3)`, quantization `σ = √3 Q/τ` (IEEE Std 952
+/// Annex C, Table C.1), in display units.
+fn fit_lines(c: &AllanCurve, f: &AllanFit, unit: f64) -> Vec<Vec<(f64, f64)>> {
+    let (Some(&lo), Some(&hi)) = (c.tau_s.first(), c.tau_s.last()) else {
+        return Vec::new();
+    };
+    let span = |r: (f64, f64)| ((r.0 / 3.0).max(lo), (r.1 * 3.0).min(hi));
+    let line = |r: (f64, f64), g: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
+        let (a, b) = span(r);
+        (0..=20)
+            .map(|i| {
+                let t = a * (b / a).powf(i as f64 / 20.0);
+                (t, g(t) / unit)
+            })
+            .collect()
+    };
+    let mut out = Vec::new();
+    if let (Some(n), Some(r)) = (f.white, f.white_tau_s) {
+        out.push(line(r, &|t| n / t.sqrt()));
+    }
+    if let (Some(b), Some(r)) = (f.bias_instability, f.bias_instability_range_s) {
+        out.push(line(r, &|_| sdins_sim::allan::FLICKER_FLOOR * b));
+    }
+    if let (Some(k), Some(r)) = (f.rate_random_walk, f.rrw_tau_s) {
+        out.push(line(r, &|t| k * (t / 3.0).sqrt()));
+    }
+    if let Some(q) = f.quantization {
+        out.push(line((lo, (lo * 10.0).min(hi)), &|t| 3f64.sqrt() * q / t));
+    }
+    out
+}
+
+/// The log-log figure: per sensor panel the three channels' deviations with their 1σ
+/// confidence bars ([`relative_sigma`]) and the fitted noise lines dashed.
+pub fn figure(r: &AllanReport) -> crate::plot::Figure {
+    use crate::plot::{Figure, Panel, Series};
+    let panels = (0..2)
+        .map(|p| {
+            let (unit, y_label, title) = if p == 0 {
+                (DPH, "Allan deviation [°/h]", "Gyroscopes")
+            } else {
+                (UG, "Allan deviation [μg]", "Accelerometers")
+            };
+            let mut series = Vec::new();
+            #[allow(clippy::needless_range_loop)] // c indexes curves, fits and names alike
+            for c in 3 * p..3 * p + 3 {
+                let cv = &r.curves[c];
+                let dt = cv.tau_s.first().copied().unwrap_or(1.0);
+                let mut pts = Vec::new();
+                let mut bars = Vec::new();
+                for ((t, s), n) in cv.tau_s.iter().zip(&cv.adev).zip(&cv.count) {
+                    if *s > 0.0 {
+                        let rel = relative_sigma(*n, (t / dt).round());
+                        let y = s / unit;
+                        pts.push((*t, y));
+                        bars.push((y * (1.0 - rel).max(0.05), y * (1.0 + rel)));
+                    }
+                }
+                let name = CHANNELS[c].to_string();
+                series.push(Series::points(name.clone(), pts, bars));
+                if let Some(f) = r.fits.get(c) {
+                    for l in fit_lines(cv, f, unit) {
+                        series.push(Series::dashed(String::new(), l).colored_as(name.clone()));
+                    }
+                }
+            }
+            series.push(crate::plot::dashed_note("fitted noise terms"));
+            Panel {
+                title: title.into(),
+                x_label: "cluster time τ [s]".into(),
+                y_label: y_label.into(),
+                log_x: true,
+                log_y: true,
+                series,
+                ..Panel::default()
+            }
+        })
+        .collect();
+    Figure {
+        panels,
+        cols: 2,
+        size: SIZE,
+    }
 }
 
 /// The log-log plot as an SVG string.
 pub fn plot_svg(r: &AllanReport) -> Result<String, CliError> {
-    register_font()?;
-    let mut s = String::new();
-    {
-        let root = SVGBackend::with_string(&mut s, SIZE).into_drawing_area();
-        draw(root, r).map_err(|e| CliError::Other(format!("SVG plot: {e}")))?;
-    }
-    Ok(s)
+    figure(r).svg()
 }
 
 /// The log-log plot as a PNG file (drawn to a temporary file, then renamed).
 pub fn plot_png(r: &AllanReport, dest: &Path) -> Result<(), CliError> {
-    crate::plot::write_png(dest, SIZE, |root| draw(root, r))
+    figure(r).png(dest)
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! `sdins errors`: analytic INS error propagation (issue 6, analytic part).
+//! `sdins errors`: analytic INS error propagation.
 //!
 //! Prints the full stationary closed form (spec `alignment_and_errors.md` §4.3) for a
 //! set of NED sensor biases, next to the 15-state linear model's deterministic error and
@@ -294,7 +294,7 @@ pub struct BudgetRow {
     pub dp_ne_m: [f64; 2],
 }
 
-/// Error budget at `t_s`: the closed form (spec §4.3) with one nonzero bias component at a
+/// Error budget at `t_s`: the closed form (docs/theory/error-analysis.md) with one nonzero bias component at a
 /// time. The closed form is linear in the errors, so the rows add up (as vectors) to the
 /// all-sources error.
 pub fn error_budget(
@@ -341,7 +341,7 @@ fn write_folder(
     env: &[EnvelopePoint],
     budget: &[BudgetRow],
 ) -> Result<(), CliError> {
-    use crate::plot::{Bars, Figure, Panel, Series};
+    use crate::plot::{Band, Bars, Figure, Panel, Series};
     // time histories: closed form and linear model on the linear model's grid (≤ 400 points)
     let stride = (env.len() / 400).max(1);
     let pts: Vec<(f64, StationarySolution, &EnvelopePoint)> = env
@@ -367,21 +367,29 @@ fn write_folder(
     }
     crate::output::write_string(&out.join("errors.csv"), &csv)?;
     let h = |t: f64| t / 3600.0;
-    let line = |name: &str, f: &dyn Fn(&(f64, StationarySolution, &EnvelopePoint)) -> f64| Series {
-        name: name.to_string(),
-        points: pts.iter().map(|p| (h(p.0), f(p))).collect(),
+    let line = |name: &str, f: &dyn Fn(&(f64, StationarySolution, &EnvelopePoint)) -> f64| {
+        Series::line(name, pts.iter().map(|p| (h(p.0), f(p))).collect())
     };
     let panel = |axis: usize, title: &str| Panel {
         title: title.to_string(),
         x_label: "time [h]".into(),
         y_label: "position error [m]".into(),
-        log_y: false,
+        bands: vec![Band {
+            name: "linear model ± 1σ".into(),
+            color_of: "linear model".into(),
+            points: pts
+                .iter()
+                .map(|p| {
+                    let s = p.2.sigma_p_m[axis];
+                    (h(p.0), p.2.dp_n_m[axis] - s, p.2.dp_n_m[axis] + s)
+                })
+                .collect(),
+        }],
         series: vec![
             line("closed form", &|p| p.1.dp_n[axis]),
             line("linear model", &|p| p.2.dp_n_m[axis]),
-            line("+1σ", &|p| p.2.sigma_p_m[axis]),
-            line("−1σ", &|p| -p.2.sigma_p_m[axis]),
         ],
+        ..Panel::default()
     };
     let fig = Figure {
         panels: vec![
@@ -391,7 +399,6 @@ fn write_folder(
         cols: 2,
         size: (1200, 450),
     };
-    fig.png(&out.join("errors.png"))?;
     let bars = Bars {
         title: format!(
             "error budget: horizontal position error at {:.3} h",
@@ -404,7 +411,6 @@ fn write_folder(
             .collect(),
         size: (900, 420),
     };
-    bars.png(&out.join("budget.png"))?;
 
     let mut rep = crate::report::Report::new("sdins errors");
     rep.para(&format!(
@@ -450,9 +456,11 @@ fn write_folder(
         ],
         &rows,
     );
-    rep.figure(
+    rep.figure_file(
         &fig,
-        "Position error vs time: closed form (spec §4.3), 15-state linear model, and its 1σ envelope (biases as 1σ uncertainty plus the grade's noise). Also errors.png.",
+        out,
+        "errors",
+        "Position error vs time: closed form (docs/theory/error-analysis.md), 15-state linear model, and its 1σ envelope (biases as 1σ uncertainty plus the grade's noise).",
     )?;
     let brows: Vec<Vec<String>> = budget
         .iter()
@@ -468,9 +476,11 @@ fn write_folder(
         .collect();
     rep.heading("Error budget");
     rep.table(&["source", "value", "δN [m]", "δE [m]", "|δp| [m]"], &brows);
-    rep.bars(
+    rep.bars_file(
         &bars,
-        "Each source alone through the closed form at the final time (the closed form is linear: the rows add up as vectors to the all-sources error). Also budget.png.",
+        out,
+        "budget",
+        "Each source alone through the closed form at the final time (the closed form is linear: the rows add up as vectors to the all-sources error).",
     )?;
     rep.write(&out.join("report.html"))?;
 
@@ -506,7 +516,7 @@ fn print_table(r: &Report<'_>) {
             .unwrap_or_default()
     );
     println!(
-        "closed = spec §4.3 closed form; nonlin = nonlinear INS (body = NED, spherical earth R0/g, 20 Hz, songlee-complete, vertical held);\nlinear = 15-state model (same biases); 1σ = covariance with the biases as 1σ"
+        "closed = closed form of docs/theory/error-analysis.md; nonlin = nonlinear INS (body = NED, spherical earth R0/g, 20 Hz, songlee-complete, vertical held);\nlinear = 15-state model (same biases); 1σ = covariance with the biases as 1σ"
     );
     println!(
         "{:>6} | {:>10} {:>10} | {:>10} {:>10} | {:>10} {:>10} | {:>9} {:>9} | {:>9} {:>9} {:>9}",
@@ -556,7 +566,7 @@ fn print_share(json: bool) -> Result<(), CliError> {
         return Ok(());
     }
     println!(
-        "Schuler share (spec §4.4 reconstruction of [P2] Table 1): t* = {T_STAR_S} s, L = 37.5°, R0 = 6371 km, g = 9.80665"
+        "Schuler share (reconstruction of [P2] Table 1, docs/theory/error-analysis.md): t* = {T_STAR_S} s, L = 37.5°, R0 = 6371 km, g = 9.80665"
     );
     println!(
         "{:>13} {:>10} {:>10} {:>10} {:>14}",

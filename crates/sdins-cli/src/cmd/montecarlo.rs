@@ -98,54 +98,50 @@ pub fn write_outputs(dir: &Path, state: &McState, stats: &McStats) -> Result<(),
     write_report(dir, state, stats)
 }
 
-/// Envelopes per channel group: mean and mean ± σ of the N and E errors (the percentiles
-/// are in the table and the CSV).
+/// Envelopes per channel group: mean (line) and mean ± σ (shaded band) of the N and E
+/// errors over the runs (the percentiles are in the table and the CSV). Attitude errors
+/// in μrad (the unit of free-inertial attitude errors in every report, docs/user-guide.md).
 fn envelope_figure(stats: &McStats) -> crate::plot::Figure {
-    use crate::plot::{Figure, Panel, Series};
-    let names = sdins_sim::montecarlo::CHANNELS;
-    let panel = |title: &str, unit: &str, first: usize| {
+    use crate::plot::{Band, Figure, Panel, Series};
+    let panel = |title: &str, unit: &str, first: usize, scale: f64| {
         let mut series = Vec::new();
+        let mut bands = Vec::new();
         for (k, axis) in ["N", "E"].iter().enumerate() {
             let c = first + k;
-            let pick =
-                |f: &dyn Fn(&sdins_sim::montecarlo::ChannelStats) -> f64| -> Vec<(f64, f64)> {
-                    stats
-                        .times_s
-                        .iter()
-                        .zip(&stats.cells)
-                        .map(|(t, row)| (*t, f(&row[c])))
-                        .collect()
-                };
-            series.push(Series {
-                name: format!("{axis} mean"),
-                points: pick(&|x| x.mean),
-            });
-            series.push(Series {
-                name: format!("{axis} mean+σ"),
-                points: pick(&|x| x.mean + x.sigma),
-            });
-            series.push(Series {
-                name: format!("{axis} mean−σ"),
-                points: pick(&|x| x.mean - x.sigma),
+            let rows = || stats.times_s.iter().zip(&stats.cells);
+            let mean = format!("{axis} mean");
+            series.push(Series::line(
+                mean.clone(),
+                rows().map(|(t, row)| (*t, row[c].mean * scale)).collect(),
+            ));
+            bands.push(Band {
+                name: format!("{axis} mean ± σ"),
+                color_of: mean,
+                points: rows()
+                    .map(|(t, row)| {
+                        let x = &row[c];
+                        (*t, (x.mean - x.sigma) * scale, (x.mean + x.sigma) * scale)
+                    })
+                    .collect(),
             });
         }
-        let _ = names;
         Panel {
             title: title.to_string(),
             x_label: "time [s]".into(),
             y_label: unit.to_string(),
-            log_y: false,
             series,
+            bands,
+            ..Panel::default()
         }
     };
     Figure {
         panels: vec![
-            panel("position error envelope", "error [m]", 0),
-            panel("velocity error envelope", "error [m/s]", 3),
-            panel("attitude error envelope", "error [rad]", 6),
+            panel("position error", "error [m]", 0, 1.0),
+            panel("velocity error", "error [m/s]", 3, 1.0),
+            panel("attitude error", "error [μrad]", 6, 1e6),
         ],
         cols: 3,
-        size: (1800, 520),
+        size: (1800, 560),
     }
 }
 
@@ -181,8 +177,7 @@ fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliE
         r.table(&["channel", "mean", "σ", "p05", "p50", "p95"], &rows);
     }
     let fig = envelope_figure(stats);
-    r.figure(&fig, "North and east error envelopes over the runs: mean and mean ± σ (percentiles in the table and mc_stats.csv).")?;
-    fig.png(&dir.join("envelopes.png"))?;
+    r.figure_file(&fig, dir, "envelopes", "North and east error envelopes over the runs: mean (line) and mean ± σ (band); percentiles in the table and mc_stats.csv.")?;
     r.write(&dir.join("report.html"))?;
     let mut t = toml::Table::new();
     t.insert("scenario".into(), job.scenario.clone().into());

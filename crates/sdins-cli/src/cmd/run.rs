@@ -4,8 +4,8 @@ use crate::error::CliError;
 use crate::output::AtomicFile;
 use crate::plot::PlotScale;
 use crate::progress::Progress;
-use sdins_core::nav::AlgorithmSpec;
-use sdins_sim::pipeline::{run_cancellable as run_pipeline, RunOptions, RunSummary};
+use sdins_core::nav::{AlgorithmSpec, NavState};
+use sdins_sim::pipeline::{run_cancellable as run_pipeline, NavError, RunOptions, RunSummary};
 use sdins_sim::run_setup::{self, AlgoChoice};
 use sdins_sim::scenario::Scenario;
 use std::io::Write;
@@ -45,6 +45,9 @@ pub struct Args {
     /// output folder (default ./sdins-out/run-<scenario>)
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// stop after this many seconds of the scenario (default: its whole duration)
+    #[arg(long)]
+    pub until_s: Option<f64>,
     /// output epoch spacing in seconds for the CSV files (default 1 s)
     #[arg(long, default_value_t = run_setup::DEFAULT_EVERY_S)]
     pub every_s: f64,
@@ -82,10 +85,6 @@ pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, Cli
 /// (t, horizontal position, |down position|, velocity norm, attitude norm).
 pub type ErrSeries = Vec<(f64, f64, f64, f64, f64)>;
 
-/// Per-axis errors of one algorithm at the output epochs: (t, [attitude N, E, D \[rad\],
-/// velocity N, E, D \[m/s\], position N, E, D \[m\]]).
-pub type NedSeries = Vec<(f64, [f64; 9])>;
-
 /// Everything a run produced.
 pub struct Outcome {
     /// the scenario
@@ -96,10 +95,90 @@ pub struct Outcome {
     pub out: PathBuf,
     /// per-algorithm error time series
     pub series: Vec<ErrSeries>,
-    /// per-algorithm per-axis error time series
-    pub ned: Vec<NedSeries>,
     /// y scale of the per-axis figure
     pub plot_scale: PlotScale,
+    /// full-rate data for the figures, min/max-decimated per pixel column
+    pub plot: PlotData,
+}
+
+/// Columns of the full-rate figure data (at least the pixel width of any panel).
+pub const PLOT_COLUMNS: usize = 2000;
+
+/// Channels of [`PlotData::errors`]: the four error norms of [`ErrSeries`], then the nine
+/// per-axis errors in display units (attitude μrad, velocity m/s,
+/// position m), as absolute values when the plot scale is logarithmic.
+const ERR_CHANNELS: usize = 13;
+
+/// Full-rate (every navigation update) figure data of a run, decimated online with
+/// min/max per column ([`crate::plot::MinMaxColumns`]) so that short manoeuvres show.
+pub struct PlotData {
+    /// per algorithm: [`ERR_CHANNELS`] channels
+    pub errors: Vec<crate::plot::MinMaxColumns>,
+    /// truth height [m], roll, pitch, yaw (unwrapped) [deg]
+    pub trajectory: crate::plot::MinMaxColumns,
+    /// truth ground track (east, north) [m] from the start, one point per column
+    pub track_en_m: Vec<(f64, f64)>,
+    track_col: Option<usize>,
+    t_end_s: f64,
+    lat0_lon0: Option<(f64, f64)>,
+    yaw_prev_deg: Option<f64>,
+    yaw_turns: f64,
+}
+
+impl PlotData {
+    fn new(n_algos: usize, t_end_s: f64) -> Self {
+        let cols = crate::plot::MinMaxColumns::new(0.0, t_end_s, PLOT_COLUMNS, ERR_CHANNELS);
+        Self {
+            errors: vec![cols; n_algos],
+            trajectory: crate::plot::MinMaxColumns::new(0.0, t_end_s, PLOT_COLUMNS, 4),
+            track_en_m: Vec::new(),
+            track_col: None,
+            t_end_s,
+            lat0_lon0: None,
+            yaw_prev_deg: None,
+            yaw_turns: 0.0,
+        }
+    }
+
+    /// Record the truth at one update: ground track relative to the first sample on the
+    /// local tangent plane, `δN = δL (R_M + h)`, `δE = δλ (R_N + h) cos L` (the position
+    /// error convention of docs/conventions.md), height and Euler angles.
+    fn push_truth(
+        &mut self,
+        earth: &sdins_core::earth::EarthModel,
+        tr: &sdins_sim::truth::TruthSample,
+    ) {
+        let d = 180.0 / std::f64::consts::PI;
+        let (lat0, lon0) = *self.lat0_lon0.get_or_insert((tr.lat_rad, tr.lon_rad));
+        let col = ((tr.t_s / self.t_end_s.max(1e-300)) * PLOT_COLUMNS as f64).floor() as usize;
+        if self.track_col != Some(col) {
+            self.track_col = Some(col);
+            let r = earth.radii(tr.lat_rad);
+            let n = (tr.lat_rad - lat0) * (r.r_m_m + tr.h_m);
+            let e = (tr.lon_rad - lon0) * (r.r_n_m + tr.h_m) * tr.lat_rad.cos();
+            self.track_en_m.push((e, n));
+        }
+        let eu = sdins_core::math::euler_from_c_b_n(&tr.c_b_n);
+        let yaw = eu.yaw_rad * d;
+        if let Some(prev) = self.yaw_prev_deg {
+            let jump = yaw - prev;
+            if jump > 180.0 {
+                self.yaw_turns -= 1.0;
+            } else if jump < -180.0 {
+                self.yaw_turns += 1.0;
+            }
+        }
+        self.yaw_prev_deg = Some(yaw);
+        self.trajectory.push(
+            tr.t_s,
+            &[
+                tr.h_m,
+                eu.roll_rad * d,
+                eu.pitch_rad * d,
+                yaw + 360.0 * self.yaw_turns,
+            ],
+        );
+    }
 }
 
 /// Run and return the summaries (used by `demo` too).
@@ -119,6 +198,16 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let bad = |e: run_setup::OptionError| CliError::BadInput(e.to_string());
     let hold =
         run_setup::vertical_hold(args.vertical.as_deref(), scn.nav.vertical_hold).map_err(bad)?;
+    if let Some(t) = args.until_s {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(CliError::bad(format!(
+                "--until-s {t}: expected a positive number of seconds"
+            )));
+        }
+    }
+    let t_end_s = args
+        .until_s
+        .map_or(scn.duration_s(), |t| t.min(scn.duration_s()));
     let n = algos[0].samples;
     let dt_u = scn.imu.dt_s() * n as f64;
     let every = run_setup::every_updates(args.every_s, dt_u).map_err(bad)?;
@@ -147,76 +236,109 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         nav_files.push(nf);
         err_files.push(ef);
     }
-    let total = (scn.duration_s() / dt_u).round() as u64;
+    let total = (t_end_s / dt_u).round() as u64; // for the progress bar
     let mut bar = Progress::new(total, "navigate", args.quiet);
     let mut io_error = None;
     let mut series: Vec<ErrSeries> = vec![Vec::new(); algos.len()];
-    let mut ned: Vec<NedSeries> = vec![Vec::new(); algos.len()];
+    let mut plot = PlotData::new(algos.len(), t_end_s);
+    let log = args.plot_scale == PlotScale::Log;
+    let earth = scn.nav.earth.model();
+    let mut updates = vec![0_u64; algos.len()];
+    let mut pending: Vec<Option<(NavState, NavError)>> = vec![None; algos.len()];
     let d = 180.0 / std::f64::consts::PI;
+    // one CSV row of each file and one point of the epoch series
+    let mut write_epoch = |i: usize, st: &NavState, e: &NavError| -> std::io::Result<()> {
+        let (p, v, a, u) = (
+            e.pos_err_ned_m,
+            e.vel_err_ned_mps,
+            e.att_err_rad,
+            e.euler_err_rad,
+        );
+        let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
+        let eu = st.euler();
+        writeln!(
+            nav_files[i].writer(),
+            "{},{},{},{},{},{},{},{},{},{}",
+            e.t_s,
+            st.lat_rad * d,
+            st.lon_rad * d,
+            st.h_m,
+            st.v_n_mps.x,
+            st.v_n_mps.y,
+            st.v_n_mps.z,
+            eu.roll_rad * d,
+            eu.pitch_rad * d,
+            eu.yaw_rad * d
+        )?;
+        writeln!(
+            err_files[i].writer(),
+            "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            e.t_s,
+            p[0],
+            p[1],
+            p[2],
+            v[0],
+            v[1],
+            v[2],
+            a[0],
+            a[1],
+            a[2],
+            e.height_err_m,
+            u[0],
+            u[1],
+            u[2]
+        )
+    };
+    // the figures take every update; the CSV files and the series every `every`
     let opts = RunOptions {
         algos: algos.clone(),
         vertical_hold: hold,
-        every,
-        until_s: None,
+        every: 1,
+        until_s: args.until_s,
         sensor_run: if args.ideal { None } else { Some(args.run) },
     };
     let summaries = run_pipeline(
         &scn,
         &opts,
         &crate::progress::token(),
-        |i, st, _tr, e| {
-            let eu = st.euler();
-            let r1 = writeln!(
-                nav_files[i].writer(),
-                "{},{},{},{},{},{},{},{},{},{}",
-                e.t_s,
-                st.lat_rad * d,
-                st.lon_rad * d,
-                st.h_m,
-                st.v_n_mps.x,
-                st.v_n_mps.y,
-                st.v_n_mps.z,
-                eu.roll_rad * d,
-                eu.pitch_rad * d,
-                eu.yaw_rad * d
-            );
-            let (p, v, a, u) = (
-                e.pos_err_ned_m,
-                e.vel_err_ned_mps,
-                e.att_err_rad,
-                e.euler_err_rad,
-            );
+        |i, st, tr, e| {
+            let (p, v, a) = (e.pos_err_ned_m, e.vel_err_ned_mps, e.att_err_rad);
             let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-            series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
-            ned[i].push((
-                e.t_s,
-                [a[0], a[1], a[2], v[0], v[1], v[2], p[0], p[1], p[2]],
-            ));
-            let r2 = writeln!(
-                err_files[i].writer(),
-                "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-                e.t_s,
-                p[0],
-                p[1],
-                p[2],
-                v[0],
-                v[1],
-                v[2],
-                a[0],
-                a[1],
-                a[2],
-                e.height_err_m,
-                u[0],
-                u[1],
-                u[2]
-            );
-            if let Err(err) = r1.and(r2) {
-                io_error.get_or_insert(err);
+            let norms = [p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)];
+            let mut ch = [0.0; ERR_CHANNELS];
+            ch[..4].copy_from_slice(&norms);
+            for k in 0..3 {
+                let f = |x: f64| if log { x.abs() } else { x };
+                ch[4 + k] = f(a[k] * 1e6);
+                ch[7 + k] = f(v[k]);
+                ch[10 + k] = f(p[k]);
+            }
+            plot.errors[i].push(e.t_s, &ch);
+            if i == 0 {
+                plot.push_truth(&earth, tr);
+            }
+            updates[i] += 1;
+            if updates[i] % every == 0 {
+                pending[i] = None;
+                if let Err(err) = write_epoch(i, st, e) {
+                    io_error.get_or_insert(err);
+                }
+            } else {
+                // the last update is an output epoch too: written after the run
+                pending[i] = Some((*st, *e));
             }
         },
         |done, _| bar.set(done),
     );
     bar.finish();
+    for (i, p) in pending.iter().enumerate() {
+        if let Some((st, e)) = p {
+            if let Err(err) = write_epoch(i, st, e) {
+                io_error.get_or_insert(err);
+            }
+        }
+    }
     if let Some(source) = io_error {
         return Err(CliError::Io { path: out, source });
     }
@@ -230,8 +352,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         sums: summaries,
         out,
         series,
-        ned,
         plot_scale: args.plot_scale,
+        plot,
     };
     write_report(&outcome)?;
     Ok(outcome)
@@ -258,10 +380,12 @@ fn write_run_toml(out: &std::path::Path, scn: &Scenario, args: &Args) -> Result<
     crate::report::write_run_toml(out, t)
 }
 
-/// The error figure of a run: log-scale error norms per algorithm.
+/// The error figure of a run: log-scale error norms per algorithm, from every
+/// navigation update (min/max per pixel column). Attitude in μrad, the unit of
+/// free-inertial attitude errors in every report.
 pub fn error_figure(o: &Outcome) -> crate::plot::Figure {
     use crate::plot::{Figure, Panel, Series};
-    let panel = |title: &str, unit: &str, k: usize| Panel {
+    let panel = |title: &str, unit: &str, k: usize, scale: f64| Panel {
         title: title.to_string(),
         x_label: "time [s]".into(),
         y_label: unit.to_string(),
@@ -269,41 +393,44 @@ pub fn error_figure(o: &Outcome) -> crate::plot::Figure {
         series: o
             .sums
             .iter()
-            .zip(&o.series)
-            .map(|(s, ser)| Series {
-                name: s.algo.clone(),
-                points: ser.iter().map(|r| (r.0, [r.1, r.2, r.3, r.4][k])).collect(),
+            .zip(&o.plot.errors)
+            .map(|(s, cols)| {
+                Series::line(
+                    s.algo.clone(),
+                    cols.series(k)
+                        .into_iter()
+                        .map(|(t, y)| (t, y * scale))
+                        .collect(),
+                )
             })
             .collect(),
+        ..Panel::default()
     };
     Figure {
         panels: vec![
-            panel("horizontal position error", "|δN, δE| [m]", 0),
-            panel("vertical position error", "|δD| [m]", 1),
-            panel("velocity error", "|δv| [m/s]", 2),
-            panel("attitude error", "|ε| [rad]", 3),
+            panel("horizontal position error", "|δN, δE| [m]", 0, 1.0),
+            panel("vertical position error", "|δD| [m]", 1, 1.0),
+            panel("velocity error", "|δv| [m/s]", 2, 1.0),
+            panel("attitude error", "|ε| [μrad]", 3, 1e6),
         ],
         cols: 2,
         size: (1400, 900),
     }
 }
 
-/// Arc seconds per radian.
-const ARCSEC_PER_RAD: f64 = 180.0 * 3600.0 / std::f64::consts::PI;
-
-/// The per-axis error figure of a run (`errors_ned.png`): attitude (arcsec), velocity
-/// (m/s) and position (m) error, N/E/D, one line per algorithm. On a log scale the
-/// absolute value is drawn.
+/// The per-axis error figure of a run (`errors_ned`): attitude (μrad), velocity (m/s)
+/// and position (m) error, N/E/D, one line per algorithm, from every navigation update
+/// (min/max per pixel column). On a log scale the absolute value is drawn.
 pub fn ned_figure(o: &Outcome) -> crate::plot::Figure {
     use crate::plot::{Figure, Panel, Series};
     let log = o.plot_scale == PlotScale::Log;
     let groups = [
-        ("attitude error", "ε", "arcsec", ARCSEC_PER_RAD, 0),
-        ("velocity error", "δv", "m/s", 1.0, 3),
-        ("position error", "δp", "m", 1.0, 6),
+        ("attitude error", "ε", "μrad", 4),
+        ("velocity error", "δv", "m/s", 7),
+        ("position error", "δp", "m", 10),
     ];
     let mut panels = Vec::new();
-    for (what, sym, unit, scale, first) in groups {
+    for (what, sym, unit, first) in groups {
         for (k, axis) in ["N", "E", "D"].iter().enumerate() {
             let y_label = if log {
                 format!("|{sym}_{axis}| [{unit}]")
@@ -318,18 +445,10 @@ pub fn ned_figure(o: &Outcome) -> crate::plot::Figure {
                 series: o
                     .sums
                     .iter()
-                    .zip(&o.ned)
-                    .map(|(s, ser)| Series {
-                        name: s.algo.clone(),
-                        points: ser
-                            .iter()
-                            .map(|(t, v)| {
-                                let y = v[first + k] * scale;
-                                (*t, if log { y.abs() } else { y })
-                            })
-                            .collect(),
-                    })
+                    .zip(&o.plot.errors)
+                    .map(|(s, cols)| Series::line(s.algo.clone(), cols.series(first + k)))
                     .collect(),
+                ..Panel::default()
             });
         }
     }
@@ -337,6 +456,52 @@ pub fn ned_figure(o: &Outcome) -> crate::plot::Figure {
         panels,
         cols: 3,
         size: (1500, 1150),
+    }
+}
+
+/// The trajectory of a run (`trajectory`): ground track north over east from the start
+/// (equal scales), height, and roll, pitch, yaw of the truth versus time (every update,
+/// min/max per pixel column; yaw unwrapped).
+pub fn trajectory_figure(o: &Outcome) -> crate::plot::Figure {
+    use crate::plot::{Figure, Panel, Series};
+    let tr = &o.plot.trajectory;
+    let time = |title: &str, y: &str, min_y_span: f64, series: Vec<Series>| Panel {
+        title: title.into(),
+        x_label: "time [s]".into(),
+        y_label: y.into(),
+        min_y_span,
+        series,
+        ..Panel::default()
+    };
+    Figure {
+        panels: vec![
+            Panel {
+                title: "ground track".into(),
+                x_label: "east [m]".into(),
+                y_label: "north [m]".into(),
+                equal_axes: true,
+                series: vec![Series::line("truth", o.plot.track_en_m.clone())],
+                ..Panel::default()
+            },
+            time(
+                "height",
+                "h [m]",
+                2.0,
+                vec![Series::line("truth", tr.series(0))],
+            ),
+            time(
+                "attitude",
+                "angle [°]",
+                2.0,
+                vec![
+                    Series::line("roll", tr.series(1)),
+                    Series::line("pitch", tr.series(2)),
+                    Series::line("yaw", tr.series(3)),
+                ],
+            ),
+        ],
+        cols: 3,
+        size: (1500, 480),
     }
 }
 
@@ -350,8 +515,8 @@ pub fn summary_rows(sums: &[RunSummary]) -> Vec<Vec<String>> {
                 e.pos_err_ned_m
                     .iter()
                     .chain(&e.vel_err_ned_mps)
-                    .chain(&e.att_err_rad)
-                    .map(|x| format!("{x:.3e}")),
+                    .map(|x| format!("{x:.3e}"))
+                    .chain(e.att_err_rad.iter().map(|x| format!("{:.3e}", x * 1e6))),
             );
             r.push(format!(
                 "{:.1}",
@@ -371,9 +536,9 @@ pub const SUMMARY_HEADER: [&str; 11] = [
     "vel N [m/s]",
     "vel E [m/s]",
     "vel D [m/s]",
-    "att N [rad]",
-    "att E [rad]",
-    "att D [rad]",
+    "att N [μrad]",
+    "att E [μrad]",
+    "att D [μrad]",
     "time [ns/update]",
 ];
 
@@ -389,17 +554,24 @@ fn write_report(o: &Outcome) -> Result<(), CliError> {
         o.sums.first().map_or(0.0, |s| s.final_err.t_s)
     ));
     r.table(&SUMMARY_HEADER, &summary_rows(&o.sums));
-    let fig = error_figure(o);
-    r.figure(
-        &fig,
-        "Error norms against the exact truth (log scale), one line per algorithm.",
+    r.figure_file(
+        &trajectory_figure(o),
+        &o.out,
+        "trajectory",
+        "Trajectory (truth): ground track from the start, height, and roll, pitch, yaw.",
     )?;
-    fig.png(&o.out.join("errors.png"))?;
-    let ned = ned_figure(o);
-    r.figure(
-        &ned,
+    r.figure_file(
+        &error_figure(o),
+        &o.out,
+        "errors",
+        "Error norms against the exact truth (log scale), one line per algorithm, every navigation update (min/max per pixel column).",
+    )?;
+    r.figure_file(
+        &ned_figure(o),
+        &o.out,
+        "errors_ned",
         &format!(
-            "Errors per NED axis against the exact truth ({}), one line per algorithm: attitude ε (arcsec), velocity (m/s), position (m). Also errors_ned.png.",
+            "Errors per NED axis against the exact truth ({}), one line per algorithm, every navigation update: attitude ε (μrad), velocity (m/s), position (m).",
             if o.plot_scale == PlotScale::Log {
                 "log scale of the absolute value"
             } else {
@@ -407,7 +579,6 @@ fn write_report(o: &Outcome) -> Result<(), CliError> {
             }
         ),
     )?;
-    ned.png(&o.out.join("errors_ned.png"))?;
     let bars = Bars {
         title: "navigation time per update".into(),
         y_label: "time [ns/update]".into(),
@@ -418,8 +589,10 @@ fn write_report(o: &Outcome) -> Result<(), CliError> {
             .collect(),
         size: (900, 400),
     };
-    r.bars(
+    r.bars_file(
         &bars,
+        &o.out,
+        "timing",
         "Wall time of each algorithm's navigation loop (truth generation excluded), this machine.",
     )?;
     r.write(&o.out.join("report.html"))

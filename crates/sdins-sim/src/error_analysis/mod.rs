@@ -1,4 +1,4 @@
-//! Error analysis (issue 6, analytic part): INS error propagation and the Schuler
+//! Error analysis: INS error propagation and the Schuler
 //! analysis of spec `alignment_and_errors.md` §4.
 //!
 //! Conventions (spec §0): navigation frame NED; attitude errors in **convention G**,

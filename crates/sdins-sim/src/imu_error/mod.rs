@@ -1,4 +1,4 @@
-//! IMU error models (issue 4): the sensor-error terms of spec §0.3 applied to exact
+//! IMU error models: the sensor-error terms of docs/theory/imu-errors.md applied to exact
 //! body-frame increments, sensor-grade presets (spec §4.5) and a reproducible,
 //! stateful corruption of an increment stream.
 //!

@@ -1,4 +1,4 @@
-//! Monte Carlo (issue 6): N seeded realisations of a scenario with its IMU error model,
+//! Monte Carlo: N seeded realisations of a scenario with its IMU error model,
 //! one navigation algorithm, and per-epoch statistics of the navigation errors in
 //! mergeable accumulators.
 //!
