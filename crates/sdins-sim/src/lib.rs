@@ -8,6 +8,7 @@ pub mod align;
 pub mod allan;
 pub mod cancel;
 pub mod error_analysis;
+pub mod fuse;
 pub mod gnss;
 pub mod gnss_fix;
 pub mod imu_error;
