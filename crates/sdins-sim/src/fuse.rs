@@ -224,6 +224,32 @@ pub fn fuse_scenario(
     opts: &FuseOptions,
     run: u64,
     cancel: &CancelToken,
+    observe: impl FnMut(FuseEvent<'_>),
+) -> Result<FuseSummary, FuseError> {
+    fuse_scenario_with(scn, None, gnss, opts, run, cancel, observe)
+}
+
+/// The exact truth of a scenario, generated once (for Monte Carlo runs sharing it).
+pub fn scenario_truth(scn: &Scenario) -> Vec<TruthSample> {
+    let cfg = TruthConfig {
+        earth: scn.nav.earth.model(),
+        dt_s: scn.imu.dt_s(),
+        lat0_rad: scn.start.lat_rad,
+        lon0_rad: scn.start.lon_rad,
+        h0_m: scn.start.h_m,
+        substeps: scn.nav.substeps,
+    };
+    TruthGenerator::new(&scn.trajectory, cfg).collect()
+}
+
+/// [`fuse_scenario`] reusing a truth from [`scenario_truth`] (`None`: generate it).
+pub fn fuse_scenario_with(
+    scn: &Scenario,
+    cached: Option<&[TruthSample]>,
+    gnss: &GnssConfig,
+    opts: &FuseOptions,
+    run: u64,
+    cancel: &CancelToken,
     mut observe: impl FnMut(FuseEvent<'_>),
 ) -> Result<FuseSummary, FuseError> {
     let earth = scn.nav.earth.model();
@@ -259,8 +285,13 @@ pub fn fuse_scenario(
         h0_m: scn.start.h_m,
         substeps: scn.nav.substeps,
     };
-    let mut truth = TruthGenerator::new(&scn.trajectory, cfg);
-    let init_true = truth.initial_state();
+    let generator = TruthGenerator::new(&scn.trajectory, cfg);
+    let init_true = generator.initial_state();
+    let len_samples = generator.len_samples();
+    let mut truth: Box<dyn Iterator<Item = TruthSample> + '_> = match cached {
+        Some(c) => Box::new(c.iter().copied()),
+        None => Box::new(generator),
+    };
     let mut gsim = GnssSimulator::new(gnss, earth, run)?;
     let mut sensor = ImuErrorState::new(&scn.imu.model, scn.imu.seed, run)
         .map_err(|e| FuseError::Imu(e.to_string()))?;
@@ -316,7 +347,7 @@ pub fn fuse_scenario(
     };
     let mut ekf = Ekf::new(mech, ekf_cfg, p0, known_ba, known_bg);
 
-    let mut total = truth.len_samples() / n as u64;
+    let mut total = len_samples / n as u64;
     if let Some(t) = opts.until_s {
         total = total.min((t * nav_rate).round() as u64);
     }

@@ -57,6 +57,9 @@ pub struct GnssConfig {
     pub outages_s: Vec<[f64; 2]>,
     /// probability that an epoch is dropped, 0…1
     pub dropout_prob: f64,
+    /// injected outliers `[t_s, dN_m, dE_m, dD_m]`: added to the fix of the epoch nearest
+    /// `t_s` (within half a period)
+    pub outliers_t_s_ned_m: Vec<[f64; 4]>,
     /// time-tag latency [s] (tag = time of validity + latency)
     pub latency_s: f64,
     /// whether the filter knows (and corrects) the latency
@@ -77,6 +80,7 @@ impl Default for GnssConfig {
             lever_arm_b_m: [0.0; 3],
             outages_s: Vec::new(),
             dropout_prob: 0.0,
+            outliers_t_s_ned_m: Vec::new(),
             latency_s: 0.0,
             latency_modelled: true,
             seed: 1,
@@ -157,6 +161,14 @@ impl GnssConfig {
             if !(o[0].is_finite() && o[1].is_finite() && o[1] > o[0]) {
                 return Err(bad("outages_s", format!("need start < end, got {o:?}")));
             }
+        }
+        if self
+            .outliers_t_s_ned_m
+            .iter()
+            .flatten()
+            .any(|x| !x.is_finite())
+        {
+            return Err(bad("outliers_t_s_ned_m", "must be finite"));
         }
         if !(self.dropout_prob.is_finite() && (0.0..=1.0).contains(&self.dropout_prob)) {
             return Err(bad("dropout_prob", "must be in 0…1"));
@@ -292,8 +304,16 @@ impl GnssSimulator {
         let scale = Vec3::new(r.r_m_m + truth.2, (r.r_n_m + truth.2) * truth.0.cos(), -1.0);
         let mut err = Vec3::zeros();
         let mut var = Vec3::zeros();
+        let half = 0.5 / c.rate_hz;
+        for o in c
+            .outliers_t_s_ned_m
+            .iter()
+            .filter(|o| (o[0] - t).abs() < half)
+        {
+            err += Vec3::new(o[1], o[2], o[3]);
+        }
         for i in 0..3 {
-            err[i] = c.sigma_pos_ned_m[i] * w[i] + self.gm[i];
+            err[i] += c.sigma_pos_ned_m[i] * w[i] + self.gm[i];
             var[i] = c.sigma_pos_ned_m[i].powi(2) + c.gm_sigma_ned_m[i].powi(2);
         }
         let vel = if c.has_velocity() {
