@@ -133,6 +133,8 @@ pub struct FuseEpoch {
     pub pos_scale: Vec3,
     /// the navigation errors in user units
     pub nav: crate::pipeline::NavError,
+    /// the true attitude at the epoch
+    pub c_b_n_true: sdins_core::math::Mat3,
 }
 
 impl FuseEpoch {
@@ -467,5 +469,6 @@ fn epoch_of<M: Mechanization>(
             -1.0,
         ),
         nav: ne,
+        c_b_n_true: truth.c_b_n,
     }
 }

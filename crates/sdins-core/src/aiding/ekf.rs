@@ -33,7 +33,9 @@
 //!   `(t_{k−1}, t_k]` is compared with the state interpolated to `t` with constant
 //!   acceleration over the interval: `v(t) = v_k − a τ`, `p(t) = p_k − τ (v_k − ½ a τ)`,
 //!   `τ = t_k − t`, `a = (v_k − v_{k−1})/(t_k − t_{k−1})`; the error state is taken as
-//!   constant over τ (it changes on the Schuler time scale).
+//!   constant over τ (it changes on the Schuler time scale). The attitude used for the
+//!   lever arm is `Ĉ(t) = Ĉ_k exp(−[ω_ib^b τ ×])` (the navigation-frame rotation over τ,
+//!   ≤ 1e-4 rad/s · τ, is neglected).
 //! * ZUPT: `ν = v̂^n`, `H = [0, I, 0, 0, 0]`; triggered by the caller (a flag).
 //! * NHC (body frame; the vehicle frame is the body frame here): `ν = (Ĉᵀ v̂)_{y,z}`,
 //!   `H = rows y, z of [0, Ĉᵀ, Ĉᵀ[v̂×], 0, 0]`.
@@ -441,7 +443,9 @@ impl<M: Mechanization> Ekf<M> {
         }
         self.propagate_covariance()?;
         let (lat, lon, h, v) = self.state_at(m.t_s);
-        let c = self.cur.c_b_n;
+        // attitude at the time of validity: rotated back by the body rate over τ
+        let tau = self.cur.t_s - m.t_s;
+        let c = self.cur.c_b_n * Quat::from_rotvec(&(-self.omega_ib_b * tau)).to_dcm();
         let l = self.cfg.lever_arm_b_m;
         let r = self.cfg.earth.radii(lat);
         let (_, cl) = libm::sincos(lat);
