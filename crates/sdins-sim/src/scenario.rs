@@ -63,6 +63,7 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "nav",
             "segment",
             "overlay",
+            "gnss",
         ],
     ),
     (
@@ -111,7 +112,30 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "end_s",
         ],
     ),
+    GNSS_KEYS,
 ];
+
+// ---- [gnss] section (INS/GNSS fusion) ----
+/// Keys of the `[gnss]` table (`crate::gnss::GnssConfig`).
+const GNSS_KEYS: (&str, &[&str]) = (
+    "gnss",
+    &[
+        "rate_hz",
+        "offset_s",
+        "sigma_pos_ned_m",
+        "sigma_vel_ned_mps",
+        "gm_sigma_ned_m",
+        "gm_tau_s",
+        "lever_arm_b_m",
+        "outages_s",
+        "dropout_prob",
+        "outliers_t_s_ned_m",
+        "latency_s",
+        "latency_modelled",
+        "seed",
+    ],
+);
+// ---- end [gnss] ----
 
 type S<T> = Spanned<T>;
 
@@ -127,6 +151,8 @@ struct FileDoc {
     segment: Vec<S<SegmentDoc>>,
     #[serde(default)]
     overlay: Vec<S<OverlayDoc>>,
+    // [gnss] section
+    gnss: Option<S<crate::gnss::GnssConfig>>,
 }
 
 #[derive(Deserialize)]
@@ -293,6 +319,8 @@ pub struct Scenario {
     pub nav: NavConfig,
     /// the trajectory
     pub trajectory: Trajectory,
+    /// GNSS receiver simulation (`[gnss]`), if the scenario has one
+    pub gnss: Option<crate::gnss::GnssConfig>,
 }
 
 struct Ctx<'a> {
@@ -816,6 +844,17 @@ impl Scenario {
         if nav.substeps == 0 {
             nav.substeps = crate::truth::auto_substeps(dt, &trajectory);
         }
+        // [gnss] section
+        let gnss = match &doc.gnss {
+            None => None,
+            Some(g) => {
+                let cfg = g.get_ref().clone();
+                if let Err(crate::gnss::GnssConfigError::Invalid { key, what }) = cfg.validate() {
+                    return cx.err(g.span(), &format!("gnss.{key}"), what);
+                }
+                Some(cfg)
+            }
+        };
         Ok(Scenario {
             name: doc.name.unwrap_or_else(|| {
                 Path::new(file)
@@ -827,6 +866,7 @@ impl Scenario {
             imu,
             nav,
             trajectory,
+            gnss,
         })
     }
 
