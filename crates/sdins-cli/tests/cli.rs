@@ -565,3 +565,42 @@ fn signal_stops_cleanly(signal: &str, code: i32) {
         .collect();
     assert!(left.is_empty(), "left behind: {left:?}");
 }
+
+/// One initial-state validator for every source: a PSINS header with latitude 95° and a
+/// truth file whose first row moves at 1e300 m/s are refused like `--init` would be (they
+/// used to give NaN with exit 0).
+#[test]
+fn initial_states_from_files_are_validated() {
+    let d = tmp("initval");
+    let imu = d.join("bad.imu");
+    let mut text = String::from(
+        "% PSINS-format SIMU log file\n0 0 -90.6 0 0 0\n95.0 108.9 380 0 10 9.78\n0.1 0.1 0.1 125 125 125\n",
+    );
+    for _ in 0..20 {
+        text += "0 0 2 0 0 80\n";
+    }
+    std::fs::write(&imu, text).unwrap();
+    let (code, _, err) = sdins(&["nav", "--imu", imu.to_str().unwrap(), "--format", "psins"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("bad.imu") && err.contains("PSINS header") && err.contains("latitude"),
+        "{err}"
+    );
+
+    truth_and_imu(&d);
+    let truth = std::fs::read_to_string(d.join("truth.csv")).unwrap();
+    let mut lines: Vec<String> = truth.lines().map(String::from).collect();
+    let mut cols: Vec<String> = lines[1].split(',').map(String::from).collect();
+    cols[4] = "1e300".into();
+    lines[1] = cols.join(",");
+    std::fs::write(d.join("truth.csv"), lines.join("\n") + "\n").unwrap();
+    let (code, _, err) = sdins(&[
+        "nav",
+        "--imu",
+        d.join("imu.csv").to_str().unwrap(),
+        "--truth",
+        d.join("truth.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("first row") && err.contains("speed"), "{err}");
+}

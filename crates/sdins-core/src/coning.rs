@@ -145,7 +145,20 @@ impl ConingSet {
         }
     }
 
-    /// Default (polynomial) set for N samples, as in S1 (`three_poly` for N = 3).
+    /// The set a user gets when they name none (CLI, Python, scenario files): the best the
+    /// method offers for N samples. For N = 1 that is `1prev` (the current sample plus the
+    /// previous one, Savage *Strapdown Analytics* §7.1.1.1 / Groves eq. 5.97 — the method
+    /// every peer tool uses), not "none"; for N ≥ 2 the polynomial set of N.
+    pub const fn recommended_for(n: usize) -> ConingSet {
+        match n {
+            1 => ConingSet::OnePrev,
+            _ => Self::default_for(n),
+        }
+    }
+
+    /// Polynomial set for N samples, as in S1 (`three_poly` for N = 3); no correction for
+    /// N = 1 (the papers' single-sample baseline). Reproductions of the papers use this;
+    /// users get [`ConingSet::recommended_for`].
     pub const fn default_for(n: usize) -> ConingSet {
         match n {
             2 => ConingSet::Two,

@@ -7,6 +7,7 @@
 pub mod align;
 pub mod allan;
 pub mod cancel;
+pub mod envelope;
 pub mod error_analysis;
 pub mod fuse;
 pub mod gnss;

@@ -547,6 +547,16 @@ impl Scenario {
             climb_rate_mps: climb,
             euler,
         };
+        // the one initial-state validator every source uses (the ranges above name the key)
+        if let Err(e) = crate::initial::validate_initial_state(&sdins_core::nav::InitialState {
+            lat_rad: start.lat_rad,
+            lon_rad: start.lon_rad,
+            h_m: start.h_m,
+            v_n_mps: sdins_core::math::Vec3::new(speed, 0.0, -climb),
+            c_b_n: sdins_core::math::c_b_n_from_euler(&euler),
+        }) {
+            return cx.err(doc.start.span(), "start", e.to_string());
+        }
 
         let im = doc.imu.get_ref();
         let rate_hz = cx.positive(&im.rate_hz, "imu.rate_hz")?;
@@ -604,6 +614,13 @@ impl Scenario {
                 );
             }
             let n = dur / dt;
+            if n.round() < 1.0 {
+                return cx.err(
+                    sd.duration_s.span(),
+                    "segment.duration_s",
+                    format!("{dur} s is shorter than one IMU sample ({dt} s at {rate_hz} Hz)"),
+                );
+            }
             if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
                 return cx.err(sd.duration_s.span(), "segment.duration_s", format!("{dur} s is not a whole number of IMU samples at {rate_hz} Hz (segment boundaries must fall on sample boundaries)"));
             }
@@ -674,8 +691,8 @@ impl Scenario {
                             format!("{a} m/s² exceeds 1000 g"),
                         );
                     }
-                    speed_now += a * dur;
-                    if speed_now < -1e-9 {
+                    speed_now = crate::trajectory::accelerated_speed(speed_now, a, dur);
+                    if speed_now < 0.0 {
                         return cx.err(s.span(), "segment.accel_mps2", format!("the speed would become negative ({speed_now} m/s) by the end of this segment"));
                     }
                     Motion::Accelerate { accel_mps2: a }
@@ -840,6 +857,21 @@ impl Scenario {
         }
 
         let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
+        if let Err(e) = crate::envelope::check_trajectory(
+            &trajectory,
+            crate::envelope::StartPosition {
+                lat_rad: start.lat_rad,
+                h_m: start.h_m,
+            },
+            dt,
+            &crate::envelope::Envelope::DEFAULT,
+        ) {
+            let span = match e.segment().and_then(|k| doc.segment.get(k)) {
+                Some(seg) => seg.span(),
+                None => doc.start.span(),
+            };
+            return cx.err(span, "segment", e.to_string());
+        }
         let mut nav = nav;
         if nav.substeps == 0 {
             nav.substeps = crate::truth::auto_substeps(dt, &trajectory);

@@ -45,6 +45,19 @@ pub enum Motion {
     },
 }
 
+/// Speed after accelerating at `accel_mps2` for `duration_s` from `speed0_mps`, with a
+/// return to rest snapped to exactly zero: `0.1 m/s² × 3 s` then `−0.3 m/s² × 1 s` rounds to
+/// 5.55e-17 m/s, which is rest to the precision of its inputs (|v| ≤ 4ε(|v0| + |aT|)).
+pub fn accelerated_speed(speed0_mps: f64, accel_mps2: f64, duration_s: f64) -> f64 {
+    let dv = accel_mps2 * duration_s;
+    let v = speed0_mps + dv;
+    if v.abs() <= 4.0 * f64::EPSILON * (speed0_mps.abs() + dv.abs()) {
+        0.0
+    } else {
+        v
+    }
+}
+
 /// A segment with its time span and its start state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Segment {
@@ -253,7 +266,11 @@ impl Segment {
         match self.motion {
             Motion::Static | Motion::Cruise => {}
             Motion::Accelerate { accel_mps2 } => {
-                n.speed = self.speed0 + accel_mps2 * tau;
+                n.speed = if tau == big_t {
+                    accelerated_speed(self.speed0, accel_mps2, big_t)
+                } else {
+                    self.speed0 + accel_mps2 * tau
+                };
                 n.speed_dot = accel_mps2;
             }
             Motion::TurnRate { rate_rps } => {

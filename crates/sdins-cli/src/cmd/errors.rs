@@ -35,8 +35,9 @@ use sdins_sim::error_analysis::{DEG_PER_HOUR, MICRO_G};
     sdins errors --schuler-share --json"
 )]
 pub struct Args {
-    /// sensor grade (marine, aviation, intermediate, tactical, consumer): its typical bias
-    /// on every NED axis, and its ARW/VRW for the covariance envelope
+    /// sensor grade (the grade table of docs/imu-errors.md: marine, aviation, intermediate,
+    /// tactical, consumer): its turn-on bias σ on every NED axis, and its ARW/VRW for the
+    /// covariance envelope
     #[arg(long, conflicts_with_all = ["gyro_bias_dph", "accel_bias_ug"])]
     pub grade: Option<String>,
     /// NED gyro bias [°/h] as N,E,D
@@ -174,8 +175,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let (gyro_dph, accel_ug) = match grade {
         Some(g) => (
-            Vec3::repeat(g.typical_gyro_bias_dph),
-            Vec3::repeat(g.typical_accel_bias_ug),
+            Vec3::repeat(g.gyro_bias_turn_on_dph),
+            Vec3::repeat(g.accel_bias_turn_on_ug),
         ),
         None => (
             vec3("gyro-bias-dph", &args.gyro_bias_dph)?,
@@ -501,7 +502,7 @@ fn print_table(r: &Report<'_>) {
         r.gyro_bias_dph_ned,
         r.accel_bias_ug_ned,
         r.grade
-            .map(|g| format!(" (grade {g}, typical biases, ARW/VRW in σ)"))
+            .map(|g| format!(" (grade {g}, turn-on bias σ, ARW/VRW in σ)"))
             .unwrap_or_default()
     );
     println!(
@@ -563,7 +564,7 @@ fn print_share(json: bool) -> Result<(), CliError> {
     );
     for r in &rows {
         let paper = grade_by_name(&r.grade)
-            .and_then(|g| g.p2_share_pct)
+            .and_then(|g| g.p2.map(|b| b.share_pct))
             .map(|(a, b)| format!("{a:.1}–{b:.1}"))
             .unwrap_or_default();
         println!(

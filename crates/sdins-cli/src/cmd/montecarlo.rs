@@ -34,9 +34,10 @@ pub struct Args {
     /// number of runs N (all shards must use the same N)
     #[arg(long)]
     pub runs: u64,
-    /// seed of the sensor-error streams (replaces the scenario's [imu] seed)
+    /// seed of the sensor-error streams (default: the scenario's [imu] seed, itself 1 by
+    /// default; every shard of one job must use the same seed)
     #[arg(long)]
-    pub seed: u64,
+    pub seed: Option<u64>,
     /// algorithm: savage, songlee, songlee-complete, dualquat
     #[arg(long, default_value = "songlee-complete")]
     pub algo: String,
@@ -264,12 +265,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     }
     let n = args.samples.unwrap_or(scn.nav.samples);
-    let algo = AlgorithmSpec::from_name(&args.algo, n).ok_or_else(|| {
+    let mut algo = AlgorithmSpec::from_name(&args.algo, n).ok_or_else(|| {
         CliError::bad(format!(
             "--algo {}: expected savage, songlee, songlee-complete or dualquat",
             args.algo
         ))
     })?;
+    algo.coning = sdins_core::coning::ConingSet::recommended_for(n);
     if !(1..=4).contains(&n) {
         return Err(CliError::bad(format!("--samples {n}: expected 1..=4")));
     }
@@ -293,7 +295,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let opts = McOptions {
         runs: args.runs,
-        seed: args.seed,
+        seed: args.seed.unwrap_or(scn.imu.seed),
         algo,
         every_s: args.every_s,
         until_s: args.until_s,

@@ -25,7 +25,9 @@ pub struct Args {
     /// IMU samples per navigation update, 1..=4 (default: the scenario's)
     #[arg(long)]
     pub samples: Option<usize>,
-    /// coning/sculling set: none, 1prev, two, three_poly, three_opt, four_poly, four_opt, polynomial, optimal
+    /// coning/sculling set: none, 1prev, two, three_poly, three_opt, four_poly, four_opt,
+    /// polynomial, optimal (default: 1prev for one sample per update, else the polynomial set
+    /// of N)
     #[arg(long)]
     pub coning: Option<String>,
     /// attitude update for local-level algorithms: transport (S1 eq. 6), five (eq. 5), savage (Savage Part 1)
@@ -81,7 +83,7 @@ pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, Cli
     };
     let coning_name = args.coning.clone().or_else(|| scn.nav.coning.clone());
     let coning = match &coning_name {
-        None => ConingSet::default_for(n),
+        None => ConingSet::recommended_for(n),
         Some(c) => {
             let set = ConingSet::parse(c, n).ok_or_else(|| {
                 CliError::bad(format!(

@@ -17,7 +17,7 @@
 //!
 //! [`schuler_share_full`] is the spec's requested variant on the full model of §4.3.
 
-use super::grades::GRADES;
+use super::grades::{P2Box, GRADES};
 use super::periods::SchulerParams;
 use super::short_term::{eq1_east_gyro, eq2_down_gyro, eq3_accel};
 use super::stationary::{StationaryClosedForm, StationaryErrors};
@@ -105,7 +105,12 @@ pub struct ShareRow {
 pub fn schuler_share_table(t: f64, lat_rad: f64, p: &SchulerParams) -> Vec<ShareRow> {
     let mut rows = Vec::new();
     for g in GRADES.iter() {
-        let (Some((a0, a1)), Some((w0, w1))) = (g.p2_accel_bias_ug, g.p2_gyro_bias_dph) else {
+        let Some(P2Box {
+            accel_bias_ug: (a0, a1),
+            gyro_bias_dph: (w0, w1),
+            ..
+        }) = g.p2
+        else {
             continue;
         };
         for a in [a0, a1] {

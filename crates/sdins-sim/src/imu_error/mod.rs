@@ -208,6 +208,77 @@ impl Default for ImuErrorModel {
     }
 }
 
+/// Unit of an `[imu.errors]` key, from its name's unit suffix.
+fn unit_of(key: &str) -> &'static str {
+    const SUFFIXES: [(&str, &str); 15] = [
+        ("_dphpsh", "°/h/√h"),
+        ("_dphpg", "°/h/g"),
+        ("_dpsh", "°/√h"),
+        ("_dph", "°/h"),
+        ("_dps", "°/s"),
+        ("_ugpsqrthz", "μg/√Hz"),
+        ("_ugpsh", "μg/√h"),
+        ("_ug", "μg"),
+        ("_mpsph", "m/s/√h"),
+        ("_mps", "m/s"),
+        ("_ppm", "ppm"),
+        ("_mrad", "mrad"),
+        ("_arcsec", "arcsec"),
+        ("_g", "g"),
+        ("_s", "s"),
+    ];
+    SUFFIXES
+        .iter()
+        .find(|(s, _)| key.ends_with(s))
+        .map_or("", |(_, u)| u)
+}
+
+/// Every `[imu.errors]` key with its shape and unit, as a Markdown table generated from
+/// [`ImuErrorModel`]'s serialization (docs/imu-errors.md holds this text; a test keeps it
+/// equal).
+pub fn keys_markdown() -> String {
+    let full = ImuErrorModel {
+        gyro_range_dps: Some([0.0; 3]),
+        accel_range_g: Some([0.0; 3]),
+        ..ImuErrorModel::default()
+    };
+    let mut s = String::from("| key | shape | unit | default |\n|---|---|---|---|\n");
+    let Ok(toml::Value::Table(t)) = toml::Value::try_from(&full) else {
+        return s;
+    };
+    let fields = toml::Value::try_from(ImuErrorModel::default())
+        .ok()
+        .and_then(|v| v.as_table().cloned())
+        .unwrap_or_default();
+    for (k, v) in &t {
+        let shape = match v {
+            toml::Value::Array(a) if a.first().is_some_and(toml::Value::is_array) => {
+                "3×3 matrix (row i = output axis i)".to_string()
+            }
+            toml::Value::Array(a) if a.len() == 3 => "3-vector (x, y, z)".to_string(),
+            toml::Value::Array(a) => format!("{} values", a.len()),
+            _ => "scalar".to_string(),
+        };
+        let default = match fields.get(k) {
+            None => "none (unlimited)".to_string(),
+            Some(toml::Value::Array(a)) if a.iter().all(|x| x.as_float() == Some(0.0)) => {
+                "0 (off)".to_string()
+            }
+            Some(toml::Value::Array(a))
+                if a.iter().all(|x| {
+                    x.as_array()
+                        .is_some_and(|r| r.iter().all(|y| y.as_float() == Some(0.0)))
+                }) =>
+            {
+                "0 (off)".to_string()
+            }
+            Some(v) => v.to_string(),
+        };
+        s += &format!("| `{k}` | {shape} | {} | {default} |\n", unit_of(k));
+    }
+    s
+}
+
 fn check_nonneg(field: &'static str, v: &[f64]) -> Result<(), ImuErrorModelError> {
     for x in v {
         if !(x.is_finite() && *x >= 0.0) {
