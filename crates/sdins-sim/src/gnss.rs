@@ -138,7 +138,7 @@ impl GnssConfig {
         pos("sigma_pos_ned_m", &self.sigma_pos_ned_m, true)?;
         pos("sigma_vel_ned_mps", &self.sigma_vel_ned_mps, false)?;
         let v = self.sigma_vel_ned_mps;
-        if v.iter().any(|x| *x > 0.0) && v.iter().any(|x| *x == 0.0) {
+        if v.iter().any(|x| *x > 0.0) && v.contains(&0.0) {
             return Err(bad("sigma_vel_ned_mps", "set all three axes or none"));
         }
         pos("gm_sigma_ned_m", &self.gm_sigma_ned_m, false)?;
@@ -401,26 +401,54 @@ mod tests {
 
     #[test]
     fn validation_names_the_key() {
-        let mut c = GnssConfig::default();
-        c.validate().unwrap();
-        c.rate_hz = 25.0;
-        assert!(c.validate().unwrap_err().to_string().contains("rate_hz"));
-        let mut c = GnssConfig::default();
-        c.sigma_pos_ned_m[1] = 0.0;
-        assert!(c
-            .validate()
-            .unwrap_err()
-            .to_string()
-            .contains("sigma_pos_ned_m"));
-        let mut c = GnssConfig::default();
-        c.dropout_prob = f64::NAN;
-        assert!(c
-            .validate()
-            .unwrap_err()
-            .to_string()
-            .contains("dropout_prob"));
-        let mut c = GnssConfig::default();
-        c.outages_s = vec![[10.0, 5.0]];
-        assert!(c.validate().unwrap_err().to_string().contains("outages_s"));
+        GnssConfig::default().validate().unwrap();
+        let cases = [
+            (
+                "rate_hz",
+                GnssConfig {
+                    rate_hz: 25.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "sigma_pos_ned_m",
+                GnssConfig {
+                    sigma_pos_ned_m: [1.0, 0.0, 1.0],
+                    ..Default::default()
+                },
+            ),
+            (
+                "dropout_prob",
+                GnssConfig {
+                    dropout_prob: f64::NAN,
+                    ..Default::default()
+                },
+            ),
+            (
+                "outages_s",
+                GnssConfig {
+                    outages_s: vec![[10.0, 5.0]],
+                    ..Default::default()
+                },
+            ),
+            (
+                "gm_tau_s",
+                GnssConfig {
+                    gm_sigma_ned_m: [1.0; 3],
+                    gm_tau_s: 0.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "latency_s",
+                GnssConfig {
+                    latency_s: -0.1,
+                    ..Default::default()
+                },
+            ),
+        ];
+        for (key, c) in cases {
+            assert!(c.validate().unwrap_err().to_string().contains(key), "{key}");
+        }
     }
 }

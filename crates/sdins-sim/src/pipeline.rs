@@ -175,10 +175,8 @@ pub fn run(
     observe: impl FnMut(usize, &NavState, &TruthSample, &NavError),
     progress: impl FnMut(u64, u64),
 ) -> Vec<RunSummary> {
-    match run_cancellable(scn, opts, &CancelToken::new(), observe, progress) {
-        Ok(v) => v,
-        Err(Cancelled) => Vec::new(), // unreachable: nobody holds the token
-    }
+    // nobody else holds the token: the error case is unreachable
+    run_cancellable(scn, opts, &CancelToken::new(), observe, progress).unwrap_or_default()
 }
 
 /// [`run`], polling `cancel` once per block of 2048 updates (a few ms of work).

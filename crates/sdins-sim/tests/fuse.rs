@@ -2,8 +2,8 @@
 //! Carlo (`#[ignore]`, release: `cargo test --release -p sdins-sim --test fuse -- --ignored`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
-use sdins_core::aiding::error_model::{I_ATT, I_BA, I_BG, I_POS, I_VEL};
+use sdins_core::aiding::ekf::MeasKind;
+use sdins_core::aiding::error_model::{I_ATT, I_BA, I_POS, I_VEL};
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
 use sdins_sim::cancel::CancelToken;
 use sdins_sim::fuse::{fuse_scenario, FuseEvent, FuseOptions};
@@ -108,6 +108,7 @@ const Z99: f64 = 2.575_829_303_548_901;
 struct Run {
     epochs: Vec<FuseEpoch>,
     gnss: Vec<(f64, f64, bool)>,
+    #[allow(dead_code)]
     summary: FuseSummary,
 }
 
@@ -222,6 +223,7 @@ fn consistency(grade: &str) {
     let mut ratio = [0.0; 6];
     for r in &runs {
         let e = r.epochs.last().unwrap();
+        #[allow(clippy::needless_range_loop)]
         for i in 0..6 {
             let idx = I_BA + i;
             if e.err[idx].abs() > 3.0 * e.sigma(idx) {
@@ -552,4 +554,26 @@ fn mc_zupt_nhc_reduce_outage_error() {
     assert!(rms_a < 0.5 * rms_p);
     assert!((lo..=hi).contains(&nees_a), "aided NEES {nees_a}");
     assert!((lo..=hi).contains(&nees_p), "plain NEES {nees_p}");
+}
+
+#[test]
+fn gnss_scenario_section_parses_and_bad_values_name_the_key() {
+    let base = maneuver_toml("tactical", 100.0, 1);
+    let ok = format!("{base}[gnss]\nrate_hz = 5.0\nlever_arm_b_m = [1.5, 0.0, -0.5]\noutages_s = [[100.0, 160.0]]\n");
+    let s = Scenario::from_toml(&ok, "g.toml").unwrap();
+    let g = s.gnss.unwrap();
+    assert_eq!(g.rate_hz, 5.0);
+    assert_eq!(g.outages_s, vec![[100.0, 160.0]]);
+    for (text, key) in [
+        ("rate_hz = 0.5", "gnss.rate_hz"),
+        ("sigma_pos_ned_m = [1.0, -1.0, 1.0]", "gnss.sigma_pos_ned_m"),
+        ("sigma_pos_ned_m = [1.0, nan, 1.0]", "gnss.sigma_pos_ned_m"),
+        ("dropout_prob = 2.0", "gnss.dropout_prob"),
+        ("outages_s = [[5.0, 1.0]]", "gnss.outages_s"),
+    ] {
+        let e = Scenario::from_toml(&format!("{base}[gnss]\n{text}\n"), "g.toml").unwrap_err();
+        assert!(e.to_string().contains(key), "{text}: {e}");
+    }
+    let e = Scenario::from_toml(&format!("{base}[gnss]\nrate_hzz = 1.0\n"), "g.toml").unwrap_err();
+    assert!(e.to_string().contains("rate_hzz"), "{e}");
 }
