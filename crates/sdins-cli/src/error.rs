@@ -45,6 +45,15 @@ impl From<sdins_sim::cancel::Cancelled> for CliError {
     }
 }
 
+impl From<sdins_sim::pipeline::PipelineError> for CliError {
+    fn from(e: sdins_sim::pipeline::PipelineError) -> Self {
+        match e {
+            sdins_sim::pipeline::PipelineError::Cancelled(_) => CliError::Interrupted,
+            other => CliError::BadInput(other.to_string()),
+        }
+    }
+}
+
 impl From<sdins_sim::scenario::ScenarioError> for CliError {
     fn from(e: sdins_sim::scenario::ScenarioError) -> Self {
         CliError::BadInput(e.to_string())

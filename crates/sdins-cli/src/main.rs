@@ -54,7 +54,19 @@ enum Command {
     Merge(cmd::merge::Args),
 }
 
+/// Die quietly on a closed stdout (`sdins run --json | head -c1`), like other Unix tools:
+/// Rust ignores SIGPIPE, which turns every later `println!` into a panic.
+fn restore_sigpipe() {
+    // SAFETY: setting a signal disposition to its default has no preconditions; this runs
+    // first in `main`, before any thread exists.
+    #[allow(unsafe_code)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = Cli::parse();
     progress::install_signal_handlers();
     let result = match cli.command {

@@ -18,6 +18,12 @@ impl AtomicFile {
     /// Start writing `dest` (its folder is created if missing).
     pub fn create(dest: &Path) -> Result<Self, CliError> {
         if let Some(dir) = dest.parent() {
+            if dir.exists() && !dir.is_dir() {
+                return Err(CliError::bad(format!(
+                    "{}: the output folder is an existing file, not a folder",
+                    dir.display()
+                )));
+            }
             if !dir.as_os_str().is_empty() {
                 std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
                     path: dir.to_path_buf(),

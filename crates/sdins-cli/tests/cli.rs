@@ -604,3 +604,97 @@ fn initial_states_from_files_are_validated() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("first row") && err.contains("speed"), "{err}");
 }
+
+/// Process conditions: a closed stdout ends the command quietly (SIGPIPE, exit 141 like
+/// other Unix tools, no panic message), an output folder that is a file and absurd
+/// resource requests are bad input (exit 2), non-UTF-8 arguments are refused by the parser.
+#[test]
+fn process_conditions_and_resource_bounds() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args(["run", "turn-90dps", "--json", "--out"])
+        .arg(tmp("pipe"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut one = [0u8; 1];
+    child.stdout.take().unwrap().read_exact(&mut one).unwrap(); // then the pipe closes
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    use std::os::unix::process::ExitStatusExt;
+    assert!(
+        out.status.success() || out.status.signal() == Some(13),
+        "{:?} {err}",
+        out.status
+    );
+
+    let file = tmp("outfile").join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let (code, _, err) = sdins(&["truth", "turn-90dps", "--out", file.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("is an existing file"), "{err}");
+
+    for args in [
+        &["montecarlo", "turn-90dps", "--runs", "18446744073709551615"][..],
+        &[
+            "montecarlo",
+            "turn-90dps",
+            "--runs",
+            "2",
+            "--threads",
+            "100000",
+        ][..],
+    ] {
+        let (code, _, err) = sdins(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+
+    use std::os::unix::ffi::OsStrExt;
+    let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .arg("run")
+        .arg(std::ffi::OsStr::from_bytes(b"\xff"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("invalid UTF-8"));
+}
+
+/// Provenance: run.toml holds u64 seeds losslessly (as strings: TOML integers are i64) and
+/// the scenario text as it was read.
+#[test]
+fn run_toml_keeps_u64_seeds_and_the_scenario_text() {
+    let d = tmp("prov");
+    let (code, _, err) = sdins(&[
+        "montecarlo",
+        "turn-90dps",
+        "--runs",
+        "2",
+        "--seed",
+        "18446744073709551615",
+        "--grade",
+        "tactical",
+        "--quiet",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let t: toml::Table = std::fs::read_to_string(d.join("run.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(t["seed"].as_str(), Some("18446744073709551615"));
+    let p = d.join("s.toml");
+    std::fs::write(&p, GOOD).unwrap();
+    let r = d.join("run");
+    let (code, _, err) = sdins(&["run", p.to_str().unwrap(), "--out", r.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let t: toml::Table = std::fs::read_to_string(r.join("run.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(t["scenario"].as_str(), Some(GOOD));
+}

@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         until_s: None,
         sensor_run: None,
     };
-    let summaries = run(&scn, &opts, |_, _, _, _| {}, |_, _| {});
+    let summaries = run(&scn, &opts, |_, _, _, _| {}, |_, _| {})?;
     for s in &summaries {
         let e = &s.final_err;
         println!(

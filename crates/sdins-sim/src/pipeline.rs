@@ -166,6 +166,76 @@ pub struct RunOptions {
     pub sensor_run: Option<u64>,
 }
 
+/// Why a pipeline run did not complete.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PipelineError {
+    /// The cancellation token was set.
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
+    /// No algorithm to run.
+    #[error("no algorithm given")]
+    NoAlgorithm,
+    /// Algorithms side by side must consume the same samples per update.
+    #[error("algorithms run side by side must share the samples per update: {first} has N = {n0}, {other} has N = {n1}")]
+    MixedSamples {
+        /// first algorithm
+        first: &'static str,
+        /// its N
+        n0: usize,
+        /// the differing one
+        other: &'static str,
+        /// its N
+        n1: usize,
+    },
+    /// N outside 1..=4, or a coefficient set for another N.
+    #[error("{algo}: {what}")]
+    BadAlgorithm {
+        /// algorithm
+        algo: &'static str,
+        /// what is wrong
+        what: String,
+    },
+    /// `until_s` is not a positive finite time.
+    #[error("until_s = {0}: expected a positive finite time [s]")]
+    BadUntil(f64),
+}
+
+/// Check the algorithm list of a run: non-empty, one N in 1..=4 shared by all, coning sets
+/// that accept that N.
+pub fn check_algorithms(algos: &[AlgorithmSpec]) -> Result<usize, PipelineError> {
+    let first = algos.first().ok_or(PipelineError::NoAlgorithm)?;
+    let n = first.samples;
+    for a in algos {
+        if a.samples != n {
+            return Err(PipelineError::MixedSamples {
+                first: first.kind.name(),
+                n0: n,
+                other: a.kind.name(),
+                n1: a.samples,
+            });
+        }
+        if !(1..=4).contains(&a.samples) {
+            return Err(PipelineError::BadAlgorithm {
+                algo: a.kind.name(),
+                what: format!("samples per update {} is outside 1..=4", a.samples),
+            });
+        }
+        if !a.coning.accepts(a.samples) {
+            return Err(PipelineError::BadAlgorithm {
+                algo: a.kind.name(),
+                what: format!(
+                    "coning set {} is for {} samples, not {}",
+                    a.coning.name(),
+                    a.coning.samples(),
+                    a.samples
+                ),
+            });
+        }
+    }
+    Ok(n)
+}
+
 /// Run the scenario's truth through every algorithm; `observe(i, state, truth, err)` is
 /// called every `opts.every` updates for algorithm `i`. `progress(done, total)` is
 /// called once per block. Not cancellable: see [`run_cancellable`].
@@ -174,9 +244,8 @@ pub fn run(
     opts: &RunOptions,
     observe: impl FnMut(usize, &NavState, &TruthSample, &NavError),
     progress: impl FnMut(u64, u64),
-) -> Vec<RunSummary> {
-    // nobody else holds the token: the error case is unreachable
-    run_cancellable(scn, opts, &CancelToken::new(), observe, progress).unwrap_or_default()
+) -> Result<Vec<RunSummary>, PipelineError> {
+    run_cancellable(scn, opts, &CancelToken::new(), observe, progress)
 }
 
 /// [`run`], polling `cancel` once per block of 2048 updates (a few ms of work).
@@ -186,7 +255,13 @@ pub fn run_cancellable(
     cancel: &CancelToken,
     mut observe: impl FnMut(usize, &NavState, &TruthSample, &NavError),
     mut progress: impl FnMut(u64, u64),
-) -> Result<Vec<RunSummary>, Cancelled> {
+) -> Result<Vec<RunSummary>, PipelineError> {
+    let n = check_algorithms(&opts.algos)?;
+    if let Some(u) = opts.until_s {
+        if !(u.is_finite() && u > 0.0) {
+            return Err(PipelineError::BadUntil(u));
+        }
+    }
     let earth = scn.nav.earth.model();
     let cfg = TruthConfig {
         earth,
@@ -198,11 +273,6 @@ pub fn run_cancellable(
     };
     let mut truth = TruthGenerator::new(&scn.trajectory, cfg);
     let init = truth.initial_state();
-    let n = opts
-        .algos
-        .first()
-        .map_or(scn.nav.samples, |a| a.samples)
-        .max(1);
     let mut mechs: Vec<AnyMechanization> = opts
         .algos
         .iter()
@@ -354,6 +424,48 @@ mod tests {
     use super::*;
     use sdins_core::math::{attitude_error, c_b_n_from_euler, euler_from_c_b_n, Euler};
     use sdins_core::nav::wrap_pi;
+
+    #[test]
+    fn bad_algorithm_lists_are_errors_not_miscomputation() {
+        use sdins_core::nav::AlgorithmKind as K;
+        let scn = Scenario::load("turn-90dps").unwrap();
+        let opts = |algos: Vec<AlgorithmSpec>, until_s| RunOptions {
+            algos,
+            vertical_hold: false,
+            every: 1,
+            until_s,
+            sensor_run: None,
+        };
+        let mixed = vec![
+            AlgorithmSpec::new(K::Savage, 3),
+            AlgorithmSpec::new(K::DualQuat, 2),
+        ];
+        let mut bad_coning = AlgorithmSpec::new(K::Savage, 2);
+        bad_coning.coning = sdins_core::coning::ConingSet::ThreePoly;
+        for (o, want) in [
+            (opts(mixed, Some(1.0)), "share the samples per update"),
+            (opts(vec![], Some(1.0)), "no algorithm"),
+            (
+                opts(vec![AlgorithmSpec::new(K::Savage, 5)], Some(1.0)),
+                "outside 1..=4",
+            ),
+            (opts(vec![bad_coning], Some(1.0)), "coning set"),
+            (
+                opts(vec![AlgorithmSpec::new(K::Savage, 3)], Some(f64::NAN)),
+                "until_s",
+            ),
+        ] {
+            let e = run(&scn, &o, |_, _, _, _| {}, |_, _| {})
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(want), "{e}");
+        }
+        let token = CancelToken::new();
+        token.cancel();
+        let o = opts(vec![AlgorithmSpec::new(K::Savage, 3)], None);
+        let r = run_cancellable(&scn, &o, &token, |_, _, _, _| {}, |_, _| {});
+        assert_eq!(r, Err(PipelineError::Cancelled(Cancelled)));
+    }
 
     /// The textbook evaluation of spec §1.4 that `nav_error` must reproduce.
     fn reference(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> NavError {

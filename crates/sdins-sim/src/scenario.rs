@@ -321,6 +321,9 @@ pub struct Scenario {
     pub trajectory: Trajectory,
     /// GNSS receiver simulation (`[gnss]`), if the scenario has one
     pub gnss: Option<crate::gnss::GnssConfig>,
+    /// the scenario text exactly as it was read (provenance: `run.toml` records this, not
+    /// the file as it may be later)
+    pub source_toml: String,
 }
 
 struct Ctx<'a> {
@@ -899,6 +902,7 @@ impl Scenario {
             nav,
             trajectory,
             gnss,
+            source_toml: text.to_string(),
         })
     }
 

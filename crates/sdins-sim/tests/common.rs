@@ -53,7 +53,8 @@ pub fn run_at(
             }
         },
         |_, _| {},
-    );
+    )
+    .unwrap();
     (summ, got)
 }
 

@@ -187,7 +187,7 @@ proptest! {
                 run(&scn, &opts, |_, st, _, e| {
                     finite &= st.lat_rad.is_finite() && st.h_m.is_finite()
                         && e.pos_err_ned_m.iter().chain(&e.att_err_rad).all(|v| v.is_finite());
-                }, |_, _| {});
+                }, |_, _| {}).unwrap();
                 prop_assert!(finite, "non-finite navigation");
             }
         }

@@ -215,7 +215,8 @@ fn linear_vs_nonlinear(scn: &Scenario, until_s: f64) -> [f64; 7] {
             },
             |_, _, _, e| v.push(*e),
             |_, _| {},
-        );
+        )
+        .unwrap();
         v
     };
     let biased = collect(Some(0));

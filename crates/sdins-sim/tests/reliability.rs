@@ -58,7 +58,8 @@ fn sweep(scn: &Scenario, n: usize, until: f64) -> Vec<(f64, f64, f64, f64)> {
             a.3 = a.3.max(ortho_defect(&st.c_b_n));
         },
         |_, _| {},
-    );
+    )
+    .unwrap();
     acc
 }
 
@@ -181,7 +182,8 @@ fn stationary_72h_vertical_hold_matches_closed_form() {
             last[i] = [e.pos_err_ned_m[0], e.pos_err_ned_m[1]];
         },
         |_, _| {},
-    );
+    )
+    .unwrap();
     let wall = t0.elapsed().as_secs_f64();
     assert_eq!(summ[0].nav_updates, 6_480_000);
     let c = cf.eval(259_200.0);

@@ -584,10 +584,10 @@ fn write_align_toml(
     if let Some(name) = &args.scenario {
         t.insert("scenario_name".into(), inp.name.clone().into());
         t.insert("scenario".into(), crate::report::scenario_text(name).into());
-        t.insert("run".into(), (args.run as i64).into());
+        t.insert("run".into(), args.run.to_string().into());
     }
     if let Some(seed) = inp.seed {
-        t.insert("seed".into(), (seed as i64).into());
+        t.insert("seed".into(), seed.to_string().into());
     }
     if let Some(p) = &args.imu {
         let abs = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());

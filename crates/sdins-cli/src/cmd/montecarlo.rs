@@ -79,7 +79,7 @@ pub struct Args {
 /// Map a library error to the CLI's exit codes.
 pub fn mc_err(e: McError) -> CliError {
     match e {
-        McError::Interrupted => CliError::Other("interrupted: no output written".into()),
+        McError::Interrupted => CliError::Interrupted,
         McError::Config(_)
         | McError::Model(_)
         | McError::Mismatch(_)
@@ -191,8 +191,9 @@ fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliE
         job.fingerprint.clone().into(),
     );
     t.insert("algo".into(), job.algo.clone().into());
-    t.insert("runs".into(), (job.runs as i64).into());
-    t.insert("seed".into(), (job.seed as i64).into());
+    // u64 values as strings: TOML integers are i64
+    t.insert("runs".into(), job.runs.to_string().into());
+    t.insert("seed".into(), job.seed.to_string().into());
     crate::report::write_run_toml(dir, t)
 }
 
@@ -319,9 +320,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let cancelled = crate::progress::interrupted;
     let compute = || run_shard(&scn, &opts, shard, &on_run, &cancelled);
+    if let Some(t) = args.threads {
+        if !(1..=1024).contains(&t) {
+            return Err(CliError::bad(format!("--threads {t}: expected 1 … 1024")));
+        }
+    }
     let result = match args.threads {
         Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t.max(1))
+            .num_threads(t)
             .build()
             .map_err(|e| CliError::Other(e.to_string()))?
             .install(compute),

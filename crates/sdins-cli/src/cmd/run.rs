@@ -317,16 +317,19 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
 fn write_run_toml(out: &std::path::Path, scn: &Scenario, args: &Args) -> Result<(), CliError> {
     let mut t = toml::Table::new();
     t.insert("scenario_name".into(), scn.name.clone().into());
-    t.insert("seed".into(), (scn.imu.seed as i64).into());
+    // u64 seeds and run indices as strings: TOML integers are i64
+    t.insert("seed".into(), scn.imu.seed.to_string().into());
     t.insert(
         "sensor_run".into(),
-        (if args.ideal { -1 } else { args.run as i64 }).into(),
+        (if args.ideal {
+            "ideal".to_string()
+        } else {
+            args.run.to_string()
+        })
+        .into(),
     );
     t.insert("plot_scale".into(), args.plot_scale.name().into());
-    t.insert(
-        "scenario".into(),
-        crate::report::scenario_text(&args.scenario).into(),
-    );
+    t.insert("scenario".into(), scn.source_toml.clone().into());
     crate::report::write_run_toml(out, t)
 }
 

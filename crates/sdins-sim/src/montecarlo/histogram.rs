@@ -96,17 +96,25 @@ impl LogHistogram {
         *self.bins.entry(bin_key(x)).or_insert(0) += 1;
     }
 
-    /// Add the counts of `o` (exact, order-independent).
+    /// Add the counts of `o` (exact, order-independent; saturating, so that a tampered
+    /// state cannot overflow — [`LogHistogram::total`] then no longer matches the run count
+    /// and the state is refused).
     pub fn merge(&mut self, o: &LogHistogram) {
         for (k, c) in &o.bins {
-            *self.bins.entry(*k).or_insert(0) += c;
+            let e = self.bins.entry(*k).or_insert(0);
+            *e = e.saturating_add(*c);
         }
-        self.nonfinite += o.nonfinite;
+        self.nonfinite = self.nonfinite.saturating_add(o.nonfinite);
     }
 
     /// Number of binned (finite) values.
     pub fn count(&self) -> u64 {
-        self.bins.values().sum()
+        self.bins.values().fold(0, |a, &c| a.saturating_add(c))
+    }
+
+    /// Number of values pushed, finite or not.
+    pub fn total(&self) -> u64 {
+        self.count().saturating_add(self.nonfinite)
     }
 
     /// Nearest-rank percentile `q ∈ [0, 1]` of the binned values (NaN if empty).

@@ -52,10 +52,10 @@ pub fn block_count(runs: u64, block: u64) -> u64 {
     runs.div_ceil(block.max(1))
 }
 
-/// Runs of block `b`.
+/// Runs of block `b` (saturating: total for every input, empty past the last block).
 pub fn block_runs(b: u64, runs: u64, block: u64) -> Range<u64> {
     let k = block.max(1);
-    (b * k).min(runs)..((b + 1) * k).min(runs)
+    b.saturating_mul(k).min(runs)..b.saturating_add(1).saturating_mul(k).min(runs)
 }
 
 /// Blocks of a shard: `⌊i·B/n⌋ … ⌊(i+1)·B/n⌋`.

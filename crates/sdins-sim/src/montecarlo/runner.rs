@@ -41,8 +41,17 @@ fn channels(e: &NavError) -> [f64; N_CHANNELS] {
     [p[0], p[1], p[2], v[0], v[1], v[2], a[0], a[1], a[2]]
 }
 
+/// Largest number of runs of one job (the per-epoch moments are exact far beyond it; the
+/// cap keeps block and shard arithmetic and run-time estimates sane).
+pub const MAX_RUNS: u64 = 100_000_000;
+
 /// One realisation: the errors at every output epoch.
-pub fn run_one(scn: &Scenario, opts: &McOptions, every: u64, run: u64) -> Vec<NavError> {
+pub fn run_one(
+    scn: &Scenario,
+    opts: &McOptions,
+    every: u64,
+    run: u64,
+) -> Result<Vec<NavError>, McError> {
     let ropts = RunOptions {
         algos: vec![opts.algo],
         vertical_hold: opts.vertical_hold,
@@ -51,14 +60,18 @@ pub fn run_one(scn: &Scenario, opts: &McOptions, every: u64, run: u64) -> Vec<Na
         sensor_run: Some(run),
     };
     let mut out = Vec::new();
-    run_pipeline(scn, &ropts, |_, _, _, e| out.push(*e), |_, _| {});
-    out
+    run_pipeline(scn, &ropts, |_, _, _, e| out.push(*e), |_, _| {})
+        .map_err(|e| McError::Config(e.to_string()))?;
+    Ok(out)
 }
 
 /// The job identity and the per-run scenario (seed replaced).
 pub fn job(scn: &Scenario, opts: &McOptions) -> Result<(McJob, Scenario), McError> {
-    if opts.runs == 0 {
-        return Err(McError::Config("runs must be ≥ 1".into()));
+    if opts.runs == 0 || opts.runs > MAX_RUNS {
+        return Err(McError::Config(format!(
+            "runs = {}: expected 1 … {MAX_RUNS}",
+            opts.runs
+        )));
     }
     if opts.block == 0 {
         return Err(McError::Config("block size must be ≥ 1".into()));
@@ -69,11 +82,12 @@ pub fn job(scn: &Scenario, opts: &McOptions) -> Result<(McJob, Scenario), McErro
             opts.every_s
         )));
     }
-    if !(1..=4).contains(&opts.algo.samples) {
-        return Err(McError::Config(format!(
-            "{} samples per update: expected 1..=4",
-            opts.algo.samples
-        )));
+    crate::pipeline::check_algorithms(std::slice::from_ref(&opts.algo))
+        .map_err(|e| McError::Config(e.to_string()))?;
+    if let Some(u) = opts.until_s {
+        if !(u.is_finite() && u > 0.0) {
+            return Err(McError::Config(format!("until_s = {u}: expected > 0")));
+        }
     }
     scn.imu
         .model
@@ -156,7 +170,7 @@ pub fn run_shard(
                 }
                 let errs = match &cache {
                     Some(c) => c.run(&s.imu.model, s.imu.seed, r, &opts.algo, opts.vertical_hold),
-                    None => run_one(&s, opts, job.every, r),
+                    None => run_one(&s, opts, job.every, r)?,
                 };
                 if times.is_empty() {
                     times = errs.iter().map(|e| e.t_s).collect();
@@ -260,6 +274,24 @@ duration_s = 60.0
     }
 
     #[test]
+    fn tampered_states_are_refused() {
+        let scn = small_scenario();
+        let o = opts(9);
+        let st = run_shard(&scn, &o, Shard::ALL, &|| {}, &|| false).unwrap();
+        st.validate().unwrap();
+        let tamper = |f: &dyn Fn(&mut McState)| {
+            let mut t = st.clone();
+            f(&mut t);
+            McState::merge(&[t]).unwrap_err().to_string()
+        };
+        assert!(tamper(&|t| t.blocks[0].moments[0].n += 1).contains("n = "));
+        assert!(tamper(&|t| t.blocks[0].moments[3].m2 = -1.0).contains("m2"));
+        assert!(tamper(&|t| t.blocks[0].moments[1].mean = f64::NAN).contains("mean"));
+        assert!(tamper(&|t| t.times_s[0] = f64::INFINITY).contains("epoch"));
+        assert!(tamper(&|t| t.hist[2] = Default::default()).contains("histogram"));
+    }
+
+    #[test]
     fn bit_identical_for_threads_and_shards() {
         let scn = small_scenario();
         let o = opts(61); // 4 blocks, the last one partial
@@ -346,7 +378,7 @@ duration_s = 60.0
                 ..o.clone()
             };
             for r in [0, 5] {
-                let a = run_one(&s, &o, job.every, r);
+                let a = run_one(&s, &o, job.every, r).unwrap();
                 let c = cache.run(&s.imu.model, s.imu.seed, r, &o.algo, hold);
                 assert_eq!(a.len(), 5);
                 assert_eq!(a, c);

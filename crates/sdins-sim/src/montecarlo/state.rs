@@ -12,7 +12,7 @@
 
 use super::histogram::LogHistogram;
 use super::moments::Moments;
-use super::plan::block_count;
+use super::plan::{block_count, block_runs};
 use super::{McError, N_CHANNELS};
 use serde::{Deserialize, Serialize};
 
@@ -113,6 +113,40 @@ impl McState {
                 )));
             }
             prev = Some(b.index);
+            // moment invariants: every cell counts the block's runs, finite mean, m2 ≥ 0
+            let runs = block_runs(b.index, self.job.runs, self.job.block);
+            let want = runs.end - runs.start;
+            for (c, m) in b.moments.iter().enumerate() {
+                if m.n != want || !m.mean.is_finite() || !m.m2.is_finite() || m.m2 < 0.0 {
+                    return Err(McError::BadState(format!(
+                        "block {} cell {c}: n = {} (expected {want}), mean = {}, m2 = {} (finite, ≥ 0 expected)",
+                        b.index, m.n, m.mean, m.m2
+                    )));
+                }
+            }
+        }
+        if self.times_s.iter().any(|t| !t.is_finite()) {
+            return Err(McError::BadState("non-finite epoch time".into()));
+        }
+        // the histograms count every run of the state's blocks, once per cell
+        let runs: u64 = self
+            .blocks
+            .iter()
+            .map(|b| {
+                let r = block_runs(b.index, self.job.runs, self.job.block);
+                r.end - r.start
+            })
+            .sum();
+        if let Some((c, h)) = self
+            .hist
+            .iter()
+            .enumerate()
+            .find(|(_, h)| h.total() != runs)
+        {
+            return Err(McError::BadState(format!(
+                "histogram of cell {c} counts {} values for {runs} runs",
+                h.total()
+            )));
         }
         Ok(())
     }
