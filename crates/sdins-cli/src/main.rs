@@ -48,6 +48,8 @@ enum Command {
     Align(cmd::align::Args),
     /// Monte Carlo: N seeded runs with the scenario's IMU errors, per-epoch statistics.
     Montecarlo(cmd::montecarlo::Args),
+    /// INS/GNSS Kalman filter on a scenario: errors with ±3σ, innovations, bias estimates.
+    Fuse(cmd::fuse::Args),
     /// Merge Monte Carlo shard states exactly into the statistics of the whole job.
     Merge(cmd::merge::Args),
 }
@@ -78,6 +80,7 @@ fn main() -> ExitCode {
         Command::Align(a) => cmd::align::run(a),
         Command::Montecarlo(a) => cmd::montecarlo::run(a),
         Command::Merge(a) => cmd::merge::run(a),
+        Command::Fuse(a) => cmd::fuse::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

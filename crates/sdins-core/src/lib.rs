@@ -55,6 +55,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod aiding;
 pub mod align;
 pub mod coning;
 pub mod earth;

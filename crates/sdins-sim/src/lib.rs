@@ -49,6 +49,8 @@ pub mod cancel;
 pub mod envelope;
 pub mod error_analysis;
 pub mod gnss_file;
+pub mod fuse;
+pub mod gnss;
 pub mod gnss_fix;
 pub mod imu_error;
 pub mod imu_file;

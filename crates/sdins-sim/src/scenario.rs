@@ -67,6 +67,7 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "vehicle",
             "angle_of_attack_deg",
             "mounting",
+            "gnss",
         ],
     ),
     (
@@ -122,7 +123,30 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "end_s",
         ],
     ),
+    GNSS_KEYS,
 ];
+
+// ---- [gnss] section (INS/GNSS fusion) ----
+/// Keys of the `[gnss]` table (`crate::gnss::GnssConfig`).
+const GNSS_KEYS: (&str, &[&str]) = (
+    "gnss",
+    &[
+        "rate_hz",
+        "offset_s",
+        "sigma_pos_ned_m",
+        "sigma_vel_ned_mps",
+        "gm_sigma_ned_m",
+        "gm_tau_s",
+        "lever_arm_b_m",
+        "outages_s",
+        "dropout_prob",
+        "outliers_t_s_ned_m",
+        "latency_s",
+        "latency_modelled",
+        "seed",
+    ],
+);
+// ---- end [gnss] ----
 
 type S<T> = Spanned<T>;
 
@@ -141,6 +165,8 @@ struct FileDoc {
     vehicle: Option<S<String>>,
     angle_of_attack_deg: Option<S<f64>>,
     mounting: Option<S<MountingDoc>>,
+    // [gnss] section
+    gnss: Option<S<crate::gnss::GnssConfig>>,
 }
 
 #[derive(Deserialize)]
@@ -329,6 +355,8 @@ pub struct Scenario {
     pub nav: NavConfig,
     /// the trajectory
     pub trajectory: Trajectory,
+    /// GNSS receiver simulation (`[gnss]`), if the scenario has one
+    pub gnss: Option<crate::gnss::GnssConfig>,
     /// the scenario text exactly as it was read (provenance: `run.toml` records this, not
     /// the file as it may be later)
     pub source_toml: String,
@@ -1036,6 +1064,17 @@ impl Scenario {
         if nav.substeps == 0 {
             nav.substeps = crate::truth::auto_substeps(dt, &trajectory);
         }
+        // [gnss] section
+        let gnss = match &doc.gnss {
+            None => None,
+            Some(g) => {
+                let cfg = g.get_ref().clone();
+                if let Err(crate::gnss::GnssConfigError::Invalid { key, what }) = cfg.validate() {
+                    return cx.err(g.span(), &format!("gnss.{key}"), what);
+                }
+                Some(cfg)
+            }
+        };
         Ok(Scenario {
             name: doc.name.unwrap_or_else(|| {
                 Path::new(file)
@@ -1047,6 +1086,7 @@ impl Scenario {
             imu,
             nav,
             trajectory,
+            gnss,
             source_toml: text.to_string(),
             mounting,
         })

@@ -5,6 +5,7 @@ pub mod align_plot;
 pub mod allan;
 pub mod demo;
 pub mod errors;
+pub mod fuse;
 pub mod merge;
 pub mod montecarlo;
 pub mod nav;

@@ -373,6 +373,24 @@ impl Mechanization for DualQuatNav {
         }
     }
 
+    fn correct_state(&mut self, s: &NavState) {
+        // Re-initialise at the corrected state: the inertial frame is re-defined to
+        // coincide with the earth frame at this instant (any fixed i frame is valid);
+        // the time and the previous-sample memory are kept.
+        let (updates, prev) = (self.updates, self.prev);
+        let init = InitialState {
+            lat_rad: s.lat_rad,
+            lon_rad: s.lon_rad,
+            h_m: s.h_m,
+            v_n_mps: s.v_n_mps,
+            c_b_n: s.c_b_n,
+        };
+        let dt_s = self.dt_update_s / self.samples.max(1) as f64;
+        *self = DualQuatNav::new(self.earth, dt_s, self.samples, self.coning, &init);
+        self.updates = updates;
+        self.prev = prev;
+    }
+
     fn hold_vertical(&mut self, h_m: f64, v_d_mps: f64) {
         // Re-seat the U translation at the held height and the G translation so that the
         // inertial velocity carries the held v_D; attitudes are untouched.

@@ -285,4 +285,35 @@ impl Mechanization for LocalLevel {
         self.h_m = h_m;
         self.v_n_mps.z = v_d_mps;
     }
+
+    fn correct_state(&mut self, s: &NavState) {
+        // offsets from the start stay continuous (no wrap of dlon across ±180°)
+        self.dlat_rad += s.lat_rad - self.lat();
+        self.dlon_rad += wrap_pi(s.lon_rad - wrap_pi(self.lon0_rad + self.dlon_rad));
+        self.h_m = s.h_m;
+        self.v_n_mps = s.v_n_mps;
+        let q_new = Quat::from_dcm(&s.c_b_n);
+        self.q = match self.cfg.attitude {
+            AttitudeMode::Transport => {
+                // c_b_n = T(L, Δλ + Ω t) · C(q): q from Tᵀ c_b_n
+                let e = &self.cfg.earth;
+                let t = self.updates as f64 * self.dt_update_s;
+                let tm = if e.transport {
+                    let (sl, cl) = libm::sincos(self.lat());
+                    transport_matrix_sc(
+                        sl,
+                        cl,
+                        self.s_lat0,
+                        self.c_lat0,
+                        self.dlon_rad + e.omega_ie_rps * t,
+                    )
+                } else {
+                    transport_matrix(self.lat0_rad, self.s_lat0, self.c_lat0, e.omega_ie_rps * t)
+                };
+                Quat::from_dcm(&(tm.transpose() * s.c_b_n)).normalized()
+            }
+            AttitudeMode::Savage | AttitudeMode::Five => q_new,
+        };
+        self.c_b_n = s.c_b_n;
+    }
 }

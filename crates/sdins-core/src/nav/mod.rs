@@ -84,6 +84,10 @@ pub trait Mechanization {
     fn state(&self) -> NavState;
     /// Replace height and down velocity by a reference (vertical channel `hold`).
     fn hold_vertical(&mut self, h_m: f64, v_d_mps: f64);
+    /// Replace position, velocity and attitude by `s` (its `t_s` is ignored), keeping the
+    /// time and the previous-sample memory of the coning/sculling corrections: the
+    /// closed-loop correction of an aided filter (Groves §14.1.1).
+    fn correct_state(&mut self, s: &NavState);
 }
 
 /// Which algorithm and options, by the CLI names (`savage`, `songlee`,
@@ -250,6 +254,13 @@ impl Mechanization for AnyMechanization {
         match self {
             AnyMechanization::LocalLevel(m) => m.hold_vertical(h_m, v_d_mps),
             AnyMechanization::DualQuat(m) => m.hold_vertical(h_m, v_d_mps),
+        }
+    }
+    #[inline]
+    fn correct_state(&mut self, s: &NavState) {
+        match self {
+            AnyMechanization::LocalLevel(m) => m.correct_state(s),
+            AnyMechanization::DualQuat(m) => m.correct_state(s),
         }
     }
 }

@@ -47,29 +47,14 @@
 //! the only allocation is the output vector, reserved once.
 
 use super::periods::SchulerParams;
-use nalgebra::{SMatrix, SVector};
 use sdins_core::earth::EarthModel;
-use sdins_core::math::skew;
 use sdins_core::{Mat3, Vec3};
 use serde::Serialize;
 
-/// Number of states.
-pub const N_STATES: usize = 15;
-/// State vector.
-pub type StateVec = SVector<f64, N_STATES>;
-/// State matrix (F, Φ, P, Q).
-pub type StateMat = SMatrix<f64, N_STATES, N_STATES>;
-
-/// Index of the first position state (δL).
-pub const I_POS: usize = 0;
-/// Index of the first velocity state.
-pub const I_VEL: usize = 3;
-/// Index of the first attitude state.
-pub const I_ATT: usize = 6;
-/// Index of the first accelerometer-bias state.
-pub const I_BA: usize = 9;
-/// Index of the first gyro-bias state.
-pub const I_BG: usize = 12;
+use sdins_core::aiding::error_model::{self as core_model, ModelPoint};
+pub use sdins_core::aiding::error_model::{
+    StateMat, StateVec, I_ATT, I_BA, I_BG, I_POS, I_VEL, N_STATES,
+};
 
 /// Error of the linear-model functions.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -276,86 +261,31 @@ impl ErrorVector {
     }
 }
 
-/// F matrix at one sample (see the module documentation for every block).
+/// F matrix at one sample: the navigation-error model of
+/// `sdins_core::aiding::error_model::f_matrix` (see the module documentation for every block).
 pub fn f_matrix(s: &TrajectorySample, opts: &ModelOptions) -> StateMat {
     let earth = &opts.earth;
-    let (lat, h, v) = (s.lat_rad, s.h_m, s.v_n);
-    let (sl, cl) = lat.sin_cos();
-    let tl = sl / cl;
+    let lat = s.lat_rad;
     let (rm, rn) = earth.radii(lat);
-    let (rmh, rnh) = (rm + h, rn + h);
-    let om = earth.omega();
-    let g = earth.gravity(lat, h);
     let (c_b_n, f_n) = s.c_b_n_and_f_n();
-
-    let w_ie = Vec3::new(om * cl, 0.0, -om * sl);
-    let w_en = Vec3::new(v.y / rnh, -v.x / rmh, -v.y * tl / rnh);
-    let w_in = w_ie + w_en;
-    // ∂ω_en/∂v
-    let a_v = Mat3::new(
-        0.0,
-        1.0 / rnh,
-        0.0,
-        -1.0 / rmh,
-        0.0,
-        0.0,
-        0.0,
-        -tl / rnh,
-        0.0,
-    );
-    // ∂ω_ie/∂(L, λ, h) and ∂ω_en/∂(L, λ, h)
-    let d_ie = Mat3::new(-om * sl, 0.0, 0.0, 0.0, 0.0, 0.0, -om * cl, 0.0, 0.0);
-    let d_en = Mat3::new(
-        0.0,
-        0.0,
-        -v.y / (rnh * rnh),
-        0.0,
-        0.0,
-        v.x / (rmh * rmh),
-        -v.y / (rnh * cl * cl),
-        0.0,
-        v.y * tl / (rnh * rnh),
-    );
-    let vx = skew(&v);
-
-    let mut f = StateMat::zeros();
-    // position rows
-    f[(0, I_VEL)] = 1.0 / rmh;
-    f[(0, 2)] = -v.x / (rmh * rmh);
-    f[(1, I_VEL + 1)] = 1.0 / (rnh * cl);
-    f[(1, 0)] = v.y * sl / (rnh * cl * cl);
-    f[(1, 2)] = -v.y / (rnh * rnh * cl);
-    f[(2, I_VEL + 2)] = -1.0;
-    // velocity rows
-    f.fixed_view_mut::<3, 3>(I_VEL, I_ATT)
-        .copy_from(&(-skew(&f_n)));
-    f.fixed_view_mut::<3, 3>(I_VEL, I_VEL)
-        .copy_from(&(-skew(&(2.0 * w_ie + w_en)) + vx * a_v));
-    let mut f_vp = vx * (2.0 * d_ie + d_en);
-    f_vp[(2, 2)] += -2.0 * g / earth.r_es(lat);
-    f.fixed_view_mut::<3, 3>(I_VEL, I_POS).copy_from(&f_vp);
-    // attitude rows
-    f.fixed_view_mut::<3, 3>(I_ATT, I_ATT)
-        .copy_from(&(-skew(&w_in)));
-    f.fixed_view_mut::<3, 3>(I_ATT, I_VEL).copy_from(&(-a_v));
-    f.fixed_view_mut::<3, 3>(I_ATT, I_POS)
-        .copy_from(&(-(d_ie + d_en)));
-    if opts.bias_states {
-        f.fixed_view_mut::<3, 3>(I_VEL, I_BA).copy_from(&c_b_n);
-        f.fixed_view_mut::<3, 3>(I_ATT, I_BG).copy_from(&c_b_n);
-    }
-    if opts.vertical == VerticalChannel::Held {
-        f.row_mut(2).fill(0.0);
-        f.row_mut(I_VEL + 2).fill(0.0);
-    }
-    f
+    let p = ModelPoint {
+        sin_cos_lat: lat.sin_cos(),
+        h_m: s.h_m,
+        v_n_mps: s.v_n,
+        c_b_n,
+        f_n_mps2: f_n,
+        r_m_m: rm,
+        r_n_m: rn,
+        g_mps2: earth.gravity(lat, s.h_m),
+        omega_ie_rps: earth.omega(),
+        r_es_m: earth.r_es(lat),
+    };
+    core_model::f_matrix(&p, opts.bias_states, opts.vertical == VerticalChannel::Held)
 }
 
-/// `Φ = I + A + A²/2 + A³/6`, `A = F Δt` (Horner form).
+/// `Φ = I + A + A²/2 + A³/6`, `A = F Δt` (Horner form; `sdins_core::aiding::error_model`).
 pub fn transition(f: &StateMat, dt: f64) -> StateMat {
-    let a = f * dt;
-    let i = StateMat::identity();
-    i + a * (i + a * (i + a / 3.0) / 2.0)
+    core_model::transition(f, dt)
 }
 
 /// Continuous noise `G Q_c Gᵀ` at a sample.

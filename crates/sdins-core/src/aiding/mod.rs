@@ -1,0 +1,5 @@
+//! Aided navigation: the linear navigation-error model and the INS/GNSS error-state
+//! Kalman filter with closed-loop correction (see `docs/theory/ins-gnss.md`).
+
+pub mod ekf;
+pub mod error_model;

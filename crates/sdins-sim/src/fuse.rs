@@ -1,0 +1,474 @@
+//! INS/GNSS fusion on a scenario: truth → IMU errors → GNSS → error-state filter
+//! (`sdins_core::aiding::ekf`) → errors against the truth, with the filter's covariance.
+//!
+//! * Filter noise from the scenario's IMU error model: ARW, VRW, turn-on bias σ (prior
+//!   of random-constant bias states), Gauss–Markov bias (σ, T; `q = 2σ²/T`), rate random
+//!   walk; the fixed bias is known (initial estimate). Not modelled (and therefore not to
+//!   be simulated in consistency runs): scale factor, misalignment, g-sensitivity, flicker,
+//!   quantization, saturation.
+//! * Initial errors: position/velocity/attitude σ of [`FuseOptions::init_sigma`], drawn
+//!   per run from P0 (`draw_initial_errors`, stream channel 10–12 of the GNSS seed) or
+//!   zero; the attitude error is applied as `Ĉ = exp([ε×]) C` (convention G). The
+//!   linearised filter is limited to initial attitude σ ≤ 10° per axis (larger is
+//!   rejected: in-motion alignment from an unknown heading is not part of this filter).
+//! * ZUPT is triggered by the scenario truth (speed below a threshold), NHC is applied
+//!   whenever the truth is not at rest; both at the covariance rate.
+//! * The observer sees every covariance epoch (true error in the filter's state
+//!   coordinates and P, after that epoch's measurements) and every measurement report.
+
+use crate::cancel::{CancelToken, Cancelled};
+use crate::gnss::{GnssConfig, GnssConfigError, GnssSimulator};
+use crate::gnss_fix::GnssFix;
+use crate::imu_error::{ImuErrorModel, ImuErrorState, DEG, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H};
+use crate::imu_error::{UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ};
+use crate::pipeline::nav_error;
+use crate::scenario::Scenario;
+use crate::truth::{lon_diff, TruthConfig, TruthGenerator, TruthSample};
+use rand::SeedableRng;
+use rand_chacha::ChaCha20Rng;
+use rand_distr::{Distribution, StandardNormal};
+use sdins_core::aiding::ekf::{
+    Ekf, EkfConfig, FilterError, GnssMeasurement, NoiseModel, UpdateReport, CHI2_999,
+};
+use sdins_core::aiding::error_model::{StateMat, StateVec, I_ATT, I_BA, I_BG, I_POS, I_VEL};
+use sdins_core::coning::Increment;
+use sdins_core::math::{Quat, Vec3};
+use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, Mechanization};
+
+/// Initial 1σ errors of position [m NED], velocity [m/s NED], attitude [rad NED].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InitSigma {
+    /// position σ N, E, D [m]
+    pub pos_ned_m: [f64; 3],
+    /// velocity σ N, E, D [m/s]
+    pub vel_ned_mps: [f64; 3],
+    /// attitude σ N, E, D [rad]
+    pub att_rad: [f64; 3],
+}
+
+impl Default for InitSigma {
+    fn default() -> Self {
+        Self {
+            pos_ned_m: [3.0; 3],
+            vel_ned_mps: [0.1; 3],
+            att_rad: [1e-3, 1e-3, 5e-3],
+        }
+    }
+}
+
+/// Options of a fused run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FuseOptions {
+    /// mechanization (any of the four, N = 1..4)
+    pub algo: AlgorithmSpec,
+    /// covariance propagation rate [Hz] (≤ the navigation update rate)
+    pub cov_rate_hz: f64,
+    /// initial errors (σ)
+    pub init_sigma: InitSigma,
+    /// draw the initial errors from P0 (else start at the truth)
+    pub draw_initial_errors: bool,
+    /// NIS gate thresholds by dof 1…6 (None: no gating)
+    pub gate_chi2: Option<[f64; 6]>,
+    /// consecutive rejections before the reset policy
+    pub max_consecutive_rejections: u32,
+    /// ZUPT σ [m/s] and the truth speed below which the vehicle is at rest [m/s]
+    pub zupt: Option<(f64, f64)>,
+    /// NHC σ [m/s]
+    pub nhc_sigma_mps: Option<f64>,
+    /// tell the filter the GNSS lever arm (false: the filter assumes zero)
+    pub model_lever_arm: bool,
+    /// stop after this time [s]
+    pub until_s: Option<f64>,
+}
+
+impl Default for FuseOptions {
+    fn default() -> Self {
+        Self {
+            algo: AlgorithmSpec::new(sdins_core::nav::AlgorithmKind::SongLeeComplete, 2),
+            cov_rate_hz: 10.0,
+            init_sigma: InitSigma::default(),
+            draw_initial_errors: true,
+            gate_chi2: Some(CHI2_999),
+            max_consecutive_rejections: 5,
+            zupt: None,
+            nhc_sigma_mps: None,
+            model_lever_arm: true,
+            until_s: None,
+        }
+    }
+}
+
+/// Why a fused run stopped.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FuseError {
+    /// Bad GNSS settings.
+    #[error(transparent)]
+    Gnss(#[from] GnssConfigError),
+    /// Bad IMU error model.
+    #[error("IMU error model: {0}")]
+    Imu(String),
+    /// Bad option.
+    #[error("fuse option `{0}`: {1}")]
+    Option(&'static str, String),
+    /// The filter failed (names the epoch).
+    #[error(transparent)]
+    Filter(#[from] FilterError),
+    /// Cancelled.
+    #[error("cancelled")]
+    Cancelled(#[from] Cancelled),
+}
+
+/// One covariance epoch: the true error in the filter's state coordinates
+/// (δL, δλ, δh; δv; ε; accel residual bias `b − b̂`; gyro residual bias) and P.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FuseEpoch {
+    /// time [s]
+    pub t_s: f64,
+    /// true error
+    pub err: StateVec,
+    /// filter covariance
+    pub p: StateMat,
+    /// scale from (δL, δλ, δh) to metres NED
+    pub pos_scale: Vec3,
+    /// the navigation errors in user units
+    pub nav: crate::pipeline::NavError,
+    /// the true attitude at the epoch
+    pub c_b_n_true: sdins_core::math::Mat3,
+}
+
+impl FuseEpoch {
+    /// NEES of the 3-state block starting at `i0` (`I_POS`, `I_VEL`, `I_ATT`, …).
+    pub fn nees_block(&self, i0: usize) -> f64 {
+        let x = self.err.fixed_rows::<3>(i0).into_owned();
+        let p = self.p.fixed_view::<3, 3>(i0, i0).into_owned();
+        p.cholesky().map_or(f64::INFINITY, |c| x.dot(&c.solve(&x)))
+    }
+    /// Horizontal (N, E) position NEES (2 dof).
+    pub fn nees_horizontal(&self) -> f64 {
+        let x = self.err.fixed_rows::<2>(I_POS).into_owned();
+        let p = self.p.fixed_view::<2, 2>(I_POS, I_POS).into_owned();
+        p.cholesky().map_or(f64::INFINITY, |c| x.dot(&c.solve(&x)))
+    }
+    /// 1σ of state `i` in user units (position in metres).
+    pub fn sigma(&self, i: usize) -> f64 {
+        let s = self.p[(i, i)].max(0.0).sqrt();
+        if i < 3 {
+            s * self.pos_scale[i].abs()
+        } else {
+            s
+        }
+    }
+}
+
+/// What the observer receives.
+#[derive(Clone, Copy, Debug)]
+pub enum FuseEvent<'a> {
+    /// a covariance epoch
+    Epoch(&'a FuseEpoch),
+    /// a measurement update (GNSS, ZUPT, NHC)
+    Update(&'a UpdateReport),
+}
+
+/// Summary of a fused run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FuseSummary {
+    /// GNSS fixes simulated
+    pub fixes: u64,
+    /// GNSS fixes rejected by the gate
+    pub rejected: u64,
+    /// true constant biases (accel [m/s²], gyro [rad/s])
+    pub true_bias: (Vec3, Vec3),
+    /// final bias estimates
+    pub est_bias: (Vec3, Vec3),
+    /// final covariance
+    pub p_final: StateMat,
+    /// navigation updates
+    pub nav_updates: u64,
+}
+
+/// The filter's noise model and bias prior from an IMU error model: (noise, σ_ba, σ_bg,
+/// known bias accel, gyro).
+pub fn noise_from_model(m: &ImuErrorModel) -> (NoiseModel, Vec3, Vec3, Vec3, Vec3) {
+    let v = |a: [f64; 3], u: f64| Vec3::new(a[0] * u, a[1] * u, a[2] * u);
+    let vrw_a = v(m.accel_vrw_ugpsqrthz, UG_PER_SQRT_HZ);
+    let vrw_b = v(m.accel_vrw_mpsph, MPS_PER_SQRT_H);
+    let tau = |t: [f64; 3], s: [f64; 3]| {
+        Vec3::from_fn(|i, _| if s[i] > 0.0 { t[i] } else { f64::INFINITY })
+    };
+    let noise = NoiseModel {
+        arw_rad_per_sqrt_s: v(m.gyro_arw_dpsh, DPSH),
+        vrw_mps_per_sqrt_s: Vec3::from_fn(|i, _| vrw_a[i].hypot(vrw_b[i])),
+        accel_bias_gm_mps2: v(m.accel_bias_gm_ug, UG),
+        accel_bias_tau_s: tau(m.accel_bias_gm_tau_s, m.accel_bias_gm_ug),
+        gyro_bias_gm_rps: v(m.gyro_bias_gm_dph, DPH),
+        gyro_bias_tau_s: tau(m.gyro_bias_gm_tau_s, m.gyro_bias_gm_dph),
+        accel_bias_rw: v(m.accel_rrw_ugpsh, UG_PER_SQRT_H),
+        gyro_bias_rw: v(m.gyro_rrw_dphpsh, DPHPSH),
+    };
+    let hyp = |a: Vec3, b: Vec3| Vec3::from_fn(|i, _| a[i].hypot(b[i]));
+    let s_ba = hyp(v(m.accel_bias_turn_on_ug, UG), v(m.accel_bias_gm_ug, UG));
+    let s_bg = hyp(v(m.gyro_bias_turn_on_dph, DPH), v(m.gyro_bias_gm_dph, DPH));
+    (
+        noise,
+        s_ba,
+        s_bg,
+        v(m.accel_bias_ug, UG),
+        v(m.gyro_bias_dph, DPH),
+    )
+}
+
+/// Run the filter on the scenario with the GNSS settings, as run number `run` (IMU and
+/// GNSS errors and initial errors of that run).
+pub fn fuse_scenario(
+    scn: &Scenario,
+    gnss: &GnssConfig,
+    opts: &FuseOptions,
+    run: u64,
+    cancel: &CancelToken,
+    observe: impl FnMut(FuseEvent<'_>),
+) -> Result<FuseSummary, FuseError> {
+    fuse_scenario_with(scn, None, gnss, opts, run, cancel, observe)
+}
+
+/// The exact truth of a scenario, generated once (for Monte Carlo runs sharing it).
+pub fn scenario_truth(scn: &Scenario) -> Vec<TruthSample> {
+    let cfg = TruthConfig {
+        earth: scn.nav.earth.model(),
+        dt_s: scn.imu.dt_s(),
+        lat0_rad: scn.start.lat_rad,
+        lon0_rad: scn.start.lon_rad,
+        h0_m: scn.start.h_m,
+        substeps: scn.nav.substeps,
+    };
+    TruthGenerator::new(&scn.trajectory, cfg).collect()
+}
+
+/// [`fuse_scenario`] reusing a truth from [`scenario_truth`] (`None`: generate it).
+pub fn fuse_scenario_with(
+    scn: &Scenario,
+    cached: Option<&[TruthSample]>,
+    gnss: &GnssConfig,
+    opts: &FuseOptions,
+    run: u64,
+    cancel: &CancelToken,
+    mut observe: impl FnMut(FuseEvent<'_>),
+) -> Result<FuseSummary, FuseError> {
+    let earth = scn.nav.earth.model();
+    let dt = scn.imu.dt_s();
+    let n = opts.algo.samples.clamp(1, 4);
+    let nav_rate = 1.0 / (dt * n as f64);
+    if !(opts.cov_rate_hz.is_finite() && opts.cov_rate_hz > 0.0 && opts.cov_rate_hz <= nav_rate) {
+        return Err(FuseError::Option(
+            "cov_rate_hz",
+            format!("must be in (0, {nav_rate}] Hz, got {}", opts.cov_rate_hz),
+        ));
+    }
+    let s = &opts.init_sigma;
+    if s.att_rad
+        .iter()
+        .any(|x| !x.is_finite() || *x < 0.0 || *x > 10.0 * DEG)
+        || s.pos_ned_m
+            .iter()
+            .chain(s.vel_ned_mps.iter())
+            .any(|x| !x.is_finite() || *x < 0.0)
+    {
+        return Err(FuseError::Option(
+            "init_sigma",
+            "σ must be finite, ≥ 0, and attitude σ ≤ 10° (the linearised filter's limit)".into(),
+        ));
+    }
+    let cov_updates = (nav_rate / opts.cov_rate_hz).round().max(1.0) as usize;
+    let cfg = TruthConfig {
+        earth,
+        dt_s: dt,
+        lat0_rad: scn.start.lat_rad,
+        lon0_rad: scn.start.lon_rad,
+        h0_m: scn.start.h_m,
+        substeps: scn.nav.substeps,
+    };
+    let generator = TruthGenerator::new(&scn.trajectory, cfg);
+    let init_true = generator.initial_state();
+    let len_samples = generator.len_samples();
+    let mut truth: Box<dyn Iterator<Item = TruthSample> + '_> = match cached {
+        Some(c) => Box::new(c.iter().copied()),
+        None => Box::new(generator),
+    };
+    let mut gsim = GnssSimulator::new(gnss, earth, run)?;
+    let mut sensor = ImuErrorState::new(&scn.imu.model, scn.imu.seed, run)
+        .map_err(|e| FuseError::Imu(e.to_string()))?;
+    let (true_bg, true_ba) = sensor.constant_bias();
+    let (noise, s_ba, s_bg, known_ba, known_bg) = noise_from_model(&scn.imu.model);
+
+    // initial errors
+    let r0 = earth.radii(init_true.lat_rad);
+    let t0 = Vec3::new(
+        r0.r_m_m + init_true.h_m,
+        (r0.r_n_m + init_true.h_m) * init_true.lat_rad.cos(),
+        -1.0,
+    );
+    let mut w = [0.0; 9];
+    if opts.draw_initial_errors {
+        let mut rng = ChaCha20Rng::seed_from_u64(gnss.seed);
+        rng.set_stream((1u64 << 63) | run.wrapping_mul(16).wrapping_add(10));
+        for wi in &mut w {
+            *wi = StandardNormal.sample(&mut rng);
+        }
+    }
+    let dp = Vec3::from_fn(|i, _| s.pos_ned_m[i] * w[i]);
+    let dv = Vec3::from_fn(|i, _| s.vel_ned_mps[i] * w[3 + i]);
+    let eps = Vec3::from_fn(|i, _| s.att_rad[i] * w[6 + i]);
+    let init = InitialState {
+        lat_rad: init_true.lat_rad + dp.x / t0.x,
+        lon_rad: init_true.lon_rad + dp.y / t0.y,
+        h_m: init_true.h_m - dp.z,
+        v_n_mps: init_true.v_n_mps + dv,
+        c_b_n: Quat::from_rotvec(&eps).to_dcm() * init_true.c_b_n,
+    };
+    let mut p0 = StateMat::zeros();
+    for i in 0..3 {
+        p0[(I_POS + i, I_POS + i)] = (s.pos_ned_m[i] / t0[i]).powi(2);
+        p0[(I_VEL + i, I_VEL + i)] = s.vel_ned_mps[i].powi(2);
+        p0[(I_ATT + i, I_ATT + i)] = s.att_rad[i].powi(2);
+        p0[(I_BA + i, I_BA + i)] = s_ba[i].powi(2);
+        p0[(I_BG + i, I_BG + i)] = s_bg[i].powi(2);
+    }
+    let mech = AnyMechanization::new(&opts.algo, earth, dt, &init);
+    let ekf_cfg = EkfConfig {
+        earth,
+        dt_s: dt,
+        cov_updates,
+        noise,
+        lever_arm_b_m: if opts.model_lever_arm {
+            Vec3::from(gnss.lever_arm_b_m)
+        } else {
+            Vec3::zeros()
+        },
+        gate_chi2: opts.gate_chi2,
+        max_consecutive_rejections: opts.max_consecutive_rejections,
+    };
+    let mut ekf = Ekf::new(mech, ekf_cfg, p0, known_ba, known_bg);
+
+    let mut total = len_samples / n as u64;
+    if let Some(t) = opts.until_s {
+        total = total.min((t * nav_rate).round() as u64);
+    }
+    let latency_fix = if gnss.latency_modelled {
+        gnss.latency_s
+    } else {
+        0.0
+    };
+    let mut prev_truth = TruthSample::new(
+        0.0,
+        Increment::default(),
+        init_true.lat_rad,
+        init_true.lon_rad,
+        init_true.h_m,
+        init_true.v_n_mps,
+        init_true.c_b_n,
+    );
+    let mut incs = [Increment::default(); 4];
+    let mut pending: Vec<GnssFix> = Vec::with_capacity(8);
+    let mut fixes = 0u64;
+    let mut last_cur = prev_truth;
+    for k in 0..total {
+        if k % 1024 == 0 {
+            cancel.check()?;
+        }
+        let mut got = 0;
+        for inc in incs.iter_mut().take(n) {
+            let Some(ts) = truth.next() else { break };
+            *inc = sensor.apply(&ts.inc, dt);
+            gsim.step(&scn.trajectory, &prev_truth, &ts, &mut pending);
+            prev_truth = ts;
+            got += 1;
+        }
+        if got < n {
+            break;
+        }
+        let cur = prev_truth;
+        last_cur = cur;
+        ekf.propagate(&incs[..n])?;
+        let t_nav = ekf.state().t_s;
+        // fixes available by now (tag ≤ t_nav), in time order
+        let mut i = 0;
+        while i < pending.len() {
+            if pending[i].t_s <= t_nav + 1e-9 {
+                let f = pending.remove(i);
+                fixes += 1;
+                let m = GnssMeasurement {
+                    t_s: f.t_s - latency_fix,
+                    lat_rad: f.lat_rad,
+                    lon_rad: f.lon_rad,
+                    h_m: f.h_m,
+                    pos_cov_ned_m2: f.pos_cov_ned_m2,
+                    vel: f.vel,
+                };
+                let rep = ekf.update_gnss(&m)?;
+                observe(FuseEvent::Update(&rep));
+            } else {
+                i += 1;
+            }
+        }
+        let epoch_now = (k + 1) % cov_updates as u64 == 0;
+        if epoch_now {
+            let at_rest = opts.zupt.is_some_and(|(_, thr)| cur.v_n_mps.norm() < thr);
+            if let (true, Some((sig, _))) = (at_rest, opts.zupt) {
+                let rep = ekf.update_zupt(sig)?;
+                observe(FuseEvent::Update(&rep));
+            } else if let Some(sig) = opts.nhc_sigma_mps {
+                let rep = ekf.update_nhc(sig)?;
+                observe(FuseEvent::Update(&rep));
+            }
+        }
+        if ekf.take_epoch().is_some() {
+            let e = epoch_of(&ekf, &cur, &earth, true_ba, true_bg);
+            observe(FuseEvent::Epoch(&e));
+        }
+    }
+    let _ = last_cur;
+    let (ba, bg) = ekf.biases();
+    Ok(FuseSummary {
+        fixes,
+        rejected: ekf.rejected_total(),
+        true_bias: (true_ba, true_bg),
+        est_bias: (ba, bg),
+        p_final: *ekf.covariance(),
+        nav_updates: total,
+    })
+}
+
+fn epoch_of<M: Mechanization>(
+    ekf: &Ekf<M>,
+    truth: &TruthSample,
+    earth: &sdins_core::earth::EarthModel,
+    true_ba: Vec3,
+    true_bg: Vec3,
+) -> FuseEpoch {
+    let st = ekf.state();
+    let ne = nav_error(earth, &st, truth);
+    let mut err = StateVec::zeros();
+    err[I_POS] = st.lat_rad - truth.lat_rad;
+    err[I_POS + 1] = lon_diff(st.lon_rad, truth.lon_rad);
+    err[I_POS + 2] = st.h_m - truth.h_m;
+    let (ba, bg) = ekf.biases();
+    for i in 0..3 {
+        err[I_VEL + i] = ne.vel_err_ned_mps[i];
+        err[I_ATT + i] = ne.att_err_rad[i];
+        err[I_BA + i] = true_ba[i] - ba[i];
+        err[I_BG + i] = true_bg[i] - bg[i];
+    }
+    let r = earth.radii(truth.lat_rad);
+    FuseEpoch {
+        t_s: st.t_s,
+        err,
+        p: *ekf.covariance(),
+        pos_scale: Vec3::new(
+            r.r_m_m + truth.h_m,
+            (r.r_n_m + truth.h_m) * truth.lat_rad.cos(),
+            -1.0,
+        ),
+        nav: ne,
+        c_b_n_true: truth.c_b_n,
+    }
+}

@@ -1,0 +1,579 @@
+//! INS/GNSS filter on simulated scenarios: quick default tests and the acceptance Monte
+//! Carlo (`#[ignore]`, release: `cargo test --release -p sdins-sim --test fuse -- --ignored`).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use sdins_core::aiding::ekf::MeasKind;
+use sdins_core::aiding::error_model::{I_ATT, I_BA, I_POS, I_VEL};
+use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
+use sdins_sim::cancel::CancelToken;
+use sdins_sim::fuse::{fuse_scenario, FuseEvent, FuseOptions};
+use sdins_sim::gnss::GnssConfig;
+use sdins_sim::scenario::Scenario;
+
+/// A maneuvering car-like scenario: accelerate, turns both ways, decelerate, cruise.
+fn maneuver_toml(grade: &str, rate_hz: f64, minutes: u32) -> String {
+    let mut segs = String::new();
+    let block = [
+        ("accelerate", "accel_mps2 = 1.0", 10.0),
+        ("turn", "rate_dps = 9.0", 10.0),
+        ("cruise", "", 10.0),
+        ("accelerate", "accel_mps2 = -0.5", 10.0),
+        ("turn", "rate_dps = -9.0", 10.0),
+        ("sturn", "amplitude_dps = 5.0", 10.0),
+    ];
+    let blocks = (minutes * 60) / 60;
+    for _ in 0..blocks {
+        for (kind, extra, dur) in block {
+            segs.push_str(&format!(
+                "[[segment]]\ntype = \"{kind}\"\nduration_s = {dur}\n{extra}\n"
+            ));
+        }
+    }
+    format!(
+        "name = \"fuse-maneuver\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nh_m = 100.0\nspeed_mps = 10.0\nyaw_deg = 30.0\n[imu]\nrate_hz = {rate_hz}\nseed = 7\ngrade = \"{grade}\"\n[nav]\nsamples = 2\n{segs}"
+    )
+}
+
+fn scenario(grade: &str, rate_hz: f64, minutes: u32) -> Scenario {
+    Scenario::from_toml(&maneuver_toml(grade, rate_hz, minutes), "maneuver.toml").unwrap()
+}
+
+#[test]
+fn short_run_every_algorithm_stays_consistent() {
+    let scn = scenario("tactical", 100.0, 2);
+    let gnss = GnssConfig::default();
+    for kind in AlgorithmKind::ALL {
+        for n in [1, 4] {
+            let opts = FuseOptions {
+                algo: AlgorithmSpec::new(kind, n),
+                ..Default::default()
+            };
+            let mut worst = 0.0_f64;
+            let mut nis = Vec::new();
+            let mut last = None;
+            let s = fuse_scenario(&scn, &gnss, &opts, 0, &CancelToken::new(), |ev| match ev {
+                FuseEvent::Epoch(e) => {
+                    if e.t_s > 30.0 {
+                        worst = worst.max(e.nees_block(I_POS)).max(e.nees_block(I_VEL));
+                    }
+                    last = Some(*e);
+                }
+                FuseEvent::Update(r) => {
+                    if r.kind == MeasKind::Gnss {
+                        nis.push(r.nis);
+                    }
+                }
+            })
+            .unwrap();
+            let e = last.unwrap();
+            println!(
+                "{} N={n}: fixes {} rejected {} worst NEES {worst:.2} final pos err {:?} σ {:.2}",
+                kind.name(),
+                s.fixes,
+                s.rejected,
+                e.nav.pos_err_ned_m,
+                e.sigma(I_POS)
+            );
+            // single run: each 3-dof NEES below the 99.99 % point 21.1 (a gross check)
+            assert!(worst < 21.1, "{} N={n}: NEES {worst}", kind.name());
+            assert_eq!(s.rejected, 0);
+            assert!(s.fixes >= 119);
+            let mean_nis = nis.iter().sum::<f64>() / nis.len() as f64;
+            // 6-dof NIS, 120 fixes: mean σ = √(12/120) ≈ 0.32, 5σ band
+            assert!(
+                (mean_nis - 6.0).abs() < 1.6,
+                "{} NIS {mean_nis}",
+                kind.name()
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Monte Carlo acceptance tests (release, --ignored)
+// ---------------------------------------------------------------------------------------
+
+use rayon::prelude::*;
+use sdins_sim::fuse::{fuse_scenario_with, scenario_truth, FuseEpoch, FuseSummary};
+
+/// Wilson–Hilferty quantile of the mean of `runs` χ²(dof) variables (χ²(runs·dof)/runs).
+fn chi2_mean_quantile(dof: f64, runs: f64, z: f64) -> f64 {
+    let k = dof * runs;
+    let a = 2.0 / (9.0 * k);
+    k * (1.0 - a + z * a.sqrt()).powi(3) / runs
+}
+const Z95: f64 = 1.959_963_984_540_054;
+const Z99: f64 = 2.575_829_303_548_901;
+
+struct Run {
+    epochs: Vec<FuseEpoch>,
+    gnss: Vec<(f64, f64, bool)>,
+    #[allow(dead_code)]
+    summary: FuseSummary,
+}
+
+fn run_mc(scn: &Scenario, gnss: &GnssConfig, opts: &FuseOptions, runs: u64) -> Vec<Run> {
+    let truth = scenario_truth(scn);
+    (0..runs)
+        .into_par_iter()
+        .map(|r| {
+            let mut epochs = Vec::new();
+            let mut g = Vec::new();
+            let summary = fuse_scenario_with(
+                scn,
+                Some(&truth),
+                gnss,
+                opts,
+                r,
+                &CancelToken::new(),
+                |ev| match ev {
+                    FuseEvent::Epoch(e) => epochs.push(*e),
+                    FuseEvent::Update(u) => {
+                        if u.kind == MeasKind::Gnss {
+                            g.push((u.t_s, u.nis, u.accepted));
+                        }
+                    }
+                },
+            )
+            .unwrap();
+            Run {
+                epochs,
+                gnss: g,
+                summary,
+            }
+        })
+        .collect()
+}
+
+/// Per-epoch run-means of a statistic, for epochs after `t0` (all runs share epochs).
+fn run_means(runs: &[Run], t0: f64, f: impl Fn(&FuseEpoch) -> f64) -> Vec<(f64, f64)> {
+    let n = runs[0].epochs.len();
+    (0..n)
+        .filter(|&k| runs[0].epochs[k].t_s > t0)
+        .map(|k| {
+            let t = runs[0].epochs[k].t_s;
+            let m = runs.iter().map(|r| f(&r.epochs[k])).sum::<f64>() / runs.len() as f64;
+            (t, m)
+        })
+        .collect()
+}
+
+/// The consistency criteria (a), (b), (c) on per-epoch run-means of χ²(dof).
+fn check_band(name: &str, means: &[f64], dof: f64, runs: f64) -> f64 {
+    let (l95, u95) = (
+        chi2_mean_quantile(dof, runs, -Z95),
+        chi2_mean_quantile(dof, runs, Z95),
+    );
+    let (l99, u99) = (
+        chi2_mean_quantile(dof, runs, -Z99),
+        chi2_mean_quantile(dof, runs, Z99),
+    );
+    let grand = means.iter().sum::<f64>() / means.len() as f64;
+    let in95 =
+        means.iter().filter(|m| (l95..=u95).contains(*m)).count() as f64 / means.len() as f64;
+    let in99 =
+        means.iter().filter(|m| (l99..=u99).contains(*m)).count() as f64 / means.len() as f64;
+    let max = means.iter().copied().fold(0.0, f64::max);
+    println!(
+        "{name}: grand mean {grand:.3} (95 % band [{l95:.2}, {u95:.2}]), epochs in 95 % band {:.1} %, in 99 % band {:.1} %, max {max:.2} (limit {:.2})",
+        100.0 * in95,
+        100.0 * in99,
+        2.0 * u99
+    );
+    assert!((l95..=u95).contains(&grand), "{name}: grand mean {grand}");
+    assert!(
+        in99 >= 0.70,
+        "{name}: only {in99} of epochs in the 99 % band"
+    );
+    assert!(max <= 2.0 * u99, "{name}: an epoch reaches {max}");
+    in95
+}
+
+fn no_gate() -> FuseOptions {
+    FuseOptions {
+        gate_chi2: None,
+        ..Default::default()
+    }
+}
+
+fn consistency(grade: &str) {
+    let scn = scenario(grade, 100.0, 10);
+    let gnss = GnssConfig::default();
+    let runs = run_mc(&scn, &gnss, &no_gate(), 100);
+    for (name, i0) in [
+        ("position", I_POS),
+        ("velocity", I_VEL),
+        ("attitude", I_ATT),
+    ] {
+        let m: Vec<f64> = run_means(&runs, 30.0, |e| e.nees_block(i0))
+            .iter()
+            .map(|x| x.1)
+            .collect();
+        check_band(&format!("{grade} NEES {name}"), &m, 3.0, 100.0);
+    }
+    // GNSS NIS (6 dof) per fix epoch
+    let nfix = runs[0].gnss.len();
+    let nis: Vec<f64> = (0..nfix)
+        .filter(|&k| runs[0].gnss[k].0 > 30.0)
+        .map(|k| runs.iter().map(|r| r.gnss[k].1).sum::<f64>() / runs.len() as f64)
+        .collect();
+    check_band(&format!("{grade} NIS"), &nis, 6.0, 100.0);
+    // biases: converge within 3σ; print σ reduction per axis
+    let mut outside = 0;
+    let mut ratio = [0.0; 6];
+    for r in &runs {
+        let e = r.epochs.last().unwrap();
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..6 {
+            let idx = I_BA + i;
+            if e.err[idx].abs() > 3.0 * e.sigma(idx) {
+                outside += 1;
+            }
+            ratio[i] += e.sigma(idx) / runs[0].epochs[0].sigma(idx).max(1e-300) / runs.len() as f64;
+        }
+    }
+    println!("{grade}: bias errors outside 3σ: {outside} of 600; final/initial σ (ba x y z, bg x y z): {ratio:.3?}");
+    // P(|z| > 3) = 0.0027: 1.6 expected of 600; > 7 has probability < 1e-3
+    assert!(outside <= 7, "{grade}: {outside} bias errors outside 3σ");
+    if grade == "tactical" {
+        // observable under these maneuvers with 1 Hz position + velocity: the vertical
+        // accelerometer (height channel), the horizontal accelerometers (separated from tilt by
+        // the heading changes) and the level gyros (tilt, through f × ε); the z gyro (heading,
+        // through the accelerations) more slowly
+        for (i, lim) in [(0, 0.5), (1, 0.5), (2, 0.2), (3, 0.5), (4, 0.5), (5, 0.8)] {
+            assert!(
+                ratio[i] < lim,
+                "{grade}: bias state {i}: σ ratio {}",
+                ratio[i]
+            );
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn mc_consistency_tactical() {
+    consistency("tactical");
+}
+
+#[test]
+#[ignore]
+fn mc_consistency_aviation() {
+    consistency("aviation");
+}
+
+#[test]
+#[ignore]
+fn mc_outage_60s_tactical() {
+    let scn = scenario("tactical", 100.0, 7);
+    let gnss = GnssConfig {
+        sigma_pos_ned_m: [1.0; 3],
+        outages_s: vec![[300.0, 360.0]],
+        ..Default::default()
+    };
+    let runs = run_mc(&scn, &gnss, &no_gate(), 100);
+    let k_end = runs[0]
+        .epochs
+        .iter()
+        .rposition(|e| e.t_s < 360.0 - 1e-9)
+        .unwrap();
+    let nees_h = runs
+        .iter()
+        .map(|r| r.epochs[k_end].nees_horizontal())
+        .sum::<f64>()
+        / 100.0;
+    let (lo, hi) = (
+        chi2_mean_quantile(2.0, 100.0, -Z95),
+        chi2_mean_quantile(2.0, 100.0, Z95),
+    );
+    let rms_h = (runs
+        .iter()
+        .map(|r| {
+            let p = r.epochs[k_end].nav.pos_err_ned_m;
+            p[0] * p[0] + p[1] * p[1]
+        })
+        .sum::<f64>()
+        / 100.0)
+        .sqrt();
+    println!(
+        "outage end t = {:.2} s: horizontal NEES {nees_h:.3} (band [{lo:.2}, {hi:.2}]), RMS horizontal error {rms_h:.2} m",
+        runs[0].epochs[k_end].t_s
+    );
+    assert!((lo..=hi).contains(&nees_h), "horizontal NEES {nees_h}");
+}
+
+/// Time-averaged position error along C_b^n l̂ per run (after 30 s).
+fn along_lever(r: &Run, l: [f64; 3]) -> f64 {
+    let lv = nalgebra::Vector3::from(l).normalize();
+    let (mut s, mut n) = (0.0, 0.0);
+    for e in r.epochs.iter().filter(|e| e.t_s > 30.0) {
+        // the epoch's attitude is the truth's to first order
+        let c = e.c_b_n_true;
+        let d = c * lv;
+        let p = nalgebra::Vector3::from(e.nav.pos_err_ned_m);
+        s += p.dot(&d);
+        n += 1.0;
+    }
+    s / n
+}
+
+fn mean_se(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    let v = x.iter().map(|a| (a - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, (v / n).sqrt())
+}
+
+#[test]
+#[ignore]
+fn mc_lever_arm_and_offset_fixes() {
+    let scn = scenario("tactical", 100.0, 5);
+    let l = [1.5, 0.0, -0.5];
+    let gnss = GnssConfig {
+        offset_s: 0.3712,
+        lever_arm_b_m: l,
+        ..Default::default()
+    };
+    let modelled = run_mc(&scn, &gnss, &no_gate(), 100);
+    for (name, i0) in [
+        ("position", I_POS),
+        ("velocity", I_VEL),
+        ("attitude", I_ATT),
+    ] {
+        let m: Vec<f64> = run_means(&modelled, 30.0, |e| e.nees_block(i0))
+            .iter()
+            .map(|x| x.1)
+            .collect();
+        check_band(&format!("lever arm modelled NEES {name}"), &m, 3.0, 100.0);
+    }
+    let a: Vec<f64> = modelled.iter().map(|r| along_lever(r, l)).collect();
+    let (m, se) = mean_se(&a);
+    println!(
+        "lever arm modelled: mean error along C l̂ {m:.4} m, SE {se:.4} m ({:.2} SE)",
+        m / se
+    );
+    assert!(m.abs() <= 3.0 * se);
+    let ignored = run_mc(
+        &scn,
+        &gnss,
+        &FuseOptions {
+            model_lever_arm: false,
+            ..no_gate()
+        },
+        100,
+    );
+    let a: Vec<f64> = ignored.iter().map(|r| along_lever(r, l)).collect();
+    let (m, se) = mean_se(&a);
+    println!(
+        "lever arm ignored: mean error along C l̂ {m:.4} m, SE {se:.4} m ({:.1} SE)",
+        m / se
+    );
+    assert!(m.abs() > 10.0 * se);
+}
+
+/// Cruise at 16 m/s; along-track mean error with a 50 ms latency.
+#[test]
+#[ignore]
+fn mc_latency_50ms_at_16mps() {
+    let toml = "name = \"cruise16\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nspeed_mps = 16.0\nyaw_deg = 45.0\n[imu]\nrate_hz = 100.0\nseed = 3\ngrade = \"tactical\"\n[nav]\nsamples = 2\n[[segment]]\ntype = \"cruise\"\nduration_s = 300.0\n";
+    let scn = Scenario::from_toml(toml, "cruise16.toml").unwrap();
+    let yaw = 45f64.to_radians();
+    let track = [yaw.cos(), yaw.sin()];
+    for modelled in [false, true] {
+        let gnss = GnssConfig {
+            latency_s: 0.05,
+            latency_modelled: modelled,
+            ..Default::default()
+        };
+        let runs = run_mc(&scn, &gnss, &no_gate(), 40);
+        let a: Vec<f64> = runs
+            .iter()
+            .map(|r| {
+                let v: Vec<f64> = r
+                    .epochs
+                    .iter()
+                    .filter(|e| e.t_s > 60.0)
+                    .map(|e| e.nav.pos_err_ned_m[0] * track[0] + e.nav.pos_err_ned_m[1] * track[1])
+                    .collect();
+                v.iter().sum::<f64>() / v.len() as f64
+            })
+            .collect();
+        let (m, se) = mean_se(&a);
+        let expect = if modelled { 0.0 } else { -16.0 * 0.05 };
+        println!("latency 50 ms modelled={modelled}: along-track mean {m:.4} m (expected {expect}), SE {se:.4}");
+        assert!((m - expect).abs() <= 3.0 * se + 0.01, "{m} vs {expect}");
+    }
+}
+
+#[test]
+fn timing_residual_below_one_percent_of_sigma_at_5mps2() {
+    for rate in [100.0, 200.0, 500.0] {
+        let toml = format!("name = \"acc5\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nspeed_mps = 1.0\n[imu]\nrate_hz = {rate}\n[nav]\nsamples = 2\n[[segment]]\ntype = \"accelerate\"\naccel_mps2 = 5.0\nduration_s = 10.0\n[[segment]]\ntype = \"turn\"\nrate_dps = 10.0\nduration_s = 5.0\n");
+        let scn = Scenario::from_toml(&toml, "acc5.toml").unwrap();
+        let gnss = GnssConfig {
+            offset_s: 0.3712,
+            lever_arm_b_m: [1.5, 0.0, -0.5],
+            // near noise-free fixes (noise 1 % of the test limits)
+            sigma_pos_ned_m: [1e-4; 3],
+            sigma_vel_ned_mps: [5e-6; 3],
+            rate_hz: 10.0,
+            ..Default::default()
+        };
+        let opts = FuseOptions {
+            draw_initial_errors: false,
+            gate_chi2: None,
+            ..Default::default()
+        };
+        let (mut wp, mut wv) = (0.0_f64, 0.0_f64);
+        fuse_scenario(&scn, &gnss, &opts, 0, &CancelToken::new(), |ev| {
+            if let FuseEvent::Update(u) = ev {
+                for i in 0..3 {
+                    wp = wp.max(u.innovation[i].abs());
+                    wv = wv.max(u.innovation[3 + i].abs());
+                }
+            }
+        })
+        .unwrap();
+        println!("{rate} Hz: max |ν_pos| {wp:.2e} m, max |ν_vel| {wv:.2e} m/s");
+        // 1 % of the default σ (1 m, 0.05 m/s)
+        assert!(wp < 0.01 && wv < 5e-4, "{rate} Hz: {wp} m, {wv} m/s");
+    }
+}
+
+#[test]
+fn gating_rejects_a_100m_outlier_and_the_solution_is_unaffected() {
+    let scn = scenario("tactical", 100.0, 2);
+    let clean = GnssConfig::default();
+    let bad = GnssConfig {
+        outliers_t_s_ned_m: vec![[60.0, 100.0, 0.0, 0.0]],
+        ..Default::default()
+    };
+    let opts = FuseOptions::default();
+    // the reference: the same run with that one fix removed
+    let clean = GnssConfig {
+        outages_s: vec![[59.99, 60.01]],
+        ..clean
+    };
+    let mut epochs = [Vec::new(), Vec::new()];
+    let mut rejected_at = Vec::new();
+    for (i, g) in [&clean, &bad].into_iter().enumerate() {
+        let s = fuse_scenario(&scn, g, &opts, 0, &CancelToken::new(), |ev| match ev {
+            FuseEvent::Epoch(e) => epochs[i].push(*e),
+            FuseEvent::Update(u) => {
+                if !u.accepted {
+                    rejected_at.push((i, u.t_s, u.nis));
+                }
+            }
+        })
+        .unwrap();
+        assert_eq!(s.rejected, i as u64);
+    }
+    println!("rejected: {rejected_at:?}");
+    assert_eq!(rejected_at.len(), 1);
+    assert!((rejected_at[0].1 - 60.0).abs() < 0.02);
+    // the solution equals the one without that fix (up to the extra covariance epoch at
+    // the rejected fix's time): < 1e-3 σ at every epoch
+    let mut worst = 0.0_f64;
+    for (a, b) in epochs[0].iter().zip(&epochs[1]) {
+        for i in 0..3 {
+            let d = (a.nav.pos_err_ned_m[i] - b.nav.pos_err_ned_m[i]).abs() / a.sigma(I_POS + i);
+            worst = worst.max(d);
+        }
+    }
+    println!("largest position difference / σ: {worst:.3}");
+    assert!(worst < 1e-3);
+}
+
+fn stop_and_go_toml() -> String {
+    let mut segs = String::new();
+    for _ in 0..5 {
+        segs.push_str("[[segment]]\ntype = \"accelerate\"\naccel_mps2 = 2.0\nduration_s = 5.0\n[[segment]]\ntype = \"cruise\"\nduration_s = 15.0\n[[segment]]\ntype = \"turn\"\nrate_dps = 9.0\nduration_s = 10.0\n[[segment]]\ntype = \"accelerate\"\naccel_mps2 = -2.0\nduration_s = 5.0\n[[segment]]\ntype = \"static\"\nduration_s = 15.0\n");
+    }
+    format!("name = \"stop-and-go\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\n[imu]\nrate_hz = 100.0\nseed = 11\ngrade = \"tactical\"\n[nav]\nsamples = 2\n{segs}")
+}
+
+#[test]
+#[ignore]
+fn mc_zupt_nhc_reduce_outage_error() {
+    let scn = Scenario::from_toml(&stop_and_go_toml(), "stop-and-go.toml").unwrap();
+    // outage 150–210 s: covers motion and a stop (stops at 185–200 s)
+    let gnss = GnssConfig {
+        outages_s: vec![[150.0, 210.0]],
+        ..Default::default()
+    };
+    let runs_n = 50;
+    let plain = run_mc(&scn, &gnss, &no_gate(), runs_n);
+    let aided = run_mc(
+        &scn,
+        &gnss,
+        &FuseOptions {
+            zupt: Some((0.01, 1e-3)),
+            nhc_sigma_mps: Some(0.05),
+            ..no_gate()
+        },
+        runs_n,
+    );
+    let k_end = plain[0]
+        .epochs
+        .iter()
+        .rposition(|e| e.t_s < 210.0 - 1e-9)
+        .unwrap();
+    let stats = |runs: &[Run]| {
+        let k = runs[0]
+            .epochs
+            .iter()
+            .rposition(|e| e.t_s < 210.0 - 1e-9)
+            .unwrap();
+        let rms = (runs
+            .iter()
+            .map(|r| {
+                let p = r.epochs[k].nav.pos_err_ned_m;
+                p[0] * p[0] + p[1] * p[1]
+            })
+            .sum::<f64>()
+            / runs.len() as f64)
+            .sqrt();
+        let nees = runs
+            .iter()
+            .map(|r| r.epochs[k].nees_horizontal())
+            .sum::<f64>()
+            / runs.len() as f64;
+        (rms, nees)
+    };
+    let (rms_p, nees_p) = stats(&plain);
+    let (rms_a, nees_a) = stats(&aided);
+    let n = runs_n as f64;
+    let (lo, hi) = (
+        chi2_mean_quantile(2.0, n, -Z95),
+        chi2_mean_quantile(2.0, n, Z95),
+    );
+    println!(
+        "outage end {:.1} s: plain RMS {rms_p:.2} m NEES {nees_p:.2}; ZUPT+NHC RMS {rms_a:.2} m NEES {nees_a:.2} (band [{lo:.2}, {hi:.2}])",
+        plain[0].epochs[k_end].t_s
+    );
+    assert!(rms_a < 0.5 * rms_p);
+    assert!((lo..=hi).contains(&nees_a), "aided NEES {nees_a}");
+    assert!((lo..=hi).contains(&nees_p), "plain NEES {nees_p}");
+}
+
+#[test]
+fn gnss_scenario_section_parses_and_bad_values_name_the_key() {
+    let base = maneuver_toml("tactical", 100.0, 1);
+    let ok = format!("{base}[gnss]\nrate_hz = 5.0\nlever_arm_b_m = [1.5, 0.0, -0.5]\noutages_s = [[100.0, 160.0]]\n");
+    let s = Scenario::from_toml(&ok, "g.toml").unwrap();
+    let g = s.gnss.unwrap();
+    assert_eq!(g.rate_hz, 5.0);
+    assert_eq!(g.outages_s, vec![[100.0, 160.0]]);
+    for (text, key) in [
+        ("rate_hz = 0.5", "gnss.rate_hz"),
+        ("sigma_pos_ned_m = [1.0, -1.0, 1.0]", "gnss.sigma_pos_ned_m"),
+        ("sigma_pos_ned_m = [1.0, nan, 1.0]", "gnss.sigma_pos_ned_m"),
+        ("dropout_prob = 2.0", "gnss.dropout_prob"),
+        ("outages_s = [[5.0, 1.0]]", "gnss.outages_s"),
+    ] {
+        let e = Scenario::from_toml(&format!("{base}[gnss]\n{text}\n"), "g.toml").unwrap_err();
+        assert!(e.to_string().contains(key), "{text}: {e}");
+    }
+    let e = Scenario::from_toml(&format!("{base}[gnss]\nrate_hzz = 1.0\n"), "g.toml").unwrap_err();
+    assert!(e.to_string().contains("rate_hzz"), "{e}");
+}
