@@ -12,9 +12,9 @@ use crate::math::Vec3;
 /// over the sample interval (mechanization.md §1.3).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Increment {
-    /// Δθ = ∫ ω_ib^b dt [rad]
+    /// Δθ = ∫ ω_ib^b dt \[rad\]
     pub dtheta_b_rad: Vec3,
-    /// Δv = ∫ f^b dt [m/s]
+    /// Δv = ∫ f^b dt \[m/s\]
     pub dv_b_mps: Vec3,
 }
 
@@ -172,13 +172,13 @@ impl ConingSet {
 /// Result of combining the N samples of one update.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Compensated {
-    /// Δθ = Σ Δθ_j [rad]
+    /// Δθ = Σ Δθ_j \[rad\]
     pub dtheta_b_rad: Vec3,
-    /// Δv = Σ Δv_j [m/s]
+    /// Δv = Σ Δv_j \[m/s\]
     pub dv_b_mps: Vec3,
-    /// rotation vector Δφ of the body over the interval (coning-compensated) [rad]
+    /// rotation vector Δφ of the body over the interval (coning-compensated) \[rad\]
     pub dphi_b_rad: Vec3,
-    /// sculling term ΔV_scul [m/s]
+    /// sculling term ΔV_scul \[m/s\]
     pub dv_scul_b_mps: Vec3,
 }
 

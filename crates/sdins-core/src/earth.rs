@@ -14,7 +14,7 @@ pub enum Gravity {
     /// `γ(L) = γ_e (1 + k sin²L)/√(1 − e² sin²L)`,
     /// `g = γ(L)[1 − (2/a)(1 + f + m − 2f sin²L) h + (3/a²) h²]`.
     Somigliana {
-        /// equatorial normal gravity γ_e [m/s²]
+        /// equatorial normal gravity γ_e \[m/s²\]
         gamma_e: f64,
         /// Somigliana constant k
         k: f64,
@@ -25,25 +25,25 @@ pub enum Gravity {
     /// `g = γ(L)(1 − 2h/a)` (drops the flattening, centrifugal and h² terms of the
     /// TR8350.2 series; used by simpler INS codes, e.g. pyins).
     SomiglianaLinear {
-        /// equatorial normal gravity γ_e [m/s²]
+        /// equatorial normal gravity γ_e \[m/s²\]
         gamma_e: f64,
         /// Somigliana constant k
         k: f64,
     },
     /// PSINS: `g = g0 (1 + c2 sin²L + c4 sin⁴L) − dh · h`.
     Psins {
-        /// g0 [m/s²]
+        /// g0 \[m/s²\]
         g0: f64,
         /// coefficient of sin²L
         c2: f64,
         /// coefficient of sin⁴L
         c4: f64,
-        /// height gradient [1/s²]
+        /// height gradient \[1/s²\]
         dh: f64,
     },
     /// Constant magnitude (flat-earth fixtures).
     Constant {
-        /// g [m/s²]
+        /// g \[m/s²\]
         g_mps2: f64,
     },
 }
@@ -51,13 +51,13 @@ pub enum Gravity {
 /// An earth model: ellipsoid, rotation rate and gravity.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EarthModel {
-    /// semi-major axis a [m]
+    /// semi-major axis a \[m\]
     pub a_m: f64,
     /// flattening f
     pub f: f64,
     /// first eccentricity squared e² = f(2 − f)
     pub e2: f64,
-    /// earth rotation rate Ω_e [rad/s]
+    /// earth rotation rate Ω_e \[rad/s\]
     pub omega_ie_rps: f64,
     /// gravity model
     pub gravity: Gravity,
@@ -69,9 +69,9 @@ pub struct EarthModel {
 /// Radii of curvature at a latitude.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Radii {
-    /// meridian radius R_M [m]
+    /// meridian radius R_M \[m\]
     pub r_m_m: f64,
-    /// prime-vertical radius R_N [m]
+    /// prime-vertical radius R_N \[m\]
     pub r_n_m: f64,
 }
 
@@ -83,11 +83,11 @@ pub struct LocalEarth {
     pub sin_lat: f64,
     /// cos L
     pub cos_lat: f64,
-    /// meridian radius R_M [m]
+    /// meridian radius R_M \[m\]
     pub r_m_m: f64,
-    /// prime-vertical radius R_N [m]
+    /// prime-vertical radius R_N \[m\]
     pub r_n_m: f64,
-    /// normal gravity g(L, h) [m/s²]
+    /// normal gravity g(L, h) \[m/s²\]
     pub g_mps2: f64,
 }
 
@@ -250,7 +250,7 @@ impl EarthModel {
         }
     }
 
-    /// Magnitude of normal gravity g(L, h) [m/s²] (positive down).
+    /// Magnitude of normal gravity g(L, h) \[m/s²\] (positive down).
     #[inline]
     pub fn gravity(&self, lat_rad: f64, h_m: f64) -> f64 {
         let s = libm::sin(lat_rad);

@@ -96,7 +96,7 @@ fn t3_multi_heading_som_ranks() {
 }
 
 /// T8: Algorithm B, noise-free linear: rank 6/9 for one heading, 9/9 for two and four;
-/// recovery of θ = [φ(t0), b_a, b_g] to 1e-9 relative.
+/// recovery of θ = \[φ(t0), b_a, b_g\] to 1e-9 relative.
 #[test]
 fn t8_algorithm_b_linear() {
     let s = site();

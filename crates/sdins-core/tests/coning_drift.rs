@@ -15,7 +15,7 @@ fn q_cone(alpha: f64, omega: f64, t: f64) -> Quat {
     Quat::new(c, s * (omega * t).cos(), s * (omega * t).sin(), 0.0)
 }
 
-/// Δθ over [t1, t2] in the cancellation-free product form of the spec's closed form.
+/// Δθ over \[t1, t2\] in the cancellation-free product form of the spec's closed form.
 fn dtheta(alpha: f64, omega: f64, t1: f64, h: f64) -> Vec3 {
     let (m, d) = (omega * (t1 + 0.5 * h), 0.5 * omega * h);
     Vec3::new(

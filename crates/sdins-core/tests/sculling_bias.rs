@@ -76,7 +76,7 @@ fn bias_z(set: ConingSet, lambda: f64) -> f64 {
     sum / updates as f64
 }
 
-/// Spec §4.3 "meas" columns (λ = 0.4, λ = 0.8) [m/s²].
+/// Spec §4.3 "meas" columns (λ = 0.4, λ = 0.8) \[m/s²\].
 const MEAS: [(ConingSet, f64, f64, i32); 4] = [
     (ConingSet::Two, -4.632e-9, -7.306e-8, 4),
     (ConingSet::ThreePoly, 6.820e-10, 1.055e-8, 4),

@@ -31,7 +31,7 @@ fn nav_only(rec: &Recorded, spec: &AlgorithmSpec) -> f64 {
     m.state().h_m
 }
 
-/// CPU time of this thread [s] from /proc (10 ms resolution; None off Linux): on a
+/// CPU time of this thread \[s\] from /proc (10 ms resolution; None off Linux): on a
 /// loaded machine the wall clock counts the time other processes had the core.
 fn thread_cpu_s() -> Option<f64> {
     let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;

@@ -26,7 +26,7 @@ use sdins_core::math::{dcm_from_rotvec, Euler, Mat3, Vec3};
 /// of every sample.
 #[derive(Clone, Debug)]
 pub struct TruthRecord {
-    /// sample period [s]
+    /// sample period \[s\]
     pub dt_s: f64,
     /// exact increments
     pub increments: Vec<Increment>,
@@ -156,11 +156,11 @@ pub fn i0_window(
     a.c_b_n()
 }
 
-/// Block length of [`disturbance_sigma_z`] [s]: long against ship and car disturbance
+/// Block length of [`disturbance_sigma_z`] \[s\]: long against ship and car disturbance
 /// periods (≤ 25 s), short against the fine filter's averaging time (hundreds of s).
 pub const DISTURBANCE_BLOCK_S: f64 = 60.0;
 
-/// White-equivalent zero-velocity σ [m/s] of a disturbed base at Kalman interval
+/// White-equivalent zero-velocity σ \[m/s\] of a disturbed base at Kalman interval
 /// `kf_dt_s` (docs/alignment_i0.md §6): the i0 velocity residual
 /// `r_k = C_{ib0}^{n0} v^{ib0}_k − v^{n0}_k` over the first `n` samples is averaged over
 /// blocks of τ_b = [`DISTURBANCE_BLOCK_S`] and its low-frequency PSD estimated as
@@ -273,13 +273,13 @@ pub fn run_fine<F: FnMut(usize, &FineAlign)>(
 pub struct MultiHeadingResult {
     /// final attitude estimate
     pub c_b_n: Mat3,
-    /// estimated accelerometer bias, body [m/s²]
+    /// estimated accelerometer bias, body \[m/s²\]
     pub accel_bias_b: Vec3,
-    /// estimated gyro bias, body [rad/s]
+    /// estimated gyro bias, body \[rad/s\]
     pub gyro_bias_b: Vec3,
-    /// 1σ of the accelerometer bias, body [m/s²] (Algorithm B: from the LS covariance)
+    /// 1σ of the accelerometer bias, body \[m/s²\] (Algorithm B: from the LS covariance)
     pub accel_bias_sigma_b: Vec3,
-    /// 1σ of the gyro bias, body [rad/s]
+    /// 1σ of the gyro bias, body \[rad/s\]
     pub gyro_bias_sigma_b: Vec3,
 }
 

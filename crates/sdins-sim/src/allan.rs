@@ -63,7 +63,7 @@ pub const SLOPE_TOL: f64 = 0.15;
 /// An Allan-deviation curve.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AllanCurve {
-    /// cluster times τ [s]
+    /// cluster times τ \[s\]
     pub tau_s: Vec<f64>,
     /// Allan deviation at each τ, in the unit of the input rate
     pub adev: Vec<f64>,
@@ -77,19 +77,19 @@ pub struct AllanCurve {
 pub struct AllanFit {
     /// White-noise density N (ARW or VRW): the −1/2 line at τ = 1 s.
     pub white: Option<f64>,
-    /// τ range [s] of the points used for `white`.
+    /// τ range \[s\] of the points used for `white`.
     pub white_tau_s: Option<(f64, f64)>,
     /// Bias instability B = σ_flat / 0.664.
     pub bias_instability: Option<f64>,
-    /// τ [s] of the minimum of the curve.
+    /// τ \[s\] of the minimum of the curve.
     pub bias_instability_tau_s: Option<f64>,
-    /// τ range [s] of the flat region averaged for `bias_instability`.
+    /// τ range \[s\] of the flat region averaged for `bias_instability`.
     pub bias_instability_range_s: Option<(f64, f64)>,
     /// Quantization noise Q (rad or m/s): the −1 line `σ = √3·Q/τ`.
     pub quantization: Option<f64>,
     /// Rate random walk K = σ(τ)·√(3/τ).
     pub rate_random_walk: Option<f64>,
-    /// τ range [s] of the points used for `rate_random_walk`.
+    /// τ range \[s\] of the points used for `rate_random_walk`.
     pub rrw_tau_s: Option<(f64, f64)>,
 }
 

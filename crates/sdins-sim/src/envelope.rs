@@ -29,17 +29,17 @@ pub const MAX_EVALUATIONS: u64 = 4_000_000;
 /// The documented limits (docs/scenarios.md, "Kinematic envelope").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Envelope {
-    /// largest speed over the earth [m/s]
+    /// largest speed over the earth \[m/s\]
     pub max_speed_mps: f64,
-    /// largest magnitude of the NED acceleration dv/dt [m/s²]
+    /// largest magnitude of the NED acceleration dv/dt \[m/s²\]
     pub max_accel_mps2: f64,
-    /// largest body angular rate relative to the navigation frame |ω_nb^b| [rad/s]
+    /// largest body angular rate relative to the navigation frame |ω_nb^b| \[rad/s\]
     pub max_rate_rps: f64,
-    /// lowest height above the ellipsoid [m]
+    /// lowest height above the ellipsoid \[m\]
     pub min_h_m: f64,
-    /// highest height above the ellipsoid [m]
+    /// highest height above the ellipsoid \[m\]
     pub max_h_m: f64,
-    /// largest |latitude| [rad]: the local-level NED mechanization is singular at the poles
+    /// largest |latitude| \[rad\]: the local-level NED mechanization is singular at the poles
     /// (tan L, 1/cos L in the transport rate)
     pub max_abs_lat_rad: f64,
 }
@@ -66,15 +66,15 @@ impl Default for Envelope {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Quantity {
-    /// speed [m/s]
+    /// speed \[m/s\]
     Speed,
-    /// acceleration [m/s²]
+    /// acceleration \[m/s²\]
     Acceleration,
-    /// angular rate [°/s]
+    /// angular rate \[°/s\]
     AngularRate,
-    /// height [m]
+    /// height \[m\]
     Height,
-    /// latitude [°]
+    /// latitude \[°\]
     Latitude,
     /// a kinematic value is NaN or infinite
     NotFinite,
@@ -106,7 +106,7 @@ pub enum EnvelopeError {
         value: f64,
         /// the limit, as text with unit
         limit: String,
-        /// time [s]
+        /// time \[s\]
         t_s: f64,
         /// index of the segment the time falls in
         segment: Option<usize>,
@@ -116,9 +116,9 @@ pub enum EnvelopeError {
     /// The trajectory has no samples at the IMU rate.
     #[error("the trajectory lasts {duration_s} s, less than one IMU sample of {dt_s} s")]
     NoSamples {
-        /// duration [s]
+        /// duration \[s\]
         duration_s: f64,
-        /// sample interval [s]
+        /// sample interval \[s\]
         dt_s: f64,
     },
 }
@@ -160,15 +160,15 @@ fn where_text(segment: &Option<usize>, overlays: &[usize]) -> String {
 /// Extremes seen by a successful check (for reports and tests).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct EnvelopeReport {
-    /// largest speed [m/s]
+    /// largest speed \[m/s\]
     pub max_speed_mps: f64,
-    /// largest acceleration [m/s²]
+    /// largest acceleration \[m/s²\]
     pub max_accel_mps2: f64,
-    /// largest angular rate [rad/s]
+    /// largest angular rate \[rad/s\]
     pub max_rate_rps: f64,
-    /// lowest and highest height [m]
+    /// lowest and highest height \[m\]
     pub h_range_m: (f64, f64),
-    /// largest |latitude| [rad]
+    /// largest |latitude| \[rad\]
     pub max_abs_lat_rad: f64,
     /// kinematics evaluations made
     pub evaluations: u64,
@@ -177,9 +177,9 @@ pub struct EnvelopeReport {
 /// Start position of the trajectory.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StartPosition {
-    /// latitude [rad]
+    /// latitude \[rad\]
     pub lat_rad: f64,
-    /// height [m]
+    /// height \[m\]
     pub h_m: f64,
 }
 

@@ -35,14 +35,14 @@ use sdins_core::coning::Increment;
 use sdins_core::math::{Quat, Vec3};
 use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, Mechanization};
 
-/// Initial 1σ errors of position [m NED], velocity [m/s NED], attitude [rad NED].
+/// Initial 1σ errors of position \[m NED\], velocity \[m/s NED\], attitude \[rad NED\].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InitSigma {
-    /// position σ N, E, D [m]
+    /// position σ N, E, D \[m\]
     pub pos_ned_m: [f64; 3],
-    /// velocity σ N, E, D [m/s]
+    /// velocity σ N, E, D \[m/s\]
     pub vel_ned_mps: [f64; 3],
-    /// attitude σ N, E, D [rad]
+    /// attitude σ N, E, D \[rad\]
     pub att_rad: [f64; 3],
 }
 
@@ -61,7 +61,7 @@ impl Default for InitSigma {
 pub struct FuseOptions {
     /// mechanization (any of the four, N = 1..4)
     pub algo: AlgorithmSpec,
-    /// covariance propagation rate [Hz] (≤ the navigation update rate)
+    /// covariance propagation rate \[Hz\] (≤ the navigation update rate)
     pub cov_rate_hz: f64,
     /// initial errors (σ)
     pub init_sigma: InitSigma,
@@ -71,13 +71,13 @@ pub struct FuseOptions {
     pub gate_chi2: Option<[f64; 6]>,
     /// consecutive rejections before the reset policy
     pub max_consecutive_rejections: u32,
-    /// ZUPT σ [m/s] and the truth speed below which the vehicle is at rest [m/s]
+    /// ZUPT σ \[m/s\] and the truth speed below which the vehicle is at rest \[m/s\]
     pub zupt: Option<(f64, f64)>,
-    /// NHC σ [m/s]
+    /// NHC σ \[m/s\]
     pub nhc_sigma_mps: Option<f64>,
     /// tell the filter the GNSS lever arm (false: the filter assumes zero)
     pub model_lever_arm: bool,
-    /// stop after this time [s]
+    /// stop after this time \[s\]
     pub until_s: Option<f64>,
 }
 
@@ -123,7 +123,7 @@ pub enum FuseError {
 /// (δL, δλ, δh; δv; ε; accel residual bias `b − b̂`; gyro residual bias) and P.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FuseEpoch {
-    /// time [s]
+    /// time \[s\]
     pub t_s: f64,
     /// true error
     pub err: StateVec,
@@ -177,7 +177,7 @@ pub struct FuseSummary {
     pub fixes: u64,
     /// GNSS fixes rejected by the gate
     pub rejected: u64,
-    /// true constant biases (accel [m/s²], gyro [rad/s])
+    /// true constant biases (accel \[m/s²\], gyro \[rad/s\])
     pub true_bias: (Vec3, Vec3),
     /// final bias estimates
     pub est_bias: (Vec3, Vec3),

@@ -39,19 +39,19 @@ use sdins_core::nav::wrap_pi;
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GnssConfig {
-    /// fix rate [Hz], 1…20 (0: no GNSS)
+    /// fix rate \[Hz\], 1…20 (0: no GNSS)
     pub rate_hz: f64,
-    /// time of the first epoch relative to the IMU clock [s]
+    /// time of the first epoch relative to the IMU clock \[s\]
     pub offset_s: f64,
-    /// white position noise σ N, E, D [m]
+    /// white position noise σ N, E, D \[m\]
     pub sigma_pos_ned_m: [f64; 3],
-    /// white velocity noise σ N, E, D [m/s]; all 0: no velocity in the fixes
+    /// white velocity noise σ N, E, D \[m/s\]; all 0: no velocity in the fixes
     pub sigma_vel_ned_mps: [f64; 3],
-    /// Gauss–Markov position error σ N, E, D [m] (0: off)
+    /// Gauss–Markov position error σ N, E, D \[m\] (0: off)
     pub gm_sigma_ned_m: [f64; 3],
-    /// its correlation time [s]
+    /// its correlation time \[s\]
     pub gm_tau_s: f64,
-    /// antenna lever arm from the IMU in body axes [m]
+    /// antenna lever arm from the IMU in body axes \[m\]
     pub lever_arm_b_m: [f64; 3],
     /// outages as `[start_s, end_s]` pairs
     pub outages_s: Vec<[f64; 2]>,
@@ -60,7 +60,7 @@ pub struct GnssConfig {
     /// injected outliers `[t_s, dN_m, dE_m, dD_m]`: added to the fix of the epoch nearest
     /// `t_s` (within half a period)
     pub outliers_t_s_ned_m: Vec<[f64; 4]>,
-    /// time-tag latency [s] (tag = time of validity + latency)
+    /// time-tag latency \[s\] (tag = time of validity + latency)
     pub latency_s: f64,
     /// whether the filter knows (and corrects) the latency
     pub latency_modelled: bool,

@@ -35,14 +35,14 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-/// Accepted ellipsoidal height range [m] (the truth-file and scenario range).
+/// Accepted ellipsoidal height range \[m\] (the truth-file and scenario range).
 pub const H_RANGE_M: (f64, f64) = (-1000.0, 100_000.0);
-/// Largest accepted position or velocity standard deviation [m, m/s].
+/// Largest accepted position or velocity standard deviation \[m, m/s\].
 pub const MAX_SIGMA_M: f64 = 1.0e6;
-/// Smallest accepted position or velocity standard deviation [m, m/s] (1 µm: below any
+/// Smallest accepted position or velocity standard deviation \[m, m/s\] (1 µm: below any
 /// receiver's claim, and σ² stays far from underflow).
 pub const MIN_SIGMA_M: f64 = 1.0e-6;
-/// Largest accepted velocity component [m/s].
+/// Largest accepted velocity component \[m/s\].
 pub const MAX_SPEED_MPS: f64 = 1.0e4;
 
 /// GNSS file format selector.
@@ -122,7 +122,7 @@ pub struct GnssReadOptions {
     /// RTKLIB: keep only fixes with quality flag `1 <= Q <= max` (1 fix, 2 float, 3 SBAS,
     /// 4 DGPS, 5 single, 6 PPP); `None` keeps all
     pub rtklib_max_q: Option<u8>,
-    /// RTKLIB: geoid undulation N [m] used to turn geodetic (mean-sea-level) heights into
+    /// RTKLIB: geoid undulation N \[m\] used to turn geodetic (mean-sea-level) heights into
     /// ellipsoidal ones, h = H + N; without it such files are refused
     pub geoid_undulation_m: Option<f64>,
 }
@@ -138,7 +138,7 @@ impl GnssReadOptions {
         self.rtklib_max_q = Some(max_q);
         self
     }
-    /// Constant geoid undulation [m] for geodetic heights.
+    /// Constant geoid undulation \[m\] for geodetic heights.
     pub fn with_geoid_undulation_m(mut self, n_m: f64) -> Self {
         self.geoid_undulation_m = Some(n_m);
         self
@@ -344,9 +344,9 @@ pub enum GnssFileError {
         line: usize,
         /// 1-based character column
         column: usize,
-        /// previous time [s]
+        /// previous time \[s\]
         prev_s: f64,
-        /// this time [s]
+        /// this time \[s\]
         t_s: f64,
     },
     /// A covariance built from the file is not positive definite.
@@ -393,13 +393,13 @@ pub enum GnssFileError {
         file: PathBuf,
         /// fixes in the file
         n_fixes: usize,
-        /// first fix time [s]
+        /// first fix time \[s\]
         gnss_first_s: f64,
-        /// last fix time [s]
+        /// last fix time \[s\]
         gnss_last_s: f64,
-        /// IMU record start [s]
+        /// IMU record start \[s\]
         imu_first_s: f64,
-        /// IMU record end [s]
+        /// IMU record end \[s\]
         imu_last_s: f64,
     },
 }
@@ -554,7 +554,7 @@ pub enum ImuClock {
     SameAsGnss,
     /// `t_imu = t_gnss + t_imu_minus_t_gnss_s` (a known constant offset)
     Offset {
-        /// the offset [s]
+        /// the offset \[s\]
         t_imu_minus_t_gnss_s: f64,
     },
     /// the IMU file counts GPS seconds of week (KF-GINS IMU files); GPS times since the

@@ -1,5 +1,5 @@
 //! IMU file readers. Every format is converted at the edge to FRD body-frame
-//! increments ([`Increment`]: Δθ [rad], Δv [m/s]) over a constant sample period.
+//! increments ([`Increment`]: Δθ \[rad\], Δv \[m/s\]) over a constant sample period.
 //!
 //! | format | flag | layout | frame | content |
 //! |---|---|---|---|---|
@@ -29,21 +29,21 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-/// Largest accepted |Δθ| per sample [rad].
+/// Largest accepted |Δθ| per sample \[rad\].
 pub const MAX_DTHETA_RAD: f64 = core::f64::consts::PI;
-/// Largest accepted |f| [g].
+/// Largest accepted |f| \[g\].
 pub const MAX_SPECIFIC_FORCE_G: f64 = 1000.0;
 /// Largest accepted relative deviation of a sample interval from the median.
 pub const DT_TOLERANCE: f64 = 0.01;
-/// Accepted sample interval range [s]: 1 MHz to 1 Hz (a strapdown IMU record outside it is
+/// Accepted sample interval range \[s\]: 1 MHz to 1 Hz (a strapdown IMU record outside it is
 /// a wrong time unit or a corrupt file).
 pub const DT_RANGE_S: (f64, f64) = (1.0e-6, 1.0);
-/// |mean specific force along z| [g] above which auto-detection tells an FRD (z down:
+/// |mean specific force along z| \[g\] above which auto-detection tells an FRD (z down:
 /// f_z ≈ −g) from an RFU (z up: f_z ≈ +g) increment CSV with the same header.
 pub const GRAVITY_SIGN_THRESHOLD_G: f64 = 0.5;
-/// Gravity used for the |f| limit [m/s²].
+/// Gravity used for the |f| limit \[m/s²\].
 const G0: f64 = 9.80665;
-/// One arcsecond [rad].
+/// One arcsecond \[rad\].
 const ARCSEC: f64 = core::f64::consts::PI / 180.0 / 3600.0;
 
 /// Column names of the sdins increment CSV (also PSINS trj CSVs).
@@ -150,25 +150,25 @@ impl FromStr for ImuFormat {
 /// Header of a PSINS `.imu` file (values as written, PSINS conventions: ENU, body RFU).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PsinsHeader {
-    /// initial [pitch, roll, yaw] [deg] (PSINS: yaw counter-clockwise from north; "maybe inaccurate")
+    /// initial \[pitch, roll, yaw\] \[deg\] (PSINS: yaw counter-clockwise from north; "maybe inaccurate")
     pub att0_deg: [f64; 3],
-    /// initial velocity [VE, VN, VU] [m/s]
+    /// initial velocity \[VE, VN, VU\] \[m/s\]
     pub vel0_enu_mps: [f64; 3],
-    /// latitude [deg]
+    /// latitude \[deg\]
     pub lat_deg: f64,
-    /// longitude [deg]
+    /// longitude \[deg\]
     pub lon_deg: f64,
-    /// height [m]
+    /// height \[m\]
     pub h_m: f64,
-    /// start time [s]
+    /// start time \[s\]
     pub t0_s: f64,
-    /// sample interval [s]
+    /// sample interval \[s\]
     pub ts_s: f64,
-    /// local gravity stated by the file [m/s²]
+    /// local gravity stated by the file \[m/s²\]
     pub g_mps2: f64,
-    /// gyro pulse weights (RFU axes) [arcsec]
+    /// gyro pulse weights (RFU axes) \[arcsec\]
     pub gyro_weight_arcsec: [f64; 3],
-    /// accelerometer pulse weights (RFU axes) [μg·s]
+    /// accelerometer pulse weights (RFU axes) \[μg·s\]
     pub accel_weight_ugs: [f64; 3],
 }
 
@@ -177,10 +177,10 @@ pub struct PsinsHeader {
 pub struct ImuData {
     /// the format actually read (never `Auto`)
     pub format: ImuFormat,
-    /// sample period [s] (mean interval `(t_last − t_0)/(n − 1)` for files with a time
+    /// sample period \[s\] (mean interval `(t_last − t_0)/(n − 1)` for files with a time
     /// column, after every interval was checked against the median)
     pub dt_s: f64,
-    /// time stamp of the first sample as given by the file [s]
+    /// time stamp of the first sample as given by the file \[s\]
     pub t0_s: f64,
     /// the samples, FRD
     pub increments: Vec<Increment>,
@@ -307,9 +307,9 @@ pub enum ImuFileError {
         file: PathBuf,
         /// line number (1-based)
         line: usize,
-        /// previous time [s]
+        /// previous time \[s\]
         prev_s: f64,
-        /// this time [s]
+        /// this time \[s\]
         t_s: f64,
     },
     /// A sample interval differs from the median by more than [`DT_TOLERANCE`].
@@ -319,11 +319,11 @@ pub enum ImuFileError {
         file: PathBuf,
         /// line number (1-based)
         line: usize,
-        /// the interval ending on that line [s]
+        /// the interval ending on that line \[s\]
         dt_s: f64,
-        /// median interval [s]
+        /// median interval \[s\]
         median_s: f64,
-        /// tolerance [%]
+        /// tolerance \[%\]
         tol_pct: f64,
     },
     /// A physically absurd value.
@@ -361,11 +361,11 @@ pub enum ImuFileError {
         file: PathBuf,
         /// 1-based line (the header line for PSINS `Ts`)
         line: usize,
-        /// the interval [s]
+        /// the interval \[s\]
         dt_s: f64,
-        /// lower limit [s]
+        /// lower limit \[s\]
         min_s: f64,
-        /// upper limit [s]
+        /// upper limit \[s\]
         max_s: f64,
     },
     /// The last line (no final newline) ends in a number with fewer decimals than the same
@@ -480,7 +480,7 @@ pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuDa
     Ok(data)
 }
 
-/// Mean specific force along body z over the record [g], in the file's own axes.
+/// Mean specific force along body z over the record \[g\], in the file's own axes.
 fn mean_fz_g(incs: &[Increment], dt_s: f64) -> f64 {
     if incs.is_empty() || dt_s.is_nan() || dt_s <= 0.0 {
         return 0.0;

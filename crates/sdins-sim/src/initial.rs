@@ -4,7 +4,7 @@
 //! `lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg` (NED, FRD).
 //!
 //! The limits are those of the kinematic envelope ([`crate::envelope::Envelope::DEFAULT`]):
-//! |latitude| ≤ 89.99°, height in [−1000, 100 000] m, speed ≤ 3000 m/s, and an attitude
+//! |latitude| ≤ 89.99°, height in \[−1000, 100 000\] m, speed ≤ 3000 m/s, and an attitude
 //! matrix that is a rotation (‖CᵀC − I‖ ≤ 1e-6, det C > 0).
 
 use crate::envelope::Envelope;

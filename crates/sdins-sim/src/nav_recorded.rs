@@ -145,7 +145,7 @@ pub fn check_time_bases(
 pub struct RecordedRun {
     /// navigation updates done
     pub updates: usize,
-    /// time in the navigation updates only (taking the states included) [s]
+    /// time in the navigation updates only (taking the states included) \[s\]
     pub wall_s: f64,
     /// errors at every update matched by a reference row, `t_s` on the file's time base
     pub errors: Vec<NavError>,

@@ -7,13 +7,13 @@
 //! used here: `arw` rad/s/√Hz (= rad/√s), `vrw` m/s²/√Hz (= m/s/√s), `arrw` rad/s²/√Hz,
 //! `vrrw` m/s³/√Hz, `gb_sta`/`gb_dyn`/`g_std` rad/s, `ab_sta`/`ab_dyn`/`a_std` m/s²,
 //! `gb_corr`/`ab_corr` s, `gb_psd` rad/s/√Hz, `ab_psd` m/s²/√Hz, `ini_align` and
-//! `ini_align_err` rad in the order [roll, pitch, yaw]; GNSS `stdm` m in the order
-//! [lat (north), lon (east), h (height)], `stdv` m/s [N, E, D], `larm` m in the body frame
+//! `ini_align_err` rad in the order \[roll, pitch, yaw\]; GNSS `stdm` m in the order
+//! \[lat (north), lon (east), h (height)\], `stdv` m/s \[N, E, D\], `larm` m in the body frame
 //! (x forward, y right, z down: FRD), `freq` Hz, `zupt_th` m/s, `zupt_win` s, `eps` s, `std`
-//! [rad, rad, m].
+//! \[rad, rad, m\].
 //!
 //! Validation: every value finite; standard deviations, noise densities and biases' σ ≥ 0;
-//! correlation times and rates > 0; GNSS `stdm`/`stdv` in [1e-6, 1e6]; `ini_align` within |roll| ≤ π, |pitch| ≤ π/2,
+//! correlation times and rates > 0; GNSS `stdm`/`stdv` in \[1e-6, 1e6\]; `ini_align` within |roll| ≤ π, |pitch| ≤ π/2,
 //! |yaw| ≤ 2π. Each failure is a [`ParamsError`] with file:line:column and the field name.
 //! Fields the parser does not know are kept in `other` (name → values) rather than refused.
 
@@ -127,39 +127,39 @@ struct Entry {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct NavegoImuParams {
-    /// angle random walk `arw` [rad/√s]
+    /// angle random walk `arw` \[rad/√s\]
     pub arw_rad_per_sqrt_s: [f64; 3],
-    /// velocity random walk `vrw` [m/s/√s]
+    /// velocity random walk `vrw` \[m/s/√s\]
     pub vrw_mps_per_sqrt_s: [f64; 3],
-    /// angle rate random walk `arrw` [rad/s/√s], zero if absent
+    /// angle rate random walk `arrw` \[rad/s/√s\], zero if absent
     pub arrw_rps_per_sqrt_s: [f64; 3],
-    /// velocity rate random walk `vrrw` [m/s²/√s], zero if absent
+    /// velocity rate random walk `vrrw` \[m/s²/√s\], zero if absent
     pub vrrw_mps2_per_sqrt_s: [f64; 3],
-    /// gyro static (turn-on) bias `gb_sta` [rad/s]
+    /// gyro static (turn-on) bias `gb_sta` \[rad/s\]
     pub gb_sta_rps: [f64; 3],
-    /// accelerometer static (turn-on) bias `ab_sta` [m/s²]
+    /// accelerometer static (turn-on) bias `ab_sta` \[m/s²\]
     pub ab_sta_mps2: [f64; 3],
-    /// gyro dynamic bias (Gauss–Markov σ) `gb_dyn` [rad/s]
+    /// gyro dynamic bias (Gauss–Markov σ) `gb_dyn` \[rad/s\]
     pub gb_dyn_rps: [f64; 3],
-    /// accelerometer dynamic bias (Gauss–Markov σ) `ab_dyn` [m/s²]
+    /// accelerometer dynamic bias (Gauss–Markov σ) `ab_dyn` \[m/s²\]
     pub ab_dyn_mps2: [f64; 3],
-    /// gyro bias correlation time `gb_corr` [s]
+    /// gyro bias correlation time `gb_corr` \[s\]
     pub gb_corr_s: [f64; 3],
-    /// accelerometer bias correlation time `ab_corr` [s]
+    /// accelerometer bias correlation time `ab_corr` \[s\]
     pub ab_corr_s: [f64; 3],
-    /// gyro dynamic-bias root-PSD `gb_psd` [rad/s/√Hz], if given
+    /// gyro dynamic-bias root-PSD `gb_psd` \[rad/s/√Hz\], if given
     pub gb_psd_rps_per_sqrt_hz: Option<[f64; 3]>,
-    /// accelerometer dynamic-bias root-PSD `ab_psd` [m/s²/√Hz], if given
+    /// accelerometer dynamic-bias root-PSD `ab_psd` \[m/s²/√Hz\], if given
     pub ab_psd_mps2_per_sqrt_hz: Option<[f64; 3]>,
-    /// gyro white-noise standard deviation per sample `g_std` [rad/s], if given
+    /// gyro white-noise standard deviation per sample `g_std` \[rad/s\], if given
     pub g_std_rps: Option<[f64; 3]>,
-    /// accelerometer white-noise standard deviation per sample `a_std` [m/s²], if given
+    /// accelerometer white-noise standard deviation per sample `a_std` \[m/s²\], if given
     pub a_std_mps2: Option<[f64; 3]>,
-    /// sampling frequency `freq` [Hz], if given
+    /// sampling frequency `freq` \[Hz\], if given
     pub freq_hz: Option<f64>,
-    /// initial attitude `ini_align` [roll, pitch, yaw] [rad]
+    /// initial attitude `ini_align` \[roll, pitch, yaw\] \[rad\]
     pub ini_align_rpy_rad: [f64; 3],
-    /// initial attitude σ `ini_align_err` [roll, pitch, yaw] [rad]
+    /// initial attitude σ `ini_align_err` \[roll, pitch, yaw\] \[rad\]
     pub ini_align_err_rpy_rad: [f64; 3],
     /// fields not interpreted above (for example `m_std`, a magnetometer σ whose unit
     /// NaveGo does not document), name → values as written
@@ -170,21 +170,21 @@ pub struct NavegoImuParams {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct NavegoGnssParams {
-    /// position σ `stdm` [north, east, down] [m] (NaveGo: [lat, lon, h]; σ_D = σ_h)
+    /// position σ `stdm` \[north, east, down\] \[m\] (NaveGo: \[lat, lon, h\]; σ_D = σ_h)
     pub stdm_ned_m: [f64; 3],
-    /// velocity σ `stdv` [N, E, D] [m/s]
+    /// velocity σ `stdv` \[N, E, D\] \[m/s\]
     pub stdv_ned_mps: [f64; 3],
-    /// lever arm IMU → antenna `larm`, body FRD [m]
+    /// lever arm IMU → antenna `larm`, body FRD \[m\]
     pub larm_frd_m: [f64; 3],
-    /// fix rate `freq` [Hz]
+    /// fix rate `freq` \[Hz\]
     pub freq_hz: f64,
-    /// ZUPT speed threshold `zupt_th` [m/s], if given
+    /// ZUPT speed threshold `zupt_th` \[m/s\], if given
     pub zupt_th_mps: Option<f64>,
-    /// ZUPT window `zupt_win` [s], if given
+    /// ZUPT window `zupt_win` \[s\], if given
     pub zupt_win_s: Option<f64>,
-    /// IMU-to-GNSS time matching window `eps` [s], if given
+    /// IMU-to-GNSS time matching window `eps` \[s\], if given
     pub eps_s: Option<f64>,
-    /// position σ in NaveGo's angular form `std` [lat rad, lon rad, h m], if given
+    /// position σ in NaveGo's angular form `std` \[lat rad, lon rad, h m\], if given
     pub std_lat_rad_lon_rad_h_m: Option<[f64; 3]>,
     /// fields not interpreted above, name → values as written
     pub other: BTreeMap<String, Vec<f64>>,
@@ -217,7 +217,7 @@ enum Range {
     Positive,
     /// any finite value
     Any,
-    /// a measurement σ in [1e-6, 1e6] (the GNSS readers' range)
+    /// a measurement σ in \[1e-6, 1e6\] (the GNSS readers' range)
     Sigma,
     /// ini_align: |roll| ≤ π, |pitch| ≤ π/2, |yaw| ≤ 2π
     Attitude,

@@ -17,17 +17,17 @@ use std::time::Instant;
 /// Navigation errors at one epoch (mechanization.md §1.4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct NavError {
-    /// time [s]
+    /// time \[s\]
     pub t_s: f64,
-    /// position error N, E, D [m]: δN = δL(R_M+h), δE = δλ(R_N+h)cosL, δD = −δh
+    /// position error N, E, D \[m\]: δN = δL(R_M+h), δE = δλ(R_N+h)cosL, δD = −δh
     pub pos_err_ned_m: [f64; 3],
-    /// velocity error v_alg − v_true, NED [m/s]
+    /// velocity error v_alg − v_true, NED \[m/s\]
     pub vel_err_ned_mps: [f64; 3],
-    /// attitude error ε, NED [rad], C_alg C_trueᵀ = I + [ε×]
+    /// attitude error ε, NED \[rad\], C_alg C_trueᵀ = I + \[ε×\]
     pub att_err_rad: [f64; 3],
-    /// height error h_alg − h_true [m]
+    /// height error h_alg − h_true \[m\]
     pub height_err_m: f64,
-    /// Euler-angle differences roll, pitch, yaw, wrapped to (−π, π] [rad]
+    /// Euler-angle differences roll, pitch, yaw, wrapped to (−π, π] \[rad\]
     pub euler_err_rad: [f64; 3],
 }
 
@@ -142,7 +142,7 @@ pub struct RunSummary {
     pub samples: usize,
     /// number of navigation updates
     pub nav_updates: u64,
-    /// time spent in the navigation loop only [s]
+    /// time spent in the navigation loop only \[s\]
     pub wall_s: f64,
     /// errors at the last update
     #[serde(rename = "final")]
@@ -160,7 +160,7 @@ pub struct RunOptions {
     pub vertical_hold: bool,
     /// output decimation: call the observer every `every` updates (and at the end)
     pub every: u64,
-    /// stop after this time [s] (None: whole scenario)
+    /// stop after this time \[s\] (None: whole scenario)
     pub until_s: Option<f64>,
     /// apply the scenario's IMU error model as run number `run` (None: ideal sensors)
     pub sensor_run: Option<u64>,

@@ -137,8 +137,8 @@ pub fn vertical_hold(v: Option<&str>, default_hold: bool) -> Result<bool, Option
     }
 }
 
-/// Output decimation in updates for an epoch spacing `every_s` [s] and an update
-/// interval `dt_update_s` [s]: round(every_s / dt_update_s), at least 1.
+/// Output decimation in updates for an epoch spacing `every_s` \[s\] and an update
+/// interval `dt_update_s` \[s\]: round(every_s / dt_update_s), at least 1.
 pub fn every_updates(every_s: f64, dt_update_s: f64) -> Result<u64, OptionError> {
     if !(every_s.is_finite() && every_s > 0.0) {
         return Err(bad(format!(
@@ -162,10 +162,10 @@ pub fn earth_by_name(name: &str) -> Result<EarthModel, OptionError> {
     }
 }
 
-/// Default output epoch spacing of `sdins run` / `sdins.run` [s].
+/// Default output epoch spacing of `sdins run` / `sdins.run` \[s\].
 pub const DEFAULT_EVERY_S: f64 = 1.0;
 
-/// Default output epoch spacing of Monte Carlo [s].
+/// Default output epoch spacing of Monte Carlo \[s\].
 pub const DEFAULT_MC_EVERY_S: f64 = 10.0;
 
 /// Replace the scenario's IMU error model by the grade preset `grade` (marine, aviation,
@@ -187,9 +187,9 @@ pub struct McChoice {
     pub algo: Option<String>,
     /// samples per update (default: the scenario's)
     pub samples: Option<usize>,
-    /// output epoch spacing [s] (default [`DEFAULT_MC_EVERY_S`])
+    /// output epoch spacing \[s\] (default [`DEFAULT_MC_EVERY_S`])
     pub every_s: Option<f64>,
-    /// stop time [s] (default: whole scenario)
+    /// stop time \[s\] (default: whole scenario)
     pub until_s: Option<f64>,
     /// vertical channel hold or free (default hold)
     pub vertical: Option<String>,

@@ -14,7 +14,7 @@ use std::path::Path;
 use toml::Spanned;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
-/// Longest accepted segment [s] (keeps sample counts far from integer overflow).
+/// Longest accepted segment \[s\] (keeps sample counts far from integer overflow).
 pub const MAX_SEGMENT_S: f64 = 1.0e7;
 
 /// A scenario error: where and what.
@@ -184,7 +184,7 @@ struct MountingDoc {
 pub struct Mounting {
     /// the IMU's lever arm and mounting (none: the IMU at the reference point, aligned)
     pub imu: Option<crate::truth::ImuMount>,
-    /// the GNSS antenna's lever arm, vehicle frame [m] (for the INS/GNSS simulation)
+    /// the GNSS antenna's lever arm, vehicle frame \[m\] (for the INS/GNSS simulation)
     pub gnss_lever_arm_b_m: Option<sdins_core::math::Vec3>,
 }
 
@@ -285,15 +285,15 @@ impl EarthChoice {
 /// Start state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Start {
-    /// latitude [rad]
+    /// latitude \[rad\]
     pub lat_rad: f64,
-    /// longitude [rad]
+    /// longitude \[rad\]
     pub lon_rad: f64,
-    /// height [m]
+    /// height \[m\]
     pub h_m: f64,
-    /// horizontal speed along the heading [m/s]
+    /// horizontal speed along the heading \[m/s\]
     pub speed_mps: f64,
-    /// climb rate [m/s], positive up (v_D = −climb)
+    /// climb rate \[m/s\], positive up (v_D = −climb)
     pub climb_rate_mps: f64,
     /// attitude
     pub euler: Euler,
@@ -302,7 +302,7 @@ pub struct Start {
 /// IMU set-up.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImuConfig {
-    /// sample rate [Hz]
+    /// sample rate \[Hz\]
     pub rate_hz: f64,
     /// random seed (error models, Monte Carlo)
     pub seed: u64,
@@ -315,7 +315,7 @@ pub struct ImuConfig {
 }
 
 impl ImuConfig {
-    /// Sample period δt [s].
+    /// Sample period δt \[s\].
     pub fn dt_s(&self) -> f64 {
         1.0 / self.rate_hz
     }
@@ -1121,7 +1121,7 @@ impl Scenario {
         })
     }
 
-    /// Duration [s].
+    /// Duration \[s\].
     pub fn duration_s(&self) -> f64 {
         self.trajectory.duration_s
     }

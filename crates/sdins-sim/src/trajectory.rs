@@ -20,54 +20,54 @@ pub enum Motion {
     Static,
     /// constant velocity and attitude
     Cruise,
-    /// constant along-track acceleration [m/s²]
+    /// constant along-track acceleration \[m/s²\]
     Accelerate {
-        /// acceleration along the heading [m/s²]
+        /// acceleration along the heading \[m/s²\]
         accel_mps2: f64,
     },
-    /// level turn at a constant yaw rate [rad/s]
+    /// level turn at a constant yaw rate \[rad/s\]
     TurnRate {
-        /// yaw rate [rad/s] (positive = right turn)
+        /// yaw rate \[rad/s\] (positive = right turn)
         rate_rps: f64,
     },
     /// level turn through an angle with a smooth (raised-cosine) rate:
     /// `ψ = ψ0 + A(x − sin(2πx)/(2π))`, `ψ̇ = (A/T)(1 − cos 2πx)`, `x = τ/T`
     /// (spec §7.3; peak rate 2A/T at mid-turn)
     TurnSmooth {
-        /// total heading change A [rad]
+        /// total heading change A \[rad\]
         angle_rad: f64,
     },
     /// S-turn: `ψ̇ = a sin(2πτ/T)`, `ψ = ψ0 + a(T/2π)(1 − cos(2πτ/T))` (spec §7.5)
     STurn {
-        /// peak yaw rate a [rad/s]
+        /// peak yaw rate a \[rad/s\]
         amplitude_rps: f64,
     },
     /// linear change of the climb rate to `to_climb_rate_mps` (v_D = −climb rate)
     Climb {
-        /// climb rate at the end of the segment [m/s], positive up
+        /// climb rate at the end of the segment \[m/s\], positive up
         to_climb_rate_mps: f64,
     },
     /// smooth speed change by `delta_speed_mps`: `s = s0 + Δ·S(x)` with the smooth step
     /// `S(x) = x − sin(2πx)/(2π)`, `x = τ/T`: `ṡ = (Δ/T)(1 − cos 2πx)` and `s̈` vanish at
     /// both ends (peak acceleration 2Δ/T at mid-segment)
     AccelerateSmooth {
-        /// speed change Δ [m/s]
+        /// speed change Δ \[m/s\]
         delta_speed_mps: f64,
     },
     /// smooth change of the climb rate to `to_climb_rate_mps`: `v_D = v_D0 + Δ·S(x)`,
     /// `Δ = −to_climb_rate − v_D0`, with the smooth step `S` of
     /// [`Motion::AccelerateSmooth`]
     ClimbSmooth {
-        /// climb rate at the end of the segment [m/s], positive up
+        /// climb rate at the end of the segment \[m/s\], positive up
         to_climb_rate_mps: f64,
     },
     /// turn-rate ramp from `from_rps` to `to_rps`: `ψ̇ = r0 + (r1 − r0)·S(x)`,
     /// `ψ = ψ0 + r0 τ + (r1 − r0) T (x²/2 + (cos 2πx − 1)/(4π²))`; ψ̈ and ψ⃛ vanish at both
     /// ends (the entry and exit of a coordinated turn)
     TurnRamp {
-        /// yaw rate at the start [rad/s]
+        /// yaw rate at the start \[rad/s\]
         from_rps: f64,
-        /// yaw rate at the end [rad/s]
+        /// yaw rate at the end \[rad/s\]
         to_rps: f64,
     },
 }
@@ -100,9 +100,9 @@ pub fn accelerated_speed(speed0_mps: f64, accel_mps2: f64, duration_s: f64) -> f
 pub struct Segment {
     /// kind of motion
     pub motion: Motion,
-    /// start time [s]
+    /// start time \[s\]
     pub t0_s: f64,
-    /// duration [s]
+    /// duration \[s\]
     pub duration_s: f64,
     speed0: f64,
     heading0: f64,
@@ -147,19 +147,19 @@ pub enum OverlayKind {
     Coning {
         /// cone axis
         axis: Axis,
-        /// half-angle α [rad]
+        /// half-angle α \[rad\]
         half_angle_rad: f64,
-        /// angular frequency Ω [rad/s]
+        /// angular frequency Ω \[rad/s\]
         omega_rps: f64,
     },
     /// classical sculling: rotation θ0 sin Ωτ about body x, in phase with a specific-force
     /// oscillation A0 sin Ωτ along the nominal body y (spec §4.3)
     Sculling {
-        /// angular amplitude θ0 [rad]
+        /// angular amplitude θ0 \[rad\]
         angle_amp_rad: f64,
-        /// acceleration amplitude A0 [m/s²]
+        /// acceleration amplitude A0 \[m/s²\]
         accel_amp_mps2: f64,
-        /// angular frequency Ω [rad/s]
+        /// angular frequency Ω \[rad/s\]
         omega_rps: f64,
     },
     /// sinusoidal linear vibration along a nominal body axis: acceleration A cos Ωτ,
@@ -167,9 +167,9 @@ pub enum OverlayKind {
     Vibration {
         /// axis of the nominal body frame
         axis: Axis,
-        /// acceleration amplitude A [m/s²]
+        /// acceleration amplitude A \[m/s²\]
         accel_amp_mps2: f64,
-        /// angular frequency Ω [rad/s]
+        /// angular frequency Ω \[rad/s\]
         omega_rps: f64,
     },
     /// angular sway (ship roll/pitch/yaw at its mooring, a rocking car): rotation by
@@ -178,17 +178,17 @@ pub enum OverlayKind {
     Sway {
         /// axis of the (nominal, after earlier overlays) body frame
         axis: Axis,
-        /// angular amplitude A [rad]
+        /// angular amplitude A \[rad\]
         amp_rad: f64,
-        /// angular frequency Ω [rad/s]
+        /// angular frequency Ω \[rad/s\]
         omega_rps: f64,
-        /// phase φ [rad]
+        /// phase φ \[rad\]
         phase_rad: f64,
     },
 }
 
 impl OverlayKind {
-    /// The angular frequency Ω of the overlay [rad/s].
+    /// The angular frequency Ω of the overlay \[rad/s\].
     pub fn omega_rps(&self) -> f64 {
         match *self {
             OverlayKind::Coning { omega_rps, .. }
@@ -213,22 +213,22 @@ type PhasePair<'a> = (&'a [(f64, f64)], &'a [(f64, f64)]);
 pub struct Overlay {
     /// kind
     pub kind: OverlayKind,
-    /// start time [s]
+    /// start time \[s\]
     pub start_s: f64,
-    /// end time [s] (the overlay state is frozen afterwards)
+    /// end time \[s\] (the overlay state is frozen afterwards)
     pub end_s: f64,
 }
 
 /// Exact kinematics at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kinematics {
-    /// NED velocity [m/s]
+    /// NED velocity \[m/s\]
     pub v_n_mps: Vec3,
-    /// its time derivative [m/s²]
+    /// its time derivative \[m/s²\]
     pub v_dot_n_mps2: Vec3,
     /// attitude body→NED
     pub c_b_n: Mat3,
-    /// body rate relative to the navigation frame, in body axes [rad/s]
+    /// body rate relative to the navigation frame, in body axes \[rad/s\]
     pub omega_nb_b_rps: Vec3,
 }
 
@@ -239,7 +239,7 @@ pub struct Trajectory {
     pitch0_rad: f64,
     segments: Vec<Segment>,
     overlays: Vec<Overlay>,
-    /// total duration [s]
+    /// total duration \[s\]
     pub duration_s: f64,
     /// per-trajectory constants of [`Trajectory::kinematics_split`]: sin/cos of roll and
     /// pitch, and per overlay sin/cos of the coning half-angle α/2 and of α
@@ -527,7 +527,7 @@ impl Trajectory {
     }
 
     /// Highest angular frequency of any periodic motion (overlays, smooth turns,
-    /// S-turns) [rad/s]; zero if none.
+    /// S-turns) \[rad/s\]; zero if none.
     pub fn max_frequency_rps(&self) -> f64 {
         let seg = self.segments.iter().map(|s| match s.motion {
             Motion::TurnSmooth { .. }

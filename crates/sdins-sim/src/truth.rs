@@ -26,17 +26,17 @@ use sdins_core::nav::{wrap_pi, InitialState};
 /// Truth at the end of one sensor sample, with the sample's increments.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TruthSample {
-    /// sample end time [s]
+    /// sample end time \[s\]
     pub t_s: f64,
     /// exact increments over the sample
     pub inc: Increment,
-    /// latitude [rad]
+    /// latitude \[rad\]
     pub lat_rad: f64,
-    /// longitude [rad]
+    /// longitude \[rad\]
     pub lon_rad: f64,
-    /// height [m]
+    /// height \[m\]
     pub h_m: f64,
-    /// NED velocity [m/s]
+    /// NED velocity \[m/s\]
     pub v_n_mps: Vec3,
     /// attitude body→NED
     pub c_b_n: Mat3,
@@ -74,13 +74,13 @@ impl TruthSample {
 pub struct TruthConfig {
     /// earth model (the navigation must use the same)
     pub earth: EarthModel,
-    /// sensor sample period δt [s]
+    /// sensor sample period δt \[s\]
     pub dt_s: f64,
-    /// start latitude [rad]
+    /// start latitude \[rad\]
     pub lat0_rad: f64,
-    /// start longitude [rad]
+    /// start longitude \[rad\]
     pub lon0_rad: f64,
-    /// start height [m]
+    /// start height \[m\]
     pub h0_m: f64,
     /// integration resolution: RK4 substeps per sample for [`TruthScheme::Rk4`] (16 in the
     /// spec; the refinement test compares with 32); [`TruthScheme::Gauss`] uses one
@@ -233,14 +233,14 @@ pub struct TruthGenerator<'a> {
 /// point; [`ImuMount::imu_point`] gives the IMU's own position, velocity and attitude.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImuMount {
-    /// lever arm from the vehicle reference point to the IMU, vehicle frame [m]
+    /// lever arm from the vehicle reference point to the IMU, vehicle frame \[m\]
     pub lever_arm_b_m: Vec3,
     /// rotation from the vehicle frame to the IMU (sensor) frame, `C_b^s`
     pub c_b_s: Mat3,
 }
 
 impl ImuMount {
-    /// Lever arm `l` [m] and mounting Euler angles (roll, pitch, yaw of the IMU axes in the
+    /// Lever arm `l` \[m\] and mounting Euler angles (roll, pitch, yaw of the IMU axes in the
     /// vehicle frame: `C_s^b = Rz Ry Rx`).
     pub fn new(lever_arm_b_m: Vec3, mount: sdins_core::math::Euler) -> Self {
         Self {
@@ -508,7 +508,7 @@ impl<'a> TruthGenerator<'a> {
     }
 
     /// Position after the last sample as offsets from the start, `(L − L0 [rad], l − l0
-    /// [rad], h [m])`: free of the rounding of the absolute coordinates of
+    /// \[rad\], h \[m\])`: free of the rounding of the absolute coordinates of
     /// [`TruthSample`] (one ulp of a longitude near 2.2 rad is 2e-9 m), for comparing schemes.
     pub fn position_offsets(&self) -> (f64, f64, f64) {
         (self.dlat, self.dlon, self.h)

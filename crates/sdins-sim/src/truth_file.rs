@@ -49,11 +49,11 @@ pub fn c_b_n_from_psins(pitch: f64, roll: f64, yaw: f64) -> Mat3 {
     p * (rz * rx * ry) * p
 }
 
-/// Largest accepted |latitude| [deg] in a reference trajectory.
+/// Largest accepted |latitude| \[deg\] in a reference trajectory.
 pub const MAX_LAT_DEG: f64 = 90.0;
-/// Accepted height range [m] (the same as the scenario parser's).
+/// Accepted height range \[m\] (the same as the scenario parser's).
 pub const H_RANGE_M: (f64, f64) = (-1000.0, 100_000.0);
-/// Largest accepted step between two reference rows [s] (a larger step is a wrong time
+/// Largest accepted step between two reference rows \[s\] (a larger step is a wrong time
 /// unit or a corrupt file; comparisons interpolate between rows).
 pub const MAX_TRUTH_STEP_S: f64 = 60.0;
 

@@ -20,7 +20,7 @@
 //!   −γ̇ sin μ + χ̇ cos γ cos μ]` and `μ̇ = (a ḃ − ȧ b)/(a² + b²)`, `a = y₁·f`, `b = z₁·f`.
 //!
 //! Smoothness (aircraft): the attitude is as smooth as `f^n`. Every segment joint must
-//! continue `v̇` and `v̈` ([`Trajectory::with_vehicle`] checks it and names the segment),
+//! continue `v̇` and `v̈` ([`crate::trajectory::Trajectory::with_vehicle`] checks it and names the segment),
 //! so `μ`, `γ` are C¹ and the attitude is C¹ everywhere (ω continuous); inside segments
 //! it is analytic except at the nodes of the position track, where it is C¹ with a
 //! jump in `ω̇` of order `∂μ/∂L·ΔL̈ < 1e-20 rad/s²`. The smooth profiles
@@ -50,7 +50,7 @@ pub enum Vehicle {
     Car,
     /// coordinated flight: wind axes plus a constant angle of attack
     Aircraft {
-        /// angle of attack α [rad] (body x above the velocity)
+        /// angle of attack α \[rad\] (body x above the velocity)
         angle_of_attack_rad: f64,
     },
 }
@@ -95,12 +95,12 @@ pub enum VehicleError {
         index: usize,
         /// vehicle name
         vehicle: &'static str,
-        /// down velocity [m/s]
+        /// down velocity \[m/s\]
         v_d_mps: f64,
     },
 }
 
-/// Node spacing of the position track [s] (upper bound).
+/// Node spacing of the position track \[s\] (upper bound).
 const TRACK_DT_S: f64 = 0.05;
 
 /// Latitude and height along the nominal velocity, piecewise cubic Hermite.
@@ -314,7 +314,7 @@ pub enum TurnError {
     /// The bank limit is not below 90°.
     #[error("bank limit {bank_deg} deg must be below 90 deg")]
     Bank {
-        /// the limit [deg]
+        /// the limit \[deg\]
         bank_deg: f64,
     },
 }

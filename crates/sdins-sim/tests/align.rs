@@ -78,7 +78,7 @@ fn ref_site() -> Site {
     ref_truth().site
 }
 
-/// x0 = [δv0, φ0, δa^n, ε^n] (NED residual biases at the true attitude).
+/// x0 = \[δv0, φ0, δa^n, ε^n\] (NED residual biases at the true attitude).
 fn x0_ned(phi0: &Vec3, c: &Mat3, ba: &Vec3, bg: &Vec3) -> Vec12 {
     let mut x = Vec12::zeros();
     x.fixed_rows_mut::<3>(3).copy_from(phi0);
@@ -213,8 +213,8 @@ fn t2_coarse_noise_sigma() {
     }
 }
 
-/// T4: fine alignment, noise-free REF, φ0 = [0.5, −0.5, 5] mrad: from 300 s on,
-/// |φ_N,E − Π x0| ≤ 10 μrad, |φ_D − Π x0| ≤ 20 μrad; Π x0 = [35.23, 91.91, 907.05] μrad.
+/// T4: fine alignment, noise-free REF, φ0 = \[0.5, −0.5, 5\] mrad: from 300 s on,
+/// |φ_N,E − Π x0| ≤ 10 μrad, |φ_D − Π x0| ≤ 20 μrad; Π x0 = \[35.23, 91.91, 907.05\] μrad.
 #[test]
 fn t4_fine_noise_free() {
     let tr = ref_truth();
@@ -373,7 +373,7 @@ fn chi2_mean_band(k: usize, n: usize) -> (f64, f64) {
     (q(-1.959964), q(1.959964))
 }
 
-/// NEES epochs [s].
+/// NEES epochs \[s\].
 const NEES_TIMES: [u64; 4] = [60, 300, 900, 1800];
 
 /// Consistency Monte Carlo: initial error (δv, φ, biases) drawn per run from N(0, P0),
@@ -585,7 +585,7 @@ fn mh_cfg_nf(s: Site) -> FineConfig {
     }
 }
 
-/// Errors of a multi-heading result: (b_a err [μg], b_g err [°/h], φ [μrad]).
+/// Errors of a multi-heading result: (b_a err \[μg\], b_g err \[°/h\], φ \[μrad\]).
 fn mh_errors(
     r: &sdins_sim::align::MultiHeadingResult,
     tr: &TruthRecord,

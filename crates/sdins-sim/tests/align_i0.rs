@@ -68,7 +68,7 @@ fn lasergyro_i0_heading_over_300s_windows() {
 /// One disturbed-base Monte Carlo (docs/alignment_i0.md §5): exact truth of `scenario`,
 /// `runs` error-model draws of `grade` (values from `imu_error::presets` at run time),
 /// window `window_s`. Returns per run (i0 heading error − its floor, 2-step heading error)
-/// [rad] and the closed-form σ of the first.
+/// \[rad\] and the closed-form σ of the first.
 fn disturbed_mc(scenario: &str, grade: &str, window_s: f64, runs: u64) -> (Vec<(f64, f64)>, f64) {
     use rayon::prelude::*;
     use sdins_core::align::i0::{heading_floor_rad, heading_sigma_rad};
@@ -247,7 +247,7 @@ fn lasergyro_fine_from_i0_is_start_independent() {
 /// Issue part 2 in simulation: the fine filter started from i0 on the moored ship
 /// (aviation grade, i0 window 300 s, filter over 600 s, σ_z from the i0 residual, bias
 /// priors from the grade preset) is consistent: the mean attitude NEES over 200 runs lies
-/// in the two-sided 99 % band of χ²(600)/200 = [2.57, 3.46] (Wilson–Hilferty).
+/// in the two-sided 99 % band of χ²(600)/200 = \[2.57, 3.46\] (Wilson–Hilferty).
 #[test]
 #[ignore = "Monte Carlo: run in release with --ignored"]
 fn fine_from_i0_moored_ship_nees() {

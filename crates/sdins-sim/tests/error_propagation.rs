@@ -28,7 +28,7 @@ struct T9Case {
     gyro_dph: [f64; 3],
     accel_ug: [f64; 3],
     phi0: [f64; 3],
-    /// (channel, hour, spec INS value [m]) — spec §6 T9 table, INS column
+    /// (channel, hour, spec INS value \[m\]) — spec §6 T9 table, INS column
     spec_points: &'static [(usize, f64, f64)],
 }
 

@@ -319,7 +319,7 @@ fn samples_carry_the_sin_cos_of_their_own_latitude() {
 
 /// Largest differences between the default (Gauss) truth at the scenario's substeps and
 /// the RK4 reference at twice as many, over `windows` of `(start_s, duration_s)`, each
-/// started from the scenario's start position: increments [rad], [m/s], and position [m]
+/// started from the scenario's start position: increments \[rad\], \[m/s\], and position \[m\]
 /// from the generators' internal offsets `(L − L0, l − l0, h)` (the absolute longitude of a
 /// `TruthSample` is rounded to 4.4e-16 rad = 2.2e-9 m, and `wrap_pi` adds a few ulp more).
 fn gauss_vs_rk4(name: &str, windows: &[(f64, f64)]) -> (f64, f64, f64) {

@@ -26,7 +26,7 @@
 //! ## Measurements (innovation `ν = ĥ(x̂) − z = H x + noise`)
 //! * GNSS position of the antenna at lever arm `l` (body): `p̂_a = p̂ + Ĉ_b^n l` (Groves
 //!   (14.110)); `ν_p = T (L̂_a − L, λ̂_a − λ, ĥ_a − h)` with `T = diag(R_M+h, (R_N+h)cos L, −1)`
-//!   [m, NED]; `H_p = [T, 0, −[(Ĉ l)×], 0, 0]`.
+//!   \[m, NED\]; `H_p = [T, 0, −[(Ĉ l)×], 0, 0]`.
 //! * GNSS velocity: `v̂_a = v̂ + Ĉ (ω̂_eb^b × l)`, `ω_eb^b = ω_ib^b − C_n^b ω_ie^n` (Groves
 //!   (14.111)); `H_v = [0, I, −[(Ĉ(ω × l))×], 0, −Ĉ [l×]]`.
 //! * Time of validity: a fix with time `t` inside the last navigation interval
@@ -70,21 +70,21 @@ pub const CHI2_999: [f64; 6] = [10.828, 13.816, 16.266, 18.467, 20.515, 22.458];
 /// Sensor noise and bias models of the filter (SI units, per body axis).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NoiseModel {
-    /// gyro angle random walk [rad/√s]
+    /// gyro angle random walk \[rad/√s\]
     pub arw_rad_per_sqrt_s: Vec3,
-    /// accelerometer velocity random walk [m/s/√s]
+    /// accelerometer velocity random walk \[m/s/√s\]
     pub vrw_mps_per_sqrt_s: Vec3,
-    /// accelerometer-bias Gauss–Markov steady-state σ [m/s²] (with `T = ∞`: unused)
+    /// accelerometer-bias Gauss–Markov steady-state σ \[m/s²\] (with `T = ∞`: unused)
     pub accel_bias_gm_mps2: Vec3,
-    /// accelerometer-bias correlation time T [s]; `f64::INFINITY` = random constant
+    /// accelerometer-bias correlation time T \[s\]; `f64::INFINITY` = random constant
     pub accel_bias_tau_s: Vec3,
-    /// gyro-bias Gauss–Markov steady-state σ [rad/s]
+    /// gyro-bias Gauss–Markov steady-state σ \[rad/s\]
     pub gyro_bias_gm_rps: Vec3,
-    /// gyro-bias correlation time T [s]; `f64::INFINITY` = random constant
+    /// gyro-bias correlation time T \[s\]; `f64::INFINITY` = random constant
     pub gyro_bias_tau_s: Vec3,
-    /// accelerometer-bias random walk [m/s²/√s]
+    /// accelerometer-bias random walk \[m/s²/√s\]
     pub accel_bias_rw: Vec3,
-    /// gyro-bias random walk [rad/s/√s]
+    /// gyro-bias random walk \[rad/s/√s\]
     pub gyro_bias_rw: Vec3,
 }
 
@@ -109,13 +109,13 @@ impl Default for NoiseModel {
 pub struct EkfConfig {
     /// earth model (the mechanization's)
     pub earth: EarthModel,
-    /// sensor sample period δt [s]
+    /// sensor sample period δt \[s\]
     pub dt_s: f64,
     /// navigation updates per covariance epoch (≥ 1)
     pub cov_updates: usize,
     /// sensor noise and bias models
     pub noise: NoiseModel,
-    /// GNSS antenna lever arm from the IMU, body frame [m]
+    /// GNSS antenna lever arm from the IMU, body frame \[m\]
     pub lever_arm_b_m: Vec3,
     /// NIS gate for GNSS fixes by degrees of freedom 1…6 (`None`: no gating)
     pub gate_chi2: Option<[f64; 6]>,
@@ -127,17 +127,17 @@ pub struct EkfConfig {
 /// velocity, with their NED covariances).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GnssMeasurement {
-    /// time of validity [s] (the navigation time base)
+    /// time of validity \[s\] (the navigation time base)
     pub t_s: f64,
-    /// antenna latitude [rad]
+    /// antenna latitude \[rad\]
     pub lat_rad: f64,
-    /// antenna longitude [rad]
+    /// antenna longitude \[rad\]
     pub lon_rad: f64,
-    /// antenna ellipsoidal height [m]
+    /// antenna ellipsoidal height \[m\]
     pub h_m: f64,
-    /// NED position covariance [m²]
+    /// NED position covariance \[m²\]
     pub pos_cov_ned_m2: Mat3,
-    /// NED velocity [m/s] and covariance [(m/s)²]
+    /// NED velocity \[m/s\] and covariance \[(m/s)²\]
     pub vel: Option<(Vec3, Mat3)>,
 }
 
@@ -156,13 +156,13 @@ pub enum MeasKind {
 /// Outcome of one measurement.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UpdateReport {
-    /// filter time at the update [s]
+    /// filter time at the update \[s\]
     pub t_s: f64,
     /// measurement kind
     pub kind: MeasKind,
     /// degrees of freedom (measurement dimension)
     pub dof: usize,
-    /// innovation ν (first `dof` entries) [m, m/s]
+    /// innovation ν (first `dof` entries) \[m, m/s\]
     pub innovation: [f64; 6],
     /// its standard deviations √diag(S)
     pub sigma: [f64; 6],
@@ -180,19 +180,19 @@ pub struct UpdateReport {
 pub enum FilterError {
     /// A covariance (P or an innovation covariance S) is not positive definite or not finite.
     NotPositiveDefinite {
-        /// filter time [s]
+        /// filter time \[s\]
         t_s: f64,
         /// which matrix
         what: &'static str,
     },
     /// The navigation state became non-finite.
     NonFiniteState {
-        /// filter time [s]
+        /// filter time \[s\]
         t_s: f64,
     },
     /// A measurement has a non-finite value.
     BadMeasurement {
-        /// filter time [s]
+        /// filter time \[s\]
         t_s: f64,
     },
 }
@@ -219,7 +219,7 @@ impl core::error::Error for FilterError {}
 /// One covariance epoch, for a smoother: `P(k|k−1) = Φ P(k−1|k−1) Φᵀ + Q`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CovEpoch {
-    /// time [s]
+    /// time \[s\]
     pub t_s: f64,
     /// transition used from the previous epoch
     pub phi: StateMat,
@@ -241,7 +241,7 @@ pub struct Ekf<M: Mechanization> {
     f_acc: Vec3,
     tau_acc: f64,
     updates_acc: usize,
-    /// compensated rate of the last update [rad/s]
+    /// compensated rate of the last update \[rad/s\]
     omega_ib_b: Vec3,
     last_epoch: Option<CovEpoch>,
     consecutive_rejections: u32,
@@ -262,7 +262,7 @@ fn cov_ok(p: &StateMat) -> bool {
 
 impl<M: Mechanization> Ekf<M> {
     /// New filter on `mech` (at its initial state), initial covariance `p0`, initial bias
-    /// estimates `b_a0` [m/s²], `b_g0` [rad/s].
+    /// estimates `b_a0` \[m/s²\], `b_g0` \[rad/s\].
     pub fn new(mech: M, cfg: EkfConfig, p0: StateMat, b_a0: Vec3, b_g0: Vec3) -> Self {
         let s = mech.state();
         Self {
@@ -291,7 +291,7 @@ impl<M: Mechanization> Ekf<M> {
     pub fn covariance(&self) -> &StateMat {
         &self.p
     }
-    /// Estimated biases (accelerometer [m/s²], gyro [rad/s]).
+    /// Estimated biases (accelerometer \[m/s²\], gyro \[rad/s\]).
     pub fn biases(&self) -> (Vec3, Vec3) {
         (self.b_a, self.b_g)
     }
@@ -536,7 +536,7 @@ impl<M: Mechanization> Ekf<M> {
         Ok(forced)
     }
 
-    /// Zero-velocity update with per-axis σ [m/s] (the caller decides when the vehicle is
+    /// Zero-velocity update with per-axis σ \[m/s\] (the caller decides when the vehicle is
     /// at rest).
     pub fn update_zupt(&mut self, sigma_mps: f64) -> Result<UpdateReport, FilterError> {
         self.propagate_covariance()?;
@@ -549,7 +549,7 @@ impl<M: Mechanization> Ekf<M> {
         self.update(MeasKind::Zupt, &h, &nu, &r, None)
     }
 
-    /// Non-holonomic constraint: body-frame lateral and vertical velocity zero, σ [m/s].
+    /// Non-holonomic constraint: body-frame lateral and vertical velocity zero, σ \[m/s\].
     pub fn update_nhc(&mut self, sigma_mps: f64) -> Result<UpdateReport, FilterError> {
         self.propagate_covariance()?;
         let ct = self.cur.c_b_n.transpose();

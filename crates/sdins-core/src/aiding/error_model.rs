@@ -48,23 +48,23 @@ pub const I_BG: usize = 12;
 pub struct ModelPoint {
     /// sin L, cos L of the latitude
     pub sin_cos_lat: (f64, f64),
-    /// height [m]
+    /// height \[m\]
     pub h_m: f64,
-    /// NED velocity [m/s]
+    /// NED velocity \[m/s\]
     pub v_n_mps: Vec3,
     /// attitude body → NED (maps the body-frame bias states)
     pub c_b_n: Mat3,
-    /// specific force in NED [m/s²]
+    /// specific force in NED \[m/s²\]
     pub f_n_mps2: Vec3,
-    /// meridian radius R_M [m]
+    /// meridian radius R_M \[m\]
     pub r_m_m: f64,
-    /// prime-vertical radius R_N [m]
+    /// prime-vertical radius R_N \[m\]
     pub r_n_m: f64,
-    /// gravity magnitude [m/s²]
+    /// gravity magnitude \[m/s²\]
     pub g_mps2: f64,
-    /// earth rate Ω [rad/s]
+    /// earth rate Ω \[rad/s\]
     pub omega_ie_rps: f64,
-    /// geocentric radius of the surface r_eS (Groves (2.137)) [m]
+    /// geocentric radius of the surface r_eS (Groves (2.137)) \[m\]
     pub r_es_m: f64,
 }
 
@@ -179,7 +179,7 @@ pub fn transition(f: &StateMat, dt: f64) -> StateMat {
     i + a * (i + a * (i + a / 3.0) / 2.0)
 }
 
-/// Position scale `T = diag(R_M + h, (R_N + h) cos L, −1)`: `δp_NED = T (δL, δλ, δh)` [m].
+/// Position scale `T = diag(R_M + h, (R_N + h) cos L, −1)`: `δp_NED = T (δL, δλ, δh)` \[m\].
 pub fn position_scale(r_m_m: f64, r_n_m: f64, cos_lat: f64, h_m: f64) -> Vec3 {
     Vec3::new(r_m_m + h_m, (r_n_m + h_m) * cos_lat, -1.0)
 }

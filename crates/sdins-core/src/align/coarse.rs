@@ -29,7 +29,7 @@ impl StaticMean {
         self.t_s += dt_s;
         self.n += 1;
     }
-    /// Window length [s].
+    /// Window length \[s\].
     pub fn duration_s(&self) -> f64 {
         self.t_s
     }
@@ -37,11 +37,11 @@ impl StaticMean {
     pub fn samples(&self) -> u64 {
         self.n
     }
-    /// Mean specific force f̄^b [m/s²] (None for an empty window).
+    /// Mean specific force f̄^b \[m/s²\] (None for an empty window).
     pub fn f_b(&self) -> Option<Vec3> {
         (self.t_s > 0.0).then(|| self.sum_dv / self.t_s)
     }
-    /// Mean angular rate ω̄^b [rad/s] (None for an empty window).
+    /// Mean angular rate ω̄^b \[rad/s\] (None for an empty window).
     pub fn omega_b(&self) -> Option<Vec3> {
         (self.t_s > 0.0).then(|| self.sum_dtheta / self.t_s)
     }
@@ -142,7 +142,7 @@ pub fn error_table(method: CoarseMethod, da_n: &Vec3, eps_n: &Vec3, site: &Site)
     Vec3::new(phi_n, phi_e, phi_d)
 }
 
-/// Noise-limited 1σ of a T_c-second average (spec §1.3), `vrw` [m/s/√s], `arw` [rad/√s]:
+/// Noise-limited 1σ of a T_c-second average (spec §1.3), `vrw` \[m/s/√s\], `arw` \[rad/√s\]:
 /// returns `(σ_tilt, σ_yaw, σ_φE(1-step))` with
 /// `σ_tilt = VRW/(g√T_c)`, `σ_yaw = √((ARW/(Ω cos L))²/T_c + (tan L σ_tilt)²)`,
 /// `σ_φE,1 = ½ √(VRW²(1 + tan²L)/g² + ARW²/(Ω cos L)²)/√T_c`.

@@ -40,17 +40,17 @@ pub struct FineConfig {
     pub site: Site,
     /// frame of the bias states
     pub bias_frame: BiasFrame,
-    /// Kalman-filter interval Δt [s] (spec: 0.1–1 s; reference 1 s)
+    /// Kalman-filter interval Δt \[s\] (spec: 0.1–1 s; reference 1 s)
     pub kf_dt_s: f64,
-    /// zero-velocity measurement σ_z [m/s] (spec §2.2: 1 mm/s on a benign pad)
+    /// zero-velocity measurement σ_z \[m/s\] (spec §2.2: 1 mm/s on a benign pad)
     pub sigma_z_mps: f64,
-    /// VRW [m/s/√s]
+    /// VRW \[m/s/√s\]
     pub vrw: f64,
-    /// ARW [rad/√s]
+    /// ARW \[rad/√s\]
     pub arw: f64,
-    /// accelerometer-bias random-walk PSD q_ba [(m/s²)²/s] (0 for constant biases)
+    /// accelerometer-bias random-walk PSD q_ba \[(m/s²)²/s\] (0 for constant biases)
     pub q_ba: f64,
-    /// gyro-bias random-walk PSD q_bg [(rad/s)²/s]
+    /// gyro-bias random-walk PSD q_bg \[(rad/s)²/s\]
     pub q_bg: f64,
     /// initial covariance P0 (bias blocks in the frame of `bias_frame`)
     pub p0: Mat12,
@@ -97,7 +97,7 @@ impl FineAlign {
         self.step_with_velocity(inc, dt_s, &Vec3::zeros())
     }
 
-    /// As [`Self::step`], with a measured reference velocity `ṽ^n` [m/s] (NED) used if a
+    /// As [`Self::step`], with a measured reference velocity `ṽ^n` \[m/s\] (NED) used if a
     /// Kalman cycle runs at the end of this sample: `z = v̂ − ṽ = H x + ν` with
     /// `ν = −(ṽ − v_true)` assumed `N(0, σ_z² I3)` (spec §2.2). For a vehicle at rest
     /// `ṽ = 0 + ν`; passing `ṽ = 0` is the plain zero-velocity update, whose actual
@@ -184,7 +184,7 @@ impl FineAlign {
     pub fn c_b_n_ins(&self) -> Mat3 {
         self.c_b_n
     }
-    /// INS velocity v̂ [m/s] (NED).
+    /// INS velocity v̂ \[m/s\] (NED).
     pub fn v_n(&self) -> Vec3 {
         self.v_n
     }
@@ -195,11 +195,11 @@ impl FineAlign {
             BiasFrame::Body => x,
         }
     }
-    /// Estimated accelerometer bias in body axes [m/s²] (applied + pending).
+    /// Estimated accelerometer bias in body axes \[m/s²\] (applied + pending).
     pub fn accel_bias_b(&self) -> Vec3 {
         self.ba_b + self.bias_b(6)
     }
-    /// Estimated gyro bias in body axes [rad/s] (applied + pending).
+    /// Estimated gyro bias in body axes \[rad/s\] (applied + pending).
     pub fn gyro_bias_b(&self) -> Vec3 {
         self.bg_b + self.bias_b(9)
     }
@@ -211,7 +211,7 @@ impl FineAlign {
     pub fn config(&self) -> &FineConfig {
         &self.cfg
     }
-    /// 1σ of the attitude error φ (NED) [rad].
+    /// 1σ of the attitude error φ (NED) \[rad\].
     pub fn attitude_sigma(&self) -> Vec3 {
         self.kf.sigma().fixed_rows::<3>(3).into_owned()
     }
@@ -224,15 +224,15 @@ impl FineAlign {
         };
         Vec3::from_fn(|i, _| libm::sqrt(pb[(i, i)].max(0.0)))
     }
-    /// 1σ of the accelerometer bias estimate, body axes [m/s²].
+    /// 1σ of the accelerometer bias estimate, body axes \[m/s²\].
     pub fn accel_bias_sigma_b(&self) -> Vec3 {
         self.bias_sigma_b(6)
     }
-    /// 1σ of the gyro bias estimate, body axes [rad/s].
+    /// 1σ of the gyro bias estimate, body axes \[rad/s\].
     pub fn gyro_bias_sigma_b(&self) -> Vec3 {
         self.bias_sigma_b(9)
     }
-    /// Time since start [s].
+    /// Time since start \[s\].
     pub fn time_s(&self) -> f64 {
         self.t_s
     }
@@ -243,7 +243,7 @@ impl FineAlign {
 }
 
 /// Reference settings of spec §2.3/§6 T4 with NED bias states, closed loop, KF at 1 Hz,
-/// σ_z = 1 mm/s and P0 of spec §2.3; `vrw` [m/s/√s], `arw` [rad/√s].
+/// σ_z = 1 mm/s and P0 of spec §2.3; `vrw` \[m/s/√s\], `arw` \[rad/√s\].
 pub fn reference_config(site: Site, vrw: f64, arw: f64) -> FineConfig {
     FineConfig {
         site,

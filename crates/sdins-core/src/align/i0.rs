@@ -138,7 +138,7 @@ impl InertialAlign {
         self.sum_v_n0 += v_n0;
     }
 
-    /// Elapsed time [s].
+    /// Elapsed time \[s\].
     pub fn duration_s(&self) -> f64 {
         self.t_s
     }
@@ -187,7 +187,7 @@ impl InertialAlign {
         Ok(c)
     }
 
-    /// RMS velocity residual of the fit [m/s],
+    /// RMS velocity residual of the fit \[m/s\],
     /// `√(Σ w_k |v^{n0}_k − C v^{ib0}_k|² / Σ w_k) = √((Σ w |v^{n0}|² + Σ w |v^{ib0}|² − 2 tr(Cᵀ B)) / Σ w)`:
     /// the disturbance (heave, surge, sway about an offset centre) velocity of the base
     /// plus the sensor-noise walk; the scale of the zero-velocity measurement error of a
@@ -234,8 +234,8 @@ fn triad(a1: &Vec3, a2: &Vec3, b1: &Vec3, b2: &Vec3) -> Result<Mat3, AlignError>
     }
 }
 
-/// Theoretical 1σ heading error [rad] of [`InertialAlign`] over a window `t_s` from
-/// angle random walk `arw` [rad/√s] and velocity random walk `vrw` [m/s/√s]
+/// Theoretical 1σ heading error \[rad\] of [`InertialAlign`] over a window `t_s` from
+/// angle random walk `arw` \[rad/√s\] and velocity random walk `vrw` \[m/s/√s\]
 /// (docs/alignment_i0.md §3): the fit part
 /// `4 (g² σ_g² T³ K₁ + σ_a² T K₂)/(T⁴ (g Ω cos L)²)` plus the gyro walk `σ_g² T` of
 /// `C_b^{ib0}(T)` about the vertical.
@@ -248,8 +248,8 @@ pub fn heading_sigma_rad(site: &Site, t_s: f64, arw: f64, vrw: f64) -> f64 {
     libm::sqrt(fit + arw * arw * t)
 }
 
-/// First-order heading error [rad] of [`InertialAlign`] at the end of a `t_s` window for
-/// constant NED biases `eps_n` [rad/s] and `nabla_n` [m/s²]: the gyrocompassing floor
+/// First-order heading error \[rad\] of [`InertialAlign`] at the end of a `t_s` window for
+/// constant NED biases `eps_n` \[rad/s\] and `nabla_n` \[m/s²\]: the gyrocompassing floor
 /// `δψ = −ε_E/(Ω cos L) + (∇_E/g) tan L` plus the drift `ε_D T` of `C_b^{ib0}` over the
 /// window (heading estimate minus truth = `φ_D` of convention G; docs/alignment_i0.md §2).
 pub fn heading_floor_rad(site: &Site, eps_n: &Vec3, nabla_n: &Vec3, t_s: f64) -> f64 {

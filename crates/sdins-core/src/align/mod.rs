@@ -72,11 +72,11 @@ impl core::fmt::Display for AlignError {
 /// earth rate (spec §0.4). The truth and the algorithm must use the same `g`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Site {
-    /// geodetic latitude L [rad]
+    /// geodetic latitude L \[rad\]
     pub lat_rad: f64,
-    /// local gravity magnitude g(L, h) [m/s²]
+    /// local gravity magnitude g(L, h) \[m/s²\]
     pub g_mps2: f64,
-    /// earth rate Ω [rad/s]
+    /// earth rate Ω \[rad/s\]
     pub omega_ie_rps: f64,
 }
 

@@ -2,7 +2,7 @@
 //!
 //! State (convention G, residual biases):
 //! `x = [δv_N, δv_E, δv_D, φ_N, φ_E, φ_D, δa (3), ε (3)]`, with the bias states either
-//! NED-resolved (spec §2.1, [P1]) or body-frame (spec §3.2, needed across rotations).
+//! NED-resolved (spec §2.1, \[P1\]) or body-frame (spec §3.2, needed across rotations).
 
 use super::Site;
 use crate::math::{skew, Mat3};
@@ -67,7 +67,7 @@ pub fn h_horizontal() -> SMatrix<f64, 2, 12> {
 }
 
 /// Continuous process-noise PSD `Q_c = diag(VRW² I3, ARW² I3, q_ba I3, q_bg I3)`
-/// (spec §2.1); `vrw` [m/s/√s], `arw` [rad/√s], `q_ba` [(m/s²)²/s], `q_bg` [(rad/s)²/s].
+/// (spec §2.1); `vrw` \[m/s/√s\], `arw` \[rad/√s\], `q_ba` \[(m/s²)²/s\], `q_bg` \[(rad/s)²/s\].
 pub fn q_continuous(vrw: f64, arw: f64, q_ba: f64, q_bg: f64) -> Mat12 {
     let mut d = Vec12::zeros();
     for i in 0..3 {
@@ -246,7 +246,7 @@ mod tests {
     }
 
     /// The pseudo model is the projection of the 12-state model: T9 F = F9 T9
-    /// (with the pseudo-9 state order [δv, φ', δa_D, ε'_N, ε'_D]).
+    /// (with the pseudo-9 state order \[δv, φ', δa_D, ε'_N, ε'_D\]).
     #[test]
     fn pseudo_model_is_consistent() {
         let s = site();

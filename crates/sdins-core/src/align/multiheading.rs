@@ -1,4 +1,4 @@
-//! Multi-heading alignment, Algorithm B of spec §3.3 (the [P1] "pseudo-error /
+//! Multi-heading alignment, Algorithm B of spec §3.3 (the \[P1\] "pseudo-error /
 //! multiple" method): per heading k a filter estimates the observable pseudo vector
 //! `p_k = [φ'_N, φ'_E, φ'_D, ε'_N, ε'_D, δa_D]` at time `t_k`; the unknowns
 //! `θ = [φ(t_0) (3), b_a^b (3), b_g^b (3)]` follow from stacking
@@ -139,7 +139,7 @@ pub struct AlgorithmB {
 /// Solution of Algorithm B.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AlgorithmBSolution {
-    /// θ = [φ(t_0) (NED, rad), b_a^b (m/s²), b_g^b (rad/s)]
+    /// θ = \[φ(t_0) (NED, rad), b_a^b (m/s²), b_g^b (rad/s)\]
     pub theta: SVector<f64, 9>,
     /// covariance of θ
     pub cov: SMatrix<f64, 9, 9>,

@@ -6,11 +6,11 @@ use super::Mat3;
 /// Roll, pitch, yaw in radians (3-2-1 sequence).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Euler {
-    /// roll φ [rad], rotation about body x
+    /// roll φ \[rad\], rotation about body x
     pub roll_rad: f64,
-    /// pitch θ [rad], rotation about the intermediate y
+    /// pitch θ \[rad\], rotation about the intermediate y
     pub pitch_rad: f64,
-    /// yaw ψ [rad], rotation about the navigation z (down), clockwise from north seen from above
+    /// yaw ψ \[rad\], rotation about the navigation z (down), clockwise from north seen from above
     pub yaw_rad: f64,
 }
 
@@ -53,7 +53,7 @@ pub fn c_b_n_from_sin_cos(roll: (f64, f64), pitch: (f64, f64), yaw: (f64, f64)) 
 }
 
 /// Euler angles of `c_b_n`: roll = atan2(C32, C33), pitch = −asin(C31), yaw = atan2(C21, C11).
-/// The pitch argument is clamped to [−1, 1] against roundoff.
+/// The pitch argument is clamped to \[−1, 1\] against roundoff.
 pub fn euler_from_c_b_n(c: &Mat3) -> Euler {
     let s = (-c[(2, 0)]).clamp(-1.0, 1.0);
     Euler {

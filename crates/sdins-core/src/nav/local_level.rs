@@ -68,7 +68,7 @@ pub struct LocalLevelConfig {
     pub rot3: bool,
     /// earth model (must equal the truth's)
     pub earth: EarthModel,
-    /// sensor sample period δt [s]
+    /// sensor sample period δt \[s\]
     pub dt_s: f64,
 }
 

@@ -23,15 +23,15 @@ use crate::math::{euler_from_c_b_n, Euler, Mat3, Quat, Vec3};
 /// Navigation state at one update epoch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NavState {
-    /// time since start [s]
+    /// time since start \[s\]
     pub t_s: f64,
-    /// geodetic latitude [rad]
+    /// geodetic latitude \[rad\]
     pub lat_rad: f64,
-    /// longitude [rad], wrapped to (−π, π]
+    /// longitude \[rad\], wrapped to (−π, π]
     pub lon_rad: f64,
-    /// height above the ellipsoid [m]
+    /// height above the ellipsoid \[m\]
     pub h_m: f64,
-    /// velocity over the earth in NED [m/s]
+    /// velocity over the earth in NED \[m/s\]
     pub v_n_mps: Vec3,
     /// attitude, body to NED
     pub c_b_n: Mat3,
@@ -51,13 +51,13 @@ impl NavState {
 /// Initial conditions of a navigation run.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InitialState {
-    /// latitude [rad]
+    /// latitude \[rad\]
     pub lat_rad: f64,
-    /// longitude [rad]
+    /// longitude \[rad\]
     pub lon_rad: f64,
-    /// height [m]
+    /// height \[m\]
     pub h_m: f64,
-    /// NED velocity [m/s]
+    /// NED velocity \[m/s\]
     pub v_n_mps: Vec3,
     /// attitude body to NED
     pub c_b_n: Mat3,

@@ -25,7 +25,7 @@ pub fn truth_config(scn: &Scenario) -> TruthConfig {
 pub struct Recorded {
     /// earth model of the scenario
     pub earth: EarthModel,
-    /// sensor period [s]
+    /// sensor period \[s\]
     pub dt_s: f64,
     /// exact initial state
     pub init: InitialState,

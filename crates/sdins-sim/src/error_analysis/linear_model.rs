@@ -124,14 +124,14 @@ impl ModelEarth {
 /// Specific force of a trajectory sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SpecificForce {
-    /// NED specific force f^n [m/s²]; bias states are then taken as NED-resolved
+    /// NED specific force f^n \[m/s²\]; bias states are then taken as NED-resolved
     /// (`C_b^n = I`).
     Nav(Vec3),
     /// Body attitude and body specific force.
     Body {
         /// body-to-NED DCM
         c_b_n: Mat3,
-        /// f^b [m/s²]
+        /// f^b \[m/s²\]
         f_b: Vec3,
     },
 }
@@ -145,7 +145,7 @@ pub struct TrajectorySample {
     pub lat_rad: f64,
     /// height \[m\]
     pub h_m: f64,
-    /// NED velocity [m/s]
+    /// NED velocity \[m/s\]
     pub v_n: Vec3,
     /// specific force
     pub force: SpecificForce,
@@ -214,13 +214,13 @@ pub struct ModelOptions {
 /// Process noise (continuous white-noise densities, per body axis).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ProcessNoise {
-    /// gyro angle random walk [rad/√s]
+    /// gyro angle random walk \[rad/√s\]
     pub arw_rad_per_sqrt_s: Vec3,
-    /// accelerometer velocity random walk [m/s/√s]
+    /// accelerometer velocity random walk \[m/s/√s\]
     pub vrw_mps_per_sqrt_s: Vec3,
-    /// accelerometer-bias random walk [m/s²/√s] (0: random constant)
+    /// accelerometer-bias random walk \[m/s²/√s\] (0: random constant)
     pub accel_bias_rw: Vec3,
-    /// gyro-bias random walk [rad/s/√s] (0: random constant)
+    /// gyro-bias random walk \[rad/s/√s\] (0: random constant)
     pub gyro_bias_rw: Vec3,
 }
 
@@ -229,13 +229,13 @@ pub struct ProcessNoise {
 pub struct ErrorVector {
     /// position error \[m\] NED
     pub dp_n_m: Vec3,
-    /// velocity error [m/s] NED
+    /// velocity error \[m/s\] NED
     pub dv_n: Vec3,
     /// attitude error φ (convention G) \[rad\]
     pub phi: Vec3,
-    /// accelerometer bias (body; NED if the trajectory gives f^n) [m/s²]
+    /// accelerometer bias (body; NED if the trajectory gives f^n) \[m/s²\]
     pub b_a: Vec3,
-    /// gyro bias (body; NED if the trajectory gives f^n) [rad/s]
+    /// gyro bias (body; NED if the trajectory gives f^n) \[rad/s\]
     pub b_g: Vec3,
 }
 
@@ -334,13 +334,13 @@ pub struct EnvelopePoint {
     pub t_s: f64,
     /// deterministic position error \[m\] NED (propagated initial state `x0`)
     pub dp_n_m: [f64; 3],
-    /// deterministic velocity error [m/s] NED
+    /// deterministic velocity error \[m/s\] NED
     pub dv_n: [f64; 3],
     /// deterministic attitude error φ \[rad\]
     pub phi: [f64; 3],
     /// 1σ position \[m\] NED
     pub sigma_p_m: [f64; 3],
-    /// 1σ velocity [m/s] NED
+    /// 1σ velocity \[m/s\] NED
     pub sigma_v: [f64; 3],
     /// 1σ attitude \[rad\]
     pub sigma_phi: [f64; 3],

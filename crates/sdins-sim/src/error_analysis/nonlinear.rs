@@ -47,7 +47,7 @@ pub struct NonlinearRun {
     pub lat_rad: f64,
     /// true attitude roll, pitch, yaw \[deg\] (body = NED: zeros)
     pub rpy_deg: [f64; 3],
-    /// body gyro bias [°/h]
+    /// body gyro bias \[°/h\]
     pub gyro_bias_dph: [f64; 3],
     /// body accelerometer bias \[μg\]
     pub accel_bias_ug: [f64; 3],

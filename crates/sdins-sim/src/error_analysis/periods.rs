@@ -14,9 +14,9 @@ use core::f64::consts::TAU;
 pub struct SchulerParams {
     /// Earth radius R0 \[m\]
     pub r0_m: f64,
-    /// gravity magnitude g [m/s²]
+    /// gravity magnitude g \[m/s²\]
     pub g_mps2: f64,
-    /// Earth rate Ω [rad/s]
+    /// Earth rate Ω \[rad/s\]
     pub omega_ie_rps: f64,
 }
 
@@ -49,7 +49,7 @@ impl SchulerParams {
         }
     }
 
-    /// Schuler angular frequency `ω_s = √(g/R0)` [rad/s].
+    /// Schuler angular frequency `ω_s = √(g/R0)` \[rad/s\].
     pub fn omega_s(&self) -> f64 {
         schuler_frequency(self.g_mps2, self.r0_m)
     }
@@ -59,13 +59,13 @@ impl SchulerParams {
         TAU / self.omega_s()
     }
 
-    /// Foucault angular frequency `ω_F = Ω sin L` [rad/s] (signed, positive north).
+    /// Foucault angular frequency `ω_F = Ω sin L` \[rad/s\] (signed, positive north).
     pub fn omega_f(&self, lat_rad: f64) -> f64 {
         foucault_frequency(self.omega_ie_rps, lat_rad)
     }
 }
 
-/// Schuler angular frequency `ω_s = √(g/R0)` [rad/s] (spec §4.1).
+/// Schuler angular frequency `ω_s = √(g/R0)` \[rad/s\] (spec §4.1).
 pub fn schuler_frequency(g_mps2: f64, r0_m: f64) -> f64 {
     (g_mps2 / r0_m).sqrt()
 }
@@ -75,7 +75,7 @@ pub fn schuler_period_s(g_mps2: f64, r0_m: f64) -> f64 {
     TAU / schuler_frequency(g_mps2, r0_m)
 }
 
-/// Foucault angular frequency `ω_F = Ω sin L` [rad/s] (spec §4.1).
+/// Foucault angular frequency `ω_F = Ω sin L` \[rad/s\] (spec §4.1).
 pub fn foucault_frequency(omega_ie_rps: f64, lat_rad: f64) -> f64 {
     omega_ie_rps * lat_rad.sin()
 }

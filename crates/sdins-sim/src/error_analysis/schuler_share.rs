@@ -30,8 +30,8 @@ pub const T_STAR_S: f64 = 6573.0;
 /// Latitude of the reconstruction, 37.5° \[rad\].
 pub const SHARE_LAT_RAD: f64 = 37.5 * core::f64::consts::PI / 180.0;
 
-/// Schuler share [%] of the spec §4.4 reconstruction for accelerometer bias `da`
-/// [m/s²] and gyro bias `dw` [rad/s] at time `t` \[s\]. Uses the single-channel formulas
+/// Schuler share \[%\] of the spec §4.4 reconstruction for accelerometer bias `da`
+/// \[m/s²\] and gyro bias `dw` \[rad/s\] at time `t` \[s\]. Uses the single-channel formulas
 /// beyond their 2 h validity on purpose (that is the definition). Returns 0 where the
 /// denominator vanishes (t = 0 or zero biases).
 pub fn schuler_share(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerParams) -> f64 {
@@ -54,7 +54,7 @@ pub fn schuler_share(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerParams) 
 /// Variant on the full stationary model (spec §4.3), defined here as
 /// `Σ_i ‖o_i'(t)‖ / Σ_i ‖δp_i(t)‖` over the three sources i = east gyro δω, down gyro δω,
 /// north accelerometer δa, each run alone through [`StationaryClosedForm`]; `o_i'` is the
-/// Foucault-rotated Schuler oscillation, norms are horizontal. [%]
+/// Foucault-rotated Schuler oscillation, norms are horizontal. \[%\]
 pub fn schuler_share_full(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerParams) -> f64 {
     let sources = [
         StationaryErrors {
@@ -92,9 +92,9 @@ pub struct ShareRow {
     pub grade: String,
     /// accelerometer bias \[μg\]
     pub accel_bias_ug: f64,
-    /// gyro bias [°/h]
+    /// gyro bias \[°/h\]
     pub gyro_bias_dph: f64,
-    /// Schuler share [%]
+    /// Schuler share \[%\]
     pub share_pct: f64,
 }
 

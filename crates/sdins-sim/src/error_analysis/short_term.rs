@@ -10,7 +10,7 @@
 //! because the spec §4.4 Schuler-share reconstruction deliberately evaluates them at
 //! any t; their doc comments say so.
 //!
-//! Units: R0 \[m\], t \[s\], ε [rad/s], δa [m/s²], results in metres. NED, convention G,
+//! Units: R0 \[m\], t \[s\], ε \[rad/s\], δa \[m/s²\], results in metres. NED, convention G,
 //! bias = measured − true.
 
 use super::periods::SchulerParams;
@@ -90,15 +90,15 @@ pub fn from_initial_velocity(dv0_n: &Vec3, t: f64, p: &SchulerParams) -> (f64, f
 pub struct ShortTermInputs {
     /// latitude L \[rad\]
     pub lat_rad: f64,
-    /// east velocity for (2) [m/s] (0 when stationary)
+    /// east velocity for (2) \[m/s\] (0 when stationary)
     pub v_e_mps: f64,
-    /// NED gyro bias ε [rad/s]
+    /// NED gyro bias ε \[rad/s\]
     pub eps_n: Vec3,
-    /// NED accelerometer bias δa [m/s²]
+    /// NED accelerometer bias δa \[m/s²\]
     pub da_n: Vec3,
     /// initial attitude error φ0 \[rad\]
     pub phi0: Vec3,
-    /// initial velocity error δv0 [m/s] (vertical ignored)
+    /// initial velocity error δv0 \[m/s\] (vertical ignored)
     pub dv0_n: Vec3,
 }
 

@@ -69,13 +69,13 @@ pub enum SlowGain {
 /// Errors and sensor biases driving the stationary closed form (NED, SI, convention G).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StationaryErrors {
-    /// NED gyro bias ε [rad/s]
+    /// NED gyro bias ε \[rad/s\]
     pub eps_n: Vec3,
-    /// NED accelerometer bias δa [m/s²] (the down component has no effect: vertical held)
+    /// NED accelerometer bias δa \[m/s²\] (the down component has no effect: vertical held)
     pub da_n: Vec3,
     /// initial attitude error φ0 (convention G) \[rad\]
     pub phi0: Vec3,
-    /// initial velocity error [m/s] (north, east used; down ignored, vertical held)
+    /// initial velocity error \[m/s\] (north, east used; down ignored, vertical held)
     pub dv0_n: Vec3,
     /// initial position error \[m\] (north, east used; down ignored)
     pub dp0_n: Vec3,
@@ -115,7 +115,7 @@ pub struct StationarySolution {
     pub t_s: f64,
     /// position error \[m\] NED (down = 0, vertical held)
     pub dp_n: [f64; 3],
-    /// velocity error [m/s] NED (down = 0)
+    /// velocity error \[m/s\] NED (down = 0)
     pub dv_n: [f64; 3],
     /// attitude error φ (convention G) \[rad\]
     pub phi: [f64; 3],
@@ -574,9 +574,9 @@ mod tests {
         assert!(((s3 - acc.eval(H).dp_n[0]) / s3).abs() < 0.01);
     }
 
-    /// spec §6 REF: body biases b_a = [50, −80, 30] μg, b_g = [0.01, −0.02, 0.015] °/h at
-    /// roll 2°, pitch −3°, yaw 40° resolve to δa = [89.2243, −30.8676, 29.7693] μg and
-    /// ε = [0.020261, −0.009774, 0.014797] °/h (printed digits).
+    /// spec §6 REF: body biases b_a = \[50, −80, 30\] μg, b_g = \[0.01, −0.02, 0.015\] °/h at
+    /// roll 2°, pitch −3°, yaw 40° resolve to δa = \[89.2243, −30.8676, 29.7693\] μg and
+    /// ε = \[0.020261, −0.009774, 0.014797\] °/h (printed digits).
     #[test]
     fn body_biases_resolve_to_spec_ref_ned_values() {
         let c = sdins_core::math::c_b_n_from_euler(&sdins_core::math::Euler {

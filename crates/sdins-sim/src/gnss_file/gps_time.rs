@@ -4,7 +4,7 @@
 /// Seconds in a GPS week.
 pub const SECONDS_PER_WEEK: f64 = 604_800.0;
 
-/// GPS − UTC [s] from each date (UTC, year, month, day) on: the leap seconds inserted since
+/// GPS − UTC \[s\] from each date (UTC, year, month, day) on: the leap seconds inserted since
 /// the GPS epoch, from IERS Bulletin C (the IERS leap-second list `Leap_Second.dat`); no leap
 /// second has been announced after the one at the end of 2016, so 18 s holds from
 /// 2017-01-01 until IERS announces the next.
@@ -57,7 +57,7 @@ pub fn gps_seconds_from_date(y: i32, mo: u32, d: u32, h: u32, mi: u32, s: f64) -
     days as f64 * 86_400.0 + f64::from(h) * 3600.0 + f64::from(mi) * 60.0 + s
 }
 
-/// GPS − UTC [s] on a UTC date (0 before 1981-07-01).
+/// GPS − UTC \[s\] on a UTC date (0 before 1981-07-01).
 pub fn gps_minus_utc_s(y: i32, mo: u32, d: u32) -> f64 {
     let day = days_from_civil(y, mo, d);
     LEAP_SECONDS

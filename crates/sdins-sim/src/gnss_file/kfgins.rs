@@ -1,6 +1,6 @@
 //! KF-GINS GNSS text: one fix per line, `t lat lon h σN σE σD` whitespace (or comma)
-//! separated, no header; `t` GPS seconds of week [s], latitude/longitude [deg], height [m]
-//! (KF-GINS uses it as ellipsoidal), σ [m] north, east, down. A week rollover inside the
+//! separated, no header; `t` GPS seconds of week \[s\], latitude/longitude \[deg\], height \[m\]
+//! (KF-GINS uses it as ellipsoidal), σ \[m\] north, east, down. A week rollover inside the
 //! file (time dropping by more than half a week) is unwrapped by adding 604 800 s.
 
 use super::rows::{self, check_cut_number, Ctx};

@@ -1,7 +1,7 @@
 //! NaveGo's GNSS data as converted to CSV: header
 //! `t_s,lat_rad,lon_rad,h_m,v_n_mps,v_e_mps,v_d_mps` (the header may be missing when the
 //! format is given), one fix per row; NaveGo keeps σ out of the data, so the position
-//! covariance is `diag(stdm²)` (stdm = [north, east, height] m) and the velocity covariance
+//! covariance is `diag(stdm²)` (stdm = \[north, east, height\] m) and the velocity covariance
 //! `diag(stdv²)` from `gnss_params.txt`.
 
 use super::rows::{self, Ctx};

@@ -292,7 +292,7 @@ pub(crate) fn check_cut_number(
     Ok(())
 }
 
-/// Wrap a longitude [rad] into (−π, π].
+/// Wrap a longitude \[rad\] into (−π, π].
 pub(crate) fn wrap_lon_rad(lon: f64) -> f64 {
     use std::f64::consts::PI;
     let mut l = lon % (2.0 * PI);

@@ -1,8 +1,8 @@
 //! sdins GNSS CSV (`docs/gnss-files.md`): header
 //! `t_s,lat_deg,lon_deg,h_m,sigma_n_m,sigma_e_m,sigma_d_m`, optionally followed by
-//! `v_n_mps,v_e_mps,v_d_mps,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps`; times [s] on the IMU
-//! file's clock, WGS-84 geodetic latitude/longitude [deg], ellipsoidal height [m], σ [m]
-//! north/east/down, NED velocity [m/s] and its σ [m/s]; covariances diagonal.
+//! `v_n_mps,v_e_mps,v_d_mps,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps`; times \[s\] on the IMU
+//! file's clock, WGS-84 geodetic latitude/longitude \[deg\], ellipsoidal height \[m\], σ \[m\]
+//! north/east/down, NED velocity \[m/s\] and its σ \[m/s\]; covariances diagonal.
 
 use super::rows::{self, Ctx};
 use super::{finish, GnssData, GnssFileError, GnssFormat, GnssReadReport, TimeBase};

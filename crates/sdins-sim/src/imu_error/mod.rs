@@ -40,7 +40,7 @@
 //! * flicker (bias instability B, the datasheet "Allan floor" value): a sum of
 //!   Gauss–Markov terms with correlation times spaced by a factor 3 over
 //!   [`ImuErrorModel::flicker_tau_s`], equal σ, scaled so that the Allan deviation
-//!   of the sum averages (in log) `0.664·B` over τ ∈ [4·T_min, T_max/2] (IEEE Std
+//!   of the sum averages (in log) `0.664·B` over τ ∈ \[4·T_min, T_max/2\] (IEEE Std
 //!   952: flicker floor = B·√(2 ln2/π)); it stays within ±10 % of that there;
 //! * turn-on bias: drawn once per run, `b ~ N(0, σ²)`; the fixed bias is added as
 //!   given.
@@ -59,7 +59,7 @@ pub use state::ImuErrorState;
 
 use serde::{Deserialize, Serialize};
 
-/// Units: one degree [rad].
+/// Units: one degree \[rad\].
 pub const DEG: f64 = core::f64::consts::PI / 180.0;
 /// Units: 1 °/h in rad/s.
 pub const DPH: f64 = DEG / 3600.0;
@@ -67,7 +67,7 @@ pub const DPH: f64 = DEG / 3600.0;
 pub const DPSH: f64 = DEG / 60.0;
 /// Units: 1 °/h/√h in rad/s/√s.
 pub const DPHPSH: f64 = DPH / 60.0;
-/// Standard gravity for μg and g conversions [m/s²] (spec §0.4).
+/// Standard gravity for μg and g conversions \[m/s²\] (spec §0.4).
 pub const G0: f64 = 9.80665;
 /// Units: 1 μg in m/s².
 pub const UG: f64 = 1e-6 * G0;
@@ -77,7 +77,7 @@ pub const UG_PER_SQRT_HZ: f64 = UG;
 pub const MPS_PER_SQRT_H: f64 = 1.0 / 60.0;
 /// Units: 1 μg/√h (accelerometer random walk) in m/s²/√s.
 pub const UG_PER_SQRT_H: f64 = UG / 60.0;
-/// Units: one arcsecond [rad].
+/// Units: one arcsecond \[rad\].
 pub const ARCSEC: f64 = DEG / 3600.0;
 /// Units: 1 ppm.
 pub const PPM: f64 = 1e-6;
@@ -111,64 +111,64 @@ pub enum ImuErrorModelError {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ImuErrorModel {
-    /// Fixed (known-value) gyro bias [°/h].
+    /// Fixed (known-value) gyro bias \[°/h\].
     pub gyro_bias_dph: [f64; 3],
-    /// Turn-on (run-to-run) gyro bias σ [°/h], drawn once per run.
+    /// Turn-on (run-to-run) gyro bias σ \[°/h\], drawn once per run.
     pub gyro_bias_turn_on_dph: [f64; 3],
-    /// First-order Gauss–Markov gyro bias: steady-state σ [°/h].
+    /// First-order Gauss–Markov gyro bias: steady-state σ \[°/h\].
     pub gyro_bias_gm_dph: [f64; 3],
-    /// First-order Gauss–Markov gyro bias: correlation time [s] (used where σ > 0).
+    /// First-order Gauss–Markov gyro bias: correlation time \[s\] (used where σ > 0).
     pub gyro_bias_gm_tau_s: [f64; 3],
-    /// Gyro bias instability B (flicker, Allan floor = 0.664·B) [°/h].
+    /// Gyro bias instability B (flicker, Allan floor = 0.664·B) \[°/h\].
     pub gyro_bias_instability_dph: [f64; 3],
-    /// Angle random walk [°/√h].
+    /// Angle random walk \[°/√h\].
     pub gyro_arw_dpsh: [f64; 3],
-    /// Rate random walk [°/h/√h].
+    /// Rate random walk \[°/h/√h\].
     pub gyro_rrw_dphpsh: [f64; 3],
-    /// Gyro scale-factor error [ppm].
+    /// Gyro scale-factor error \[ppm\].
     pub gyro_scale_ppm: [f64; 3],
-    /// Gyro scale-factor asymmetry a [ppm]: the scale error is s + a for a positive
+    /// Gyro scale-factor asymmetry a \[ppm\]: the scale error is s + a for a positive
     /// rate and s − a for a negative one.
     pub gyro_scale_asym_ppm: [f64; 3],
-    /// Gyro misalignment / non-orthogonality, small-angle matrix [mrad]:
+    /// Gyro misalignment / non-orthogonality, small-angle matrix \[mrad\]:
     /// `ω̃ ∋ M ω` (row i = output axis i).
     pub gyro_misalignment_mrad: [[f64; 3]; 3],
-    /// Gyro g-sensitivity matrix [°/h/g]: `δω = G f / g0`.
+    /// Gyro g-sensitivity matrix \[°/h/g\]: `δω = G f / g0`.
     pub gyro_g_sensitivity_dphpg: [[f64; 3]; 3],
-    /// Gyro output quantum (angle per pulse) [arcsec]; 0 = none.
+    /// Gyro output quantum (angle per pulse) \[arcsec\]; 0 = none.
     pub gyro_quantum_arcsec: [f64; 3],
-    /// Gyro measuring range (saturation) [°/s]; `None` = unlimited.
+    /// Gyro measuring range (saturation) \[°/s\]; `None` = unlimited.
     pub gyro_range_dps: Option<[f64; 3]>,
 
-    /// Fixed (known-value) accelerometer bias [μg].
+    /// Fixed (known-value) accelerometer bias \[μg\].
     pub accel_bias_ug: [f64; 3],
-    /// Turn-on (run-to-run) accelerometer bias σ [μg], drawn once per run.
+    /// Turn-on (run-to-run) accelerometer bias σ \[μg\], drawn once per run.
     pub accel_bias_turn_on_ug: [f64; 3],
-    /// First-order Gauss–Markov accelerometer bias: steady-state σ [μg].
+    /// First-order Gauss–Markov accelerometer bias: steady-state σ \[μg\].
     pub accel_bias_gm_ug: [f64; 3],
-    /// First-order Gauss–Markov accelerometer bias: correlation time [s].
+    /// First-order Gauss–Markov accelerometer bias: correlation time \[s\].
     pub accel_bias_gm_tau_s: [f64; 3],
-    /// Accelerometer bias instability B (flicker) [μg].
+    /// Accelerometer bias instability B (flicker) \[μg\].
     pub accel_bias_instability_ug: [f64; 3],
-    /// Velocity random walk [μg/√Hz] (1 μg/√Hz = 9.80665e-6 m/s/√s).
+    /// Velocity random walk \[μg/√Hz\] (1 μg/√Hz = 9.80665e-6 m/s/√s).
     pub accel_vrw_ugpsqrthz: [f64; 3],
-    /// Velocity random walk [m/s/√h]; added in quadrature to
+    /// Velocity random walk \[m/s/√h\]; added in quadrature to
     /// [`Self::accel_vrw_ugpsqrthz`] (normally only one of the two is set).
     pub accel_vrw_mpsph: [f64; 3],
-    /// Acceleration random walk [μg/√h].
+    /// Acceleration random walk \[μg/√h\].
     pub accel_rrw_ugpsh: [f64; 3],
-    /// Accelerometer scale-factor error [ppm].
+    /// Accelerometer scale-factor error \[ppm\].
     pub accel_scale_ppm: [f64; 3],
-    /// Accelerometer scale-factor asymmetry [ppm] (s ± a, as for the gyro).
+    /// Accelerometer scale-factor asymmetry \[ppm\] (s ± a, as for the gyro).
     pub accel_scale_asym_ppm: [f64; 3],
-    /// Accelerometer misalignment / non-orthogonality matrix [mrad].
+    /// Accelerometer misalignment / non-orthogonality matrix \[mrad\].
     pub accel_misalignment_mrad: [[f64; 3]; 3],
-    /// Accelerometer output quantum (velocity per pulse) [m/s]; 0 = none.
+    /// Accelerometer output quantum (velocity per pulse) \[m/s\]; 0 = none.
     pub accel_quantum_mps: [f64; 3],
-    /// Accelerometer measuring range (saturation) [g]; `None` = unlimited.
+    /// Accelerometer measuring range (saturation) \[g\]; `None` = unlimited.
     pub accel_range_g: Option<[f64; 3]>,
 
-    /// Range of the flicker Gauss–Markov correlation times [s] (default 0.1…10 000 s).
+    /// Range of the flicker Gauss–Markov correlation times \[s\] (default 0.1…10 000 s).
     pub flicker_tau_s: [f64; 2],
 }
 

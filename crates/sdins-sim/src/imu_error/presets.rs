@@ -1,6 +1,6 @@
 //! Sensor-grade presets (spec `alignment_and_errors.md` §4.5).
 //!
-//! Source of the table: spec §4.5, which quotes [P2] (Ko, Lee, Park, Kim & Song,
+//! Source of the table: spec §4.5, which quotes \[P2\] (Ko, Lee, Park, Kim & Song,
 //! "Analysis of SDINS Performance According to Schuler Period Error Effect") for the
 //! bias ranges and Groves, *Principles of GNSS, Inertial, and Multisensor Integrated
 //! Navigation Systems* (2nd ed.), Tables 4.1/4.2, for the typical biases. The noise
@@ -53,9 +53,9 @@ use serde::Serialize;
 pub struct P2Box {
     /// accelerometer-bias range \[μg\] (min, max)
     pub accel_bias_ug: (f64, f64),
-    /// gyro-bias range [°/h] (min, max)
+    /// gyro-bias range \[°/h\] (min, max)
     pub gyro_bias_dph: (f64, f64),
-    /// reported Schuler share [%] (min, max)
+    /// reported Schuler share \[%\] (min, max)
     pub share_pct: (f64, f64),
 }
 
@@ -67,11 +67,11 @@ pub struct Grade {
     pub name: &'static str,
     /// accelerometer turn-on bias σ \[μg\]
     pub accel_bias_turn_on_ug: f64,
-    /// gyro turn-on bias σ [°/h]
+    /// gyro turn-on bias σ \[°/h\]
     pub gyro_bias_turn_on_dph: f64,
     /// velocity random walk \[μg/√Hz\]
     pub accel_vrw_ugpsqrthz: f64,
-    /// angle random walk [°/√h]
+    /// angle random walk \[°/√h\]
     pub gyro_arw_dpsh: f64,
     /// true when the noise values are the spec's engineering interpolation
     pub noise_interpolated: bool,
@@ -88,11 +88,11 @@ impl Grade {
     pub fn arw_si(&self) -> f64 {
         self.gyro_arw_dpsh * DEG / 60.0
     }
-    /// Accelerometer turn-on bias σ [m/s²].
+    /// Accelerometer turn-on bias σ \[m/s²\].
     pub fn accel_bias_si(&self) -> f64 {
         self.accel_bias_turn_on_ug * UG
     }
-    /// Gyro turn-on bias σ [rad/s].
+    /// Gyro turn-on bias σ \[rad/s\].
     pub fn gyro_bias_si(&self) -> f64 {
         self.gyro_bias_turn_on_dph * DEG / 3600.0
     }

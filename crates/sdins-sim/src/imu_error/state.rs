@@ -172,7 +172,7 @@ impl Channel {
         }
     }
 
-    /// Additive error of this sample (bias terms + white noise) [rad/s or m/s²].
+    /// Additive error of this sample (bias terms + white noise) \[rad/s or m/s²\].
     fn additive(&mut self, dt_s: f64) -> f64 {
         let mut e = self.bias;
         if self.white > 0.0 {
@@ -289,7 +289,7 @@ impl ImuErrorState {
     }
 
     /// The constant part of the bias of this run (fixed + drawn turn-on):
-    /// gyro [rad/s], accel [m/s²].
+    /// gyro \[rad/s\], accel \[m/s²\].
     pub fn constant_bias(&self) -> (Vec3, Vec3) {
         (
             Vec3::new(self.gyro[0].bias, self.gyro[1].bias, self.gyro[2].bias),
@@ -297,7 +297,7 @@ impl ImuErrorState {
         )
     }
 
-    /// Corrupt one sample of period `dt_s` [s]. A non-positive or non-finite `dt_s`
+    /// Corrupt one sample of period `dt_s` \[s\]. A non-positive or non-finite `dt_s`
     /// returns the input unchanged (and consumes no random numbers).
     pub fn apply(&mut self, inc: &Increment, dt_s: f64) -> Increment {
         if !(dt_s.is_finite() && dt_s > 0.0) {

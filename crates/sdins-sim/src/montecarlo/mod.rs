@@ -9,7 +9,7 @@
 //!   output epoch. Long runs with sensor errors use the vertical channel **held** to the
 //!   truth (the free inertial vertical channel diverges, spec §4.3), so the horizontal
 //!   channels are the ones to compare; the down channels are then zero.
-//! * Channels ([`CHANNELS`]): position error N, E, D \[m\], velocity error N, E, D [m/s],
+//! * Channels ([`CHANNELS`]): position error N, E, D \[m\], velocity error N, E, D \[m/s\],
 //!   attitude error ε N, E, D \[rad\] (convention G, `C_alg C_trueᵀ = I + [ε×]`).
 //! * Statistics per epoch and channel: mean, sample σ = √(M2/(n − 1)), and the 5/50/95 %
 //!   percentiles ([`histogram`]).
