@@ -240,10 +240,12 @@ pub fn run<'py>(
             return Err(err(format!("--until-s {u}: expected > 0")));
         }
     }
+    // as `sdins run`: observe every update (so `max_abs` is over every update, as the
+    // CLI's), keep every `every`-th one and the last one as the output series
     let opts = RunOptions {
         algos: specs.clone(),
         vertical_hold: hold,
-        every,
+        every: 1,
         until_s,
         sensor_run: if ideal.unwrap_or(false) {
             None
@@ -256,16 +258,30 @@ pub fn run<'py>(
         let mut cols: Vec<(States, Errors)> = (0..k)
             .map(|_| (States::default(), Errors::default()))
             .collect();
+        let mut updates = vec![0_u64; k];
+        let mut pending = vec![None; k];
         let r = run_cancellable(
             scn,
             &opts,
             tok,
             |i, st, _tr, e| {
-                cols[i].0.push(e.t_s, st);
-                cols[i].1.push(e);
+                updates[i] += 1;
+                if updates[i] % every == 0 {
+                    pending[i] = None;
+                    cols[i].0.push(e.t_s, st);
+                    cols[i].1.push(e);
+                } else {
+                    pending[i] = Some((*st, *e));
+                }
             },
             |_, _| {},
         );
+        for (i, p) in pending.into_iter().enumerate() {
+            if let Some((st, e)) = p {
+                cols[i].0.push(e.t_s, &st);
+                cols[i].1.push(&e);
+            }
+        }
         (cols, r)
     })?;
     let sums = sums.map_err(|_| err("interrupted"))?;
