@@ -140,6 +140,13 @@ fn align_bad_input_exits_2() {
     let _ = std::fs::remove_file(&d);
     let (code, _, err) = sdins(&["align", "alignment", "--window-s", "0"]);
     assert_eq!(code, 2, "{err}");
+    // numeric options: NaN and negative noise values are bad input naming the option
+    for (opt, val) in [("--vrw", "nan"), ("--arw", "-1"), ("--duration-s", "0")] {
+        let a = format!("{opt}={val}");
+        let (code, _, err) = sdins(&["align", "alignment", "--method", "fine", &a]);
+        assert_eq!(code, 2, "{a}: {err}");
+        assert!(err.contains(opt), "{a}: {err}");
+    }
 }
 
 /// `--method i0` on the moored ship recovers the heading at the window end within 0.05°

@@ -281,6 +281,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.sigma_z
         )));
     }
+    // every numeric option finite and in range (a NaN noise value used to give NaN results)
+    for (name, v, lo, lo_open, hi) in [
+        ("--vrw", args.vrw, 0.0, false, 1e6),
+        ("--arw", args.arw, 0.0, false, 1e3),
+        ("--duration-s", args.duration_s, 0.0, true, 1e7),
+        ("--lat", args.lat, -89.99, false, 89.99),
+        ("--h", args.h, -1000.0, false, 100_000.0),
+    ] {
+        if let Some(x) = v {
+            let low_ok = if lo_open { x > lo } else { x >= lo };
+            if !(x.is_finite() && low_ok && x <= hi) {
+                return Err(CliError::bad(format!(
+                    "{name} {x}: expected a finite value in {}{lo}, {hi}]",
+                    if lo_open { "(" } else { "[" }
+                )));
+            }
+        }
+    }
     let mut inp = load(&args)?;
     if let Some(d) = args.duration_s {
         let n = (d / inp.dt_s).round().max(0.0) as usize;
