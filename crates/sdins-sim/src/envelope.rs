@@ -219,16 +219,6 @@ pub fn check_trajectory(
         max_abs_lat_rad: start.lat_rad.abs(),
         ..EnvelopeReport::default()
     };
-    let seg_of = |t: f64| {
-        traj.segments()
-            .iter()
-            .rposition(|s| s.t0_s <= t)
-            .or(if traj.segments().is_empty() {
-                None
-            } else {
-                Some(0)
-            })
-    };
     let overlays_at = |t: f64| -> Vec<usize> {
         traj.overlays()
             .iter()
@@ -242,7 +232,7 @@ pub fn check_trajectory(
         value,
         limit,
         t_s: t,
-        segment: seg_of(t),
+        segment: traj.segment_at(t),
         overlays: overlays_at(t),
     };
     let check_point = |t: f64, t_sel: f64, rep: &mut EnvelopeReport| {

@@ -299,6 +299,7 @@ pub fn run_cancellable(
     let mut last = vec![NavError::default(); mechs.len()];
     let mut maxes = vec![NavError::default(); mechs.len()];
     let every = opts.every.max(1);
+    let mut epochs: Vec<(usize, NavState)> = Vec::with_capacity(BLOCK);
     let mut done = 0_u64;
     while done < total_updates {
         cancel.check()?;
@@ -322,34 +323,28 @@ pub fn run_cancellable(
         }
         let count = ends.len();
         for (i, m) in mechs.iter_mut().enumerate() {
-            // timed update runs between observation epochs; observation is untimed
-            let mut u = 0;
-            while u < count {
-                let global = done + u as u64; // updates completed before this one
-                let to_epoch = every - (global % every); // updates until the next epoch
-                let stop = (u + to_epoch as usize).min(count);
-                let t0 = Instant::now();
+            // one timed pass over the block (two clock reads per block, not per epoch: with
+            // every = 1 per-epoch timing measured the clock); the states of the output
+            // epochs are kept and observed after the pass, untimed
+            epochs.clear();
+            let t0 = Instant::now();
+            for k in 0..count {
+                m.update(&incs[k * n..(k + 1) * n]);
                 if opts.vertical_hold {
-                    for (k, end) in ends.iter().enumerate().take(stop).skip(u) {
-                        m.update(&incs[k * n..(k + 1) * n]);
-                        m.hold_vertical(end.h_m, end.v_n_mps.z);
-                    }
-                } else {
-                    for k in u..stop {
-                        m.update(&incs[k * n..(k + 1) * n]);
-                    }
+                    m.hold_vertical(ends[k].h_m, ends[k].v_n_mps.z);
                 }
-                wall[i] += t0.elapsed().as_secs_f64();
-                let finished = done + stop as u64;
+                let finished = done + k as u64 + 1;
                 if finished.is_multiple_of(every) || finished == total_updates {
-                    let tr = &ends[stop - 1];
-                    let st = m.state();
-                    let e = nav_error(&earth, &st, tr);
-                    last[i] = e;
-                    maxes[i] = maxes[i].max_abs(&e);
-                    observe(i, &st, tr, &e);
+                    epochs.push((k, m.state()));
                 }
-                u = stop;
+            }
+            wall[i] += t0.elapsed().as_secs_f64();
+            for (k, st) in &epochs {
+                let tr = &ends[*k];
+                let e = nav_error(&earth, st, tr);
+                last[i] = e;
+                maxes[i] = maxes[i].max_abs(&e);
+                observe(i, st, tr, &e);
             }
         }
         done += count as u64;

@@ -567,7 +567,7 @@ impl Trajectory {
     }
 
     /// Index of the segment whose branch `t_sel` selects.
-    fn segment_at(&self, t_sel: f64) -> Option<usize> {
+    pub fn segment_at(&self, t_sel: f64) -> Option<usize> {
         // Segments are few; linear search from the end finds the last one starting ≤ t_sel.
         self.segments
             .iter()
