@@ -8,6 +8,7 @@
 //! `profile = "smooth"` also works at zero speed), see [`multiheading_trajectory`]; no
 //! new segment type is needed.
 
+use crate::cancel::{CancelToken, Cancelled, POLL_EVERY_SAMPLES};
 use crate::imu_error::{ImuErrorModel, ImuErrorModelError, ImuErrorState};
 use crate::trajectory::{Motion, Trajectory};
 use crate::truth::{auto_substeps, TruthConfig, TruthGenerator};
@@ -22,6 +23,24 @@ use sdins_core::coning::Increment;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{dcm_from_rotvec, Euler, Mat3, Vec3};
 
+/// Why an alignment runner stopped without a result.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum AlignStop {
+    /// the alignment mathematics failed (degenerate geometry, too few samples, ...)
+    #[error("{0}")]
+    Align(AlignError),
+    /// stopped through the [`CancelToken`]
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
+}
+
+impl From<AlignError> for AlignStop {
+    fn from(e: AlignError) -> Self {
+        AlignStop::Align(e)
+    }
+}
+
 /// Exact (error-free) IMU increments of a trajectory with the true attitude at the end
 /// of every sample.
 #[derive(Clone, Debug)]
@@ -34,6 +53,8 @@ pub struct TruthRecord {
     pub c_b_n: Vec<Mat3>,
     /// true `C_b^n` at t = 0
     pub c_b_n0: Mat3,
+    /// true speed `‖v^n‖` at the end of each sample \[m/s\]
+    pub speed_mps: Vec<f64>,
     /// site (latitude, gravity and earth rate of the truth's earth model)
     pub site: Site,
 }
@@ -60,15 +81,18 @@ pub fn truth_record(
     let n = gen.len_samples() as usize;
     let mut increments = Vec::with_capacity(n);
     let mut c_b_n = Vec::with_capacity(n);
+    let mut speed_mps = Vec::with_capacity(n);
     for s in gen {
         increments.push(s.inc);
         c_b_n.push(s.c_b_n);
+        speed_mps.push(s.v_n_mps.norm());
     }
     TruthRecord {
         dt_s,
         increments,
         c_b_n,
         c_b_n0,
+        speed_mps,
         site: Site::from_earth(&earth, lat_rad, h_m),
     }
 }
@@ -221,7 +245,8 @@ pub fn fine_from_i0<F: FnMut(usize, &FineAlign)>(
     mut cfg: FineConfig,
     n: usize,
     on_update: F,
-) -> Result<(FineAlign, Mat3, f64), AlignError> {
+    token: &CancelToken,
+) -> Result<(FineAlign, Mat3, f64), AlignStop> {
     let mut a = InertialAlign::new(cfg.site);
     for inc in incs.iter().take(n) {
         a.add(inc, dt_s);
@@ -236,7 +261,7 @@ pub fn fine_from_i0<F: FnMut(usize, &FineAlign)>(
         cfg.kf_dt_s,
     ));
     let sz = cfg.sigma_z_mps;
-    let first = run_fine(incs, dt_s, cfg, &c0, |_, _| {});
+    let first = run_fine(incs, dt_s, cfg, &c0, |_, _| {}, token)?;
     // C_b^{ib0}(T) from the gyros
     let mut q = sdins_core::math::Quat::IDENTITY;
     for inc in incs {
@@ -247,25 +272,30 @@ pub fn fine_from_i0<F: FnMut(usize, &FineAlign)>(
     let t = incs.len() as f64 * dt_s;
     let r = dcm_from_rotvec(&(cfg.site.omega_ie_n() * t));
     let c0b = sdins_core::math::orthonormalize(&(r * first.c_b_n() * q.to_dcm().transpose()));
-    Ok((run_fine(incs, dt_s, cfg, &c0b, on_update), c0b, sz))
+    Ok((run_fine(incs, dt_s, cfg, &c0b, on_update, token)?, c0b, sz))
 }
 
 /// Run a fine alignment over `incs` from `c0`; `on_update(j, &filter)` is called after
-/// every Kalman cycle, with `j` the index of the sample that ended it.
+/// every Kalman cycle, with `j` the index of the sample that ended it. `token` is polled
+/// every [`POLL_EVERY_SAMPLES`] samples.
 pub fn run_fine<F: FnMut(usize, &FineAlign)>(
     incs: &[Increment],
     dt_s: f64,
     cfg: FineConfig,
     c0: &Mat3,
     mut on_update: F,
-) -> FineAlign {
+    token: &CancelToken,
+) -> Result<FineAlign, Cancelled> {
     let mut fa = FineAlign::new(cfg, c0);
     for (j, inc) in incs.iter().enumerate() {
+        if j as u64 % POLL_EVERY_SAMPLES == 0 {
+            token.check()?;
+        }
         if fa.step(inc, dt_s) {
             on_update(j, &fa);
         }
     }
-    fa
+    Ok(fa)
 }
 
 /// Result of a multi-heading alignment.
@@ -292,12 +322,13 @@ pub fn algorithm_a<F: FnMut(usize, &FineAlign)>(
     mut cfg: FineConfig,
     coarse_s: f64,
     on_update: F,
-) -> Result<MultiHeadingResult, AlignError> {
+    token: &CancelToken,
+) -> Result<MultiHeadingResult, AlignStop> {
     let n = (coarse_s / dt_s).round() as usize;
     let c0 = coarse_window(incs, dt_s, 0, n, &cfg.site, CoarseMethod::TwoStep)?;
     cfg.bias_frame = BiasFrame::Body;
     cfg.closed_loop = true;
-    let fa = run_fine(incs, dt_s, cfg, &c0, on_update);
+    let fa = run_fine(incs, dt_s, cfg, &c0, on_update, token)?;
     Ok(MultiHeadingResult {
         c_b_n: fa.c_b_n(),
         accel_bias_b: fa.accel_bias_b(),
@@ -319,7 +350,8 @@ pub fn algorithm_b(
     mut cfg: FineConfig,
     coarse_s: f64,
     phases: &[(f64, f64)],
-) -> Result<MultiHeadingResult, AlignError> {
+    token: &CancelToken,
+) -> Result<MultiHeadingResult, AlignStop> {
     let site = cfg.site;
     let n = (coarse_s / dt_s).round() as usize;
     let c0 = coarse_window(incs, dt_s, 0, n, &site, CoarseMethod::TwoStep)?;
@@ -335,6 +367,9 @@ pub fn algorithm_b(
     let ends: Vec<usize> = phases.iter().map(|p| idx(p.0 + p.1)).collect();
     let mut last_t = 0.0;
     for (j, inc) in incs.iter().enumerate() {
+        if j as u64 % POLL_EVERY_SAMPLES == 0 {
+            token.check()?;
+        }
         if starts.contains(&j) && j > 0 {
             fa.restart(&p0);
         }

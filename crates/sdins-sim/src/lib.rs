@@ -44,6 +44,7 @@
 //! `cargo run --release -p sdins-sim --example navigate` is the same tour at full length.
 
 pub mod align;
+pub mod align_run;
 pub mod allan;
 pub mod cancel;
 pub mod envelope;

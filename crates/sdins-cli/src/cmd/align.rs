@@ -16,21 +16,19 @@
 use super::align_plot::{write_plots, HistRow};
 use crate::error::CliError;
 use crate::output::write_string;
-use sdins_core::align::coarse::CoarseMethod;
-use sdins_core::align::fine::{reference_config, FineAlign, FineConfig};
+use sdins_core::align::fine::FineConfig;
 use sdins_core::align::model::{f_matrix, f_pseudo9, h_horizontal, h_zupt, BiasFrame, Mat12};
 use sdins_core::align::observability::{analyze, scale12, scale9};
 use sdins_core::align::Site;
-use sdins_core::coning::Increment;
 use sdins_core::earth::EarthModel;
-use sdins_core::math::{attitude_error, c_b_n_from_euler, euler_from_c_b_n, Euler, Mat3, Vec3};
-use sdins_sim::align::{
-    algorithm_a, algorithm_b, coarse_window, corrupt, fine_from_i0, i0_window, truth_record,
+use sdins_core::math::{c_b_n_from_euler, Euler, Mat3, Vec3};
+use sdins_sim::align_run::{
+    align, check_options, AlignInput, AlignMethod, AlignOptions, AlignOutcome, AlignRunError,
+    FineStart, MultiheadingAlg,
 };
 use sdins_sim::imu_error::{DPH, DPSH, UG};
 use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use sdins_sim::scenario::Scenario;
-use sdins_sim::trajectory::Motion;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -143,31 +141,42 @@ fn file_error(e: ImuFileError) -> CliError {
     }
 }
 
-/// Loaded input.
-struct Input {
-    name: String,
-    dt_s: f64,
-    incs: Vec<Increment>,
-    site: Site,
-    /// true attitude per sample (scenarios)
-    truth: Option<Vec<Mat3>>,
-    /// true body biases (scenarios): accel [m/s²], gyro [rad/s]
-    true_bias: Option<(Vec3, Vec3)>,
-    /// static phases (scenarios)
-    phases: Vec<(f64, f64)>,
-    vrw: f64,
-    arw: f64,
-    /// error-model seed (scenarios)
-    seed: Option<u64>,
-    /// the format actually read (IMU files)
-    format: Option<ImuFormat>,
-    /// latitude [deg] and height [m] used
-    lat_deg: f64,
-    h_m: f64,
+fn run_error(e: AlignRunError) -> CliError {
+    match e {
+        AlignRunError::Cancelled => CliError::Interrupted,
+        other => CliError::BadInput(other.to_string()),
+    }
 }
 
-fn load(args: &Args) -> Result<Input, CliError> {
-    let d2r = std::f64::consts::PI / 180.0;
+impl Args {
+    /// The library options of these arguments.
+    fn options(&self) -> AlignOptions {
+        AlignOptions {
+            method: match self.method {
+                Method::Coarse1 => AlignMethod::Coarse1,
+                Method::Coarse2 => AlignMethod::Coarse2,
+                Method::I0 => AlignMethod::I0,
+                Method::Fine => AlignMethod::Fine,
+                Method::Multiheading => AlignMethod::Multiheading,
+            },
+            alg: match self.alg {
+                Alg::A => MultiheadingAlg::A,
+                Alg::B => MultiheadingAlg::B,
+            },
+            start: match self.start {
+                Start::I0 => FineStart::I0,
+                Start::Coarse2 => FineStart::Coarse2,
+            },
+            window_s: self.window_s,
+            duration_s: self.duration_s,
+            sigma_z_mps: self.sigma_z,
+            vrw_ug_per_sqrt_hz: self.vrw,
+            arw_deg_per_sqrt_h: self.arw,
+        }
+    }
+}
+
+fn load(args: &Args) -> Result<AlignInput, CliError> {
     match (&args.scenario, &args.imu) {
         (Some(_), Some(_)) => Err(CliError::bad("give either a scenario or --imu, not both")),
         (None, None) => Err(CliError::bad(
@@ -175,174 +184,37 @@ fn load(args: &Args) -> Result<Input, CliError> {
         )),
         (Some(name), None) => {
             let scn = Scenario::load(name)?;
-            let earth = scn.nav.earth.model();
-            let lat = args.lat.map_or(scn.start.lat_rad, |l| l * d2r);
-            let tr = truth_record(
-                &scn.trajectory,
-                earth,
-                scn.imu.dt_s(),
-                lat,
-                scn.start.lon_rad,
-                scn.start.h_m,
-            );
-            let model = &scn.imu.model;
-            let incs = corrupt(&tr.increments, tr.dt_s, model, scn.imu.seed, args.run)
-                .map_err(|e| CliError::bad(format!("{name}: imu.errors: {e}")))?;
-            let st = sdins_sim::imu_error::ImuErrorState::new(model, scn.imu.seed, args.run)
-                .map_err(|e| CliError::bad(format!("{name}: imu.errors: {e}")))?;
-            let (bg, ba) = st.constant_bias();
-            let phases = scn
-                .trajectory
-                .segments()
-                .iter()
-                .filter(|s| matches!(s.motion, Motion::Static))
-                .map(|s| (s.t0_s, s.duration_s))
-                .collect();
-            let vrw = model.accel_vrw_ugpsqrthz[0].max(1e-3) * UG;
-            let arw = model.gyro_arw_dpsh[0].max(1e-6) * DPSH;
-            Ok(Input {
-                name: scn.name.clone(),
-                dt_s: tr.dt_s,
-                incs,
-                site: tr.site,
-                truth: Some(tr.c_b_n),
-                true_bias: Some((ba, bg)),
-                phases,
-                vrw,
-                arw,
-                seed: Some(scn.imu.seed),
-                format: None,
-                lat_deg: lat.to_degrees(),
-                h_m: scn.start.h_m,
-            })
+            AlignInput::from_scenario(&scn, args.run, args.lat).map_err(run_error)
         }
         (None, Some(path)) => {
             let data = read_imu_file(path, args.format).map_err(file_error)?;
-            let (earth, lat_hdr, h_hdr) = match &data.psins {
-                Some(p) => (EarthModel::PSINS, Some(p.lat_deg), p.h_m),
-                None => (EarthModel::WGS84, None, 0.0),
-            };
-            let lat = args.lat.or(lat_hdr).ok_or_else(|| {
-                CliError::bad(format!(
-                    "{}: no latitude in the file: give --lat DEG",
-                    path.display()
-                ))
-            })?;
-            if !(lat.is_finite() && lat.abs() <= 80.0) {
-                return Err(CliError::bad(format!(
-                    "--lat {lat}: expected a latitude within ±80° (docs/theory/alignment.md)"
-                )));
-            }
-            let h = args.h.unwrap_or(h_hdr);
-            Ok(Input {
-                name: path.display().to_string(),
-                dt_s: data.dt_s,
-                incs: data.increments,
-                site: Site::from_earth(&earth, lat * d2r, h),
-                truth: None,
-                true_bias: None,
-                phases: Vec::new(),
-                vrw: 20.0 * UG,
-                arw: 0.002 * DPSH,
-                seed: None,
-                format: Some(data.format),
-                lat_deg: lat,
-                h_m: h,
-            })
+            AlignInput::from_imu_data(&path.display().to_string(), data, args.lat, args.h)
+                .map_err(run_error)
         }
     }
 }
 
-/// One alignment result.
-struct Result1 {
-    method: String,
-    c_b_n: Mat3,
-    accel_bias: Option<(Vec3, Vec3)>,
-    gyro_bias: Option<(Vec3, Vec3)>,
-    att_sigma: Option<Vec3>,
-}
-
-/// Run the command.
-pub fn run(args: Args) -> Result<(), CliError> {
-    if args.observability {
-        let lat = args.lat.unwrap_or(37.5);
-        print!("{}", observability_tables(lat)?);
-        return Ok(());
-    }
-    if !(args.window_s.is_finite() && args.window_s > 0.0) {
-        return Err(CliError::bad(format!(
-            "--window-s {}: expected a positive number of seconds",
-            args.window_s
-        )));
-    }
-    if !(args.sigma_z.is_finite() && args.sigma_z > 0.0) {
-        return Err(CliError::bad(format!(
-            "--sigma-z {}: expected a positive velocity σ in m/s",
-            args.sigma_z
-        )));
-    }
-    // every numeric option finite and in range (a NaN noise value used to give NaN results)
-    for (name, v, lo, lo_open, hi) in [
-        ("--vrw", args.vrw, 0.0, false, 1e6),
-        ("--arw", args.arw, 0.0, false, 1e3),
-        ("--duration-s", args.duration_s, 0.0, true, 1e7),
-        ("--lat", args.lat, -89.99, false, 89.99),
-        ("--h", args.h, -1000.0, false, 100_000.0),
-    ] {
-        if let Some(x) = v {
-            let low_ok = if lo_open { x > lo } else { x >= lo };
-            if !(x.is_finite() && low_ok && x <= hi) {
-                return Err(CliError::bad(format!(
-                    "{name} {x}: expected a finite value in {}{lo}, {hi}]",
-                    if lo_open { "(" } else { "[" }
-                )));
-            }
-        }
-    }
-    let mut inp = load(&args)?;
-    if let Some(d) = args.duration_s {
-        let n = (d / inp.dt_s).round().max(0.0) as usize;
-        inp.incs.truncate(n);
-    }
-    let nw = (args.window_s / inp.dt_s).round() as usize;
-    if nw == 0 || nw > inp.incs.len() {
-        return Err(CliError::bad(format!(
-            "{}: --window-s {} needs {nw} samples, the record has {}",
-            inp.name,
-            args.window_s,
-            inp.incs.len()
-        )));
-    }
-    let mut cfg: FineConfig = reference_config(
-        inp.site,
-        args.vrw.map_or(inp.vrw, |v| v * UG),
-        args.arw.map_or(inp.arw, |v| v * DPSH),
-    );
-    cfg.sigma_z_mps = args.sigma_z;
+/// The per-update history as `align_history.csv` text and plot rows.
+fn history(res: &AlignOutcome) -> (String, Vec<HistRow>) {
     let mut hist = String::from(
         "t_s,roll_deg,pitch_deg,yaw_deg,sig_phi_n_urad,sig_phi_e_urad,sig_phi_d_urad,\
          ba_x_ug,ba_y_ug,ba_z_ug,sig_ba_x_ug,sig_ba_y_ug,sig_ba_z_ug,\
          bg_x_dph,bg_y_dph,bg_z_dph,sig_bg_x_dph,sig_bg_y_dph,sig_bg_z_dph,\
          phi_n_urad,phi_e_urad,phi_d_urad\n",
     );
-    let mut rows: Vec<HistRow> = Vec::new();
-    let truth = inp.truth.clone();
-    let dt = inp.dt_s;
-    let mut record = |j: usize, fa: &FineAlign| {
-        let e = euler_from_c_b_n(&fa.c_b_n());
-        let sa = fa.attitude_sigma() / 1e-6;
-        let ba = fa.accel_bias_b() / UG;
-        let sba = fa.accel_bias_sigma_b() / UG;
-        let bg = fa.gyro_bias_b() / DPH;
-        let sbg = fa.gyro_bias_sigma_b() / DPH;
-        let phi = truth
-            .as_ref()
-            .and_then(|t| t.get(j))
-            .map(|c| attitude_error(&fa.c_b_n(), c) / 1e-6);
+    let mut rows = Vec::with_capacity(res.history.len());
+    for h in &res.history {
+        let e = h.euler;
+        let sa = h.attitude_sigma / 1e-6;
+        let ba = h.accel_bias_b / UG;
+        let sba = h.accel_bias_sigma_b / UG;
+        let bg = h.gyro_bias_b / DPH;
+        let sbg = h.gyro_bias_sigma_b / DPH;
+        let phi = h.phi_true.map(|p| p / 1e-6);
         let _ = write!(
             hist,
             "{:.3},{:.9},{:.9},{:.9},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
-            (j + 1) as f64 * dt,
+            h.t_s,
             e.roll_rad.to_degrees(),
             e.pitch_rad.to_degrees(),
             e.yaw_rad.to_degrees(),
@@ -356,7 +228,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
         let a = |v: Vec3| [v.x, v.y, v.z];
         rows.push(HistRow {
-            t_s: (j + 1) as f64 * dt,
+            t_s: h.t_s,
             phi_urad: phi.map(a),
             sig_phi_urad: a(sa),
             ba_ug: a(ba),
@@ -364,109 +236,36 @@ pub fn run(args: Args) -> Result<(), CliError> {
             bg_dph: a(bg),
             sig_bg_dph: a(sbg),
         });
-    };
-    let bad = |e: sdins_core::align::AlignError| CliError::bad(format!("{}: {e}", inp.name));
-    let res = match args.method {
-        Method::Coarse1 | Method::Coarse2 => {
-            let m = if args.method == Method::Coarse1 {
-                CoarseMethod::OneStep
-            } else {
-                CoarseMethod::TwoStep
-            };
-            let c = coarse_window(&inp.incs, dt, 0, nw, &inp.site, m).map_err(bad)?;
-            Result1 {
-                method: if m == CoarseMethod::OneStep {
-                    "coarse1"
-                } else {
-                    "coarse2"
-                }
-                .into(),
-                c_b_n: c,
-                accel_bias: None,
-                gyro_bias: None,
-                att_sigma: None,
-            }
-        }
-        Method::I0 => Result1 {
-            method: "i0".into(),
-            c_b_n: i0_window(&inp.incs, dt, 0, nw, &inp.site).map_err(bad)?,
-            accel_bias: None,
-            gyro_bias: None,
-            att_sigma: None,
-        },
-        Method::Fine => {
-            let fa = match args.start {
-                Start::Coarse2 => {
-                    let c0 = coarse_window(&inp.incs, dt, 0, nw, &inp.site, CoarseMethod::TwoStep)
-                        .map_err(bad)?;
-                    let mut fa = FineAlign::new(cfg, &c0);
-                    for (j, inc) in inp.incs.iter().enumerate() {
-                        if fa.step(inc, dt) {
-                            record(j, &fa);
-                        }
-                    }
-                    fa
-                }
-                Start::I0 => {
-                    let (fa, _, sz) =
-                        fine_from_i0(&inp.incs, dt, cfg, nw, |j, fa| record(j, fa)).map_err(bad)?;
-                    if !args.json {
-                        println!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
-                    }
-                    fa
-                }
-            };
-            Result1 {
-                method: "fine".into(),
-                c_b_n: fa.c_b_n(),
-                accel_bias: Some((fa.accel_bias_b(), fa.accel_bias_sigma_b())),
-                gyro_bias: Some((fa.gyro_bias_b(), fa.gyro_bias_sigma_b())),
-                att_sigma: Some(fa.attitude_sigma()),
-            }
-        }
-        Method::Multiheading => {
-            let r = match args.alg {
-                Alg::A => algorithm_a(&inp.incs, dt, cfg, args.window_s, |j, fa| record(j, fa))
-                    .map_err(bad)?,
-                Alg::B => {
-                    if inp.phases.len() < 2 {
-                        return Err(CliError::bad(format!(
-                            "{}: Algorithm B needs a scenario with at least two static segments at different headings",
-                            inp.name
-                        )));
-                    }
-                    algorithm_b(&inp.incs, dt, cfg, args.window_s, &inp.phases).map_err(bad)?
-                }
-            };
-            Result1 {
-                method: format!(
-                    "multiheading-{}",
-                    if args.alg == Alg::A { "a" } else { "b" }
-                ),
-                c_b_n: r.c_b_n,
-                accel_bias: Some((r.accel_bias_b, r.accel_bias_sigma_b)),
-                gyro_bias: Some((r.gyro_bias_b, r.gyro_bias_sigma_b)),
-                att_sigma: None,
-            }
-        }
-    };
-    let t_end = inp.incs.len() as f64 * dt;
-    let c_true_end = inp.truth.as_ref().and_then(|t| {
-        let j = match args.method {
-            Method::Coarse1 | Method::Coarse2 => 0,
-            Method::I0 => nw - 1,
-            _ => inp.incs.len().saturating_sub(1),
-        };
-        t.get(j).copied()
-    });
-    let phi = c_true_end.map(|c| attitude_error(&res.c_b_n, &c));
-    let e = euler_from_c_b_n(&res.c_b_n);
+    }
+    (hist, rows)
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    if args.observability {
+        let lat = args.lat.unwrap_or(37.5);
+        print!("{}", observability_tables(lat)?);
+        return Ok(());
+    }
+    let opts = args.options();
+    check_options(&opts).map_err(run_error)?;
+    let inp = load(&args)?;
+    let res = align(&inp, &opts, &crate::progress::token()).map_err(run_error)?;
+    for w in &res.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let (Some(sz), false) = (res.sigma_z_used_mps, args.json) {
+        println!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
+    }
+    let (hist, rows) = history(&res);
+    let dt = inp.dt_s;
+    let t_end = res.samples as f64 * dt;
+    let phi = res.phi_true;
+    let e = res.euler;
     if let Some(dir) = &args.out {
         write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi))?;
         let mut svgs = None;
-        if matches!(args.method, Method::Fine | Method::Multiheading) && args.alg == Alg::A
-            || args.method == Method::Fine
-        {
+        if res.has_history {
             write_string(&dir.join("align_history.csv"), &hist)?;
             if rows.len() >= 2 {
                 let tb = inp.true_bias.map(|(ba, bg)| {
@@ -482,7 +281,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             }
         }
         write_report(dir, &args, &inp, &res, &e, phi, svgs.as_ref())?;
-        write_align_toml(dir, &args, &inp, &cfg)?;
+        write_align_toml(dir, &args, &inp, &res.config)?;
     }
     if args.json {
         println!("{}", result_json(&res, &e, phi, inp.true_bias));
@@ -490,7 +289,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         println!(
             "{}: {} samples, dt {} s, {:.1} s, latitude {:.6}°, g {:.6} m/s²",
             inp.name,
-            inp.incs.len(),
+            res.samples,
             dt,
             t_end,
             inp.site.lat_rad.to_degrees(),
@@ -503,7 +302,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             e.pitch_rad.to_degrees(),
             e.yaw_rad.to_degrees()
         );
-        if let Some(s) = res.att_sigma {
+        if let Some(s) = res.attitude_sigma {
             println!(
                 "  1σ φ N/E/D: {:.1} / {:.1} / {:.1} μrad (includes the unobservable part)",
                 s.x / 1e-6,
@@ -561,8 +360,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
 fn write_report(
     dir: &std::path::Path,
     args: &Args,
-    inp: &Input,
-    res: &Result1,
+    inp: &AlignInput,
+    res: &AlignOutcome,
     e: &Euler,
     phi: Option<Vec3>,
     svgs: Option<&[String; 2]>,
@@ -573,9 +372,9 @@ fn write_report(
          Method {}, coarse window {} s. Attitude errors in convention G (Ĉ = (I + [φ×]) C, NED); \
          biases in body axes (FRD).",
         inp.name,
-        inp.incs.len(),
+        res.samples,
         inp.dt_s,
-        inp.incs.len() as f64 * inp.dt_s,
+        res.samples as f64 * inp.dt_s,
         inp.lat_deg,
         inp.h_m,
         inp.site.g_mps2,
@@ -616,7 +415,7 @@ fn write_report(
         row("true accelerometer bias [μg]", plain(ba, UG, 2));
         row("true gyro bias [°/h]", plain(bg, DPH, 5));
     }
-    if let Some(s) = res.att_sigma {
+    if let Some(s) = res.attitude_sigma {
         row("attitude 1σ φ N/E/D [μrad]", plain(s, 1e-6, 1));
     }
     if let Some(p) = phi {
@@ -646,7 +445,7 @@ fn write_report(
 fn write_align_toml(
     dir: &std::path::Path,
     args: &Args,
-    inp: &Input,
+    inp: &AlignInput,
     cfg: &FineConfig,
 ) -> Result<(), CliError> {
     let mut t = toml::Table::new();
@@ -689,11 +488,11 @@ fn write_align_toml(
     t.insert("sigma_z_mps".into(), cfg.sigma_z_mps.into());
     t.insert(
         "vrw_ug_per_sqrt_hz".into(),
-        (args.vrw.unwrap_or(inp.vrw / UG)).into(),
+        (args.vrw.unwrap_or(inp.vrw_mps_per_sqrt_s / UG)).into(),
     );
     t.insert(
         "arw_deg_per_sqrt_h".into(),
-        (args.arw.unwrap_or(inp.arw / DPSH)).into(),
+        (args.arw.unwrap_or(inp.arw_rad_per_sqrt_s / DPSH)).into(),
     );
     crate::report::write_run_toml(dir, t)
 }
@@ -702,7 +501,7 @@ fn v3(v: &Vec3, unit: f64) -> String {
     format!("[{}, {}, {}]", v.x / unit, v.y / unit, v.z / unit)
 }
 
-fn result_json(r: &Result1, e: &Euler, phi: Option<Vec3>, tb: Option<(Vec3, Vec3)>) -> String {
+fn result_json(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>, tb: Option<(Vec3, Vec3)>) -> String {
     let mut s = format!(
         "{{\"method\": \"{}\", \"roll_deg\": {}, \"pitch_deg\": {}, \"yaw_deg\": {}",
         r.method,
@@ -726,7 +525,7 @@ fn result_json(r: &Result1, e: &Euler, phi: Option<Vec3>, tb: Option<(Vec3, Vec3
             v3(&sd, DPH)
         );
     }
-    if let Some(a) = r.att_sigma {
+    if let Some(a) = r.attitude_sigma {
         let _ = write!(s, ", \"attitude_sigma_urad\": {}", v3(&a, 1e-6));
     }
     if let Some(p) = phi {
@@ -744,7 +543,7 @@ fn result_json(r: &Result1, e: &Euler, phi: Option<Vec3>, tb: Option<(Vec3, Vec3
     s
 }
 
-fn result_csv(r: &Result1, e: &Euler, phi: Option<Vec3>) -> String {
+fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> String {
     let mut s = String::from(
         "method,roll_deg,pitch_deg,yaw_deg,ba_x_ug,ba_y_ug,ba_z_ug,sig_ba_x_ug,sig_ba_y_ug,sig_ba_z_ug,\
          bg_x_dph,bg_y_dph,bg_z_dph,sig_bg_x_dph,sig_bg_y_dph,sig_bg_z_dph,phi_n_urad,phi_e_urad,phi_d_urad\n",
