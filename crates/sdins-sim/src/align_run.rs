@@ -414,8 +414,22 @@ pub fn check_options(o: &AlignOptions) -> Result<(), AlignRunError> {
             ),
         });
     }
-    range("vrw_ug_per_sqrt_hz", "--vrw", o.vrw_ug_per_sqrt_hz, 0.0, false, 1e6)?;
-    range("arw_deg_per_sqrt_h", "--arw", o.arw_deg_per_sqrt_h, 0.0, false, 1e3)?;
+    range(
+        "vrw_ug_per_sqrt_hz",
+        "--vrw",
+        o.vrw_ug_per_sqrt_hz,
+        0.0,
+        false,
+        1e6,
+    )?;
+    range(
+        "arw_deg_per_sqrt_h",
+        "--arw",
+        o.arw_deg_per_sqrt_h,
+        0.0,
+        false,
+        1e3,
+    )?;
     range("duration_s", "--duration-s", o.duration_s, 0.0, true, 1e7)?;
     Ok(())
 }
@@ -552,7 +566,11 @@ pub fn align(
                     algorithm_b(incs, dt, cfg, o.window_s, &inp.phases, token).map_err(stop)?
                 }
             };
-            let alg = if o.alg == MultiheadingAlg::A { "a" } else { "b" };
+            let alg = if o.alg == MultiheadingAlg::A {
+                "a"
+            } else {
+                "b"
+            };
             (
                 format!("multiheading-{alg}"),
                 r.c_b_n,

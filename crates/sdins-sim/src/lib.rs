@@ -49,6 +49,7 @@ pub mod allan;
 pub mod cancel;
 pub mod envelope;
 pub mod error_analysis;
+pub mod errors_run;
 pub mod fuse;
 pub mod gnss;
 pub mod gnss_file;

@@ -22,6 +22,7 @@ use sdins_sim::align::{
     algorithm_a, algorithm_b, coarse_window, corrupt, multiheading_trajectory, run_fine,
     truth_record, TruthRecord,
 };
+use sdins_sim::cancel::CancelToken;
 use sdins_sim::imu_error::{ImuErrorModel, DPH, DPSH, UG};
 use sdins_sim::scenario::Scenario;
 use std::sync::OnceLock;
@@ -239,28 +240,36 @@ fn t4_fine_noise_free() {
     assert!((want / URAD - Vec3::new(35.23, 91.91, 907.05)).amax() < 0.05);
     let (mut max_t, mut max_h) = (0.0f64, 0.0f64);
     let (mut at60, mut at120) = (0.0f64, 0.0f64);
-    run_fine(&incs, tr.dt_s, cfg, &c0, |j, fa| {
-        let t = (j + 1) as f64 * tr.dt_s;
-        let d = attitude_error(&fa.c_b_n(), &tr.c_b_n[j]) - want;
-        if t >= 300.0 - 1e-6 {
-            max_t = max_t.max(d.x.abs().max(d.y.abs()));
-            max_h = max_h.max(d.z.abs());
-        }
-        if t >= 60.0 - 1e-6 {
-            at60 = at60.max(d.x.abs().max(d.y.abs()));
-        }
-        if t >= 120.0 - 1e-6 {
-            at120 = at120.max(d.z.abs());
-        }
-        let ti = t.round() as u64;
-        if [10, 30, 60, 120, 200, 300, 600, 900, 1200, 1800].contains(&ti) {
-            println!(
-                "  t={ti} d={:.2?} μrad σ={:.1?} μrad",
-                (d / URAD).as_slice(),
-                (fa.attitude_sigma() / URAD).as_slice()
-            );
-        }
-    });
+    run_fine(
+        &incs,
+        tr.dt_s,
+        cfg,
+        &c0,
+        |j, fa| {
+            let t = (j + 1) as f64 * tr.dt_s;
+            let d = attitude_error(&fa.c_b_n(), &tr.c_b_n[j]) - want;
+            if t >= 300.0 - 1e-6 {
+                max_t = max_t.max(d.x.abs().max(d.y.abs()));
+                max_h = max_h.max(d.z.abs());
+            }
+            if t >= 60.0 - 1e-6 {
+                at60 = at60.max(d.x.abs().max(d.y.abs()));
+            }
+            if t >= 120.0 - 1e-6 {
+                at120 = at120.max(d.z.abs());
+            }
+            let ti = t.round() as u64;
+            if [10, 30, 60, 120, 200, 300, 600, 900, 1200, 1800].contains(&ti) {
+                println!(
+                    "  t={ti} d={:.2?} μrad σ={:.1?} μrad",
+                    (d / URAD).as_slice(),
+                    (fa.attitude_sigma() / URAD).as_slice()
+                );
+            }
+        },
+        &CancelToken::new(),
+    )
+    .unwrap();
     println!(
         "T4: max |tilt − Πx0| from 300 s {:.2} μrad (≤10), heading {:.2} μrad (≤20); tilt from 60 s {:.2}, heading from 120 s {:.2}",
         max_t / URAD, max_h / URAD, at60 / URAD, at120 / URAD
@@ -276,17 +285,25 @@ fn t4_fine_noise_free() {
     let cfg = reference_config(s, vrw(), arw());
     let (mut max_t, mut max_h, mut sig_h) = (0.0f64, 0.0f64, 0.0f64);
     let t9 = pseudo9_transform(&s);
-    run_fine(&incs, tr.dt_s, cfg, &c0, |j, fa| {
-        let t = (j + 1) as f64 * tr.dt_s;
-        let d = attitude_error(&fa.c_b_n(), &tr.c_b_n[j]) - want;
-        if t >= 300.0 - 1e-6 {
-            max_t = max_t.max(d.x.abs().max(d.y.abs()));
-            let pp = t9 * fa.kf().p * t9.transpose();
-            let sh = pp[(5, 5)].sqrt();
-            max_h = max_h.max(d.z.abs() / sh);
-            sig_h = sh;
-        }
-    });
+    run_fine(
+        &incs,
+        tr.dt_s,
+        cfg,
+        &c0,
+        |j, fa| {
+            let t = (j + 1) as f64 * tr.dt_s;
+            let d = attitude_error(&fa.c_b_n(), &tr.c_b_n[j]) - want;
+            if t >= 300.0 - 1e-6 {
+                max_t = max_t.max(d.x.abs().max(d.y.abs()));
+                let pp = t9 * fa.kf().p * t9.transpose();
+                let sh = pp[(5, 5)].sqrt();
+                max_h = max_h.max(d.z.abs() / sh);
+                sig_h = sh;
+            }
+        },
+        &CancelToken::new(),
+    )
+    .unwrap();
     println!(
         "T4 with aviation Q: max |tilt − Πx0| from 300 s {:.2} μrad, max |φ_D − Πx0|/σ(φ'_D) {:.3}, σ(φ'_D)@1800 {:.0} μrad",
         max_t / URAD, max_h, sig_h / URAD
@@ -335,7 +352,9 @@ fn t5_run(run: u64) -> ([Vec3; 4], f64) {
                 _ => {}
             }
         },
-    );
+        &CancelToken::new(),
+    )
+    .unwrap();
     (out, max_tilt)
 }
 
@@ -614,7 +633,15 @@ fn t6_multiheading_noise_free_algorithm_a() {
             0,
         )
         .unwrap();
-        let r = algorithm_a(&incs, tr.dt_s, mh_cfg_nf(s), 60.0, |_, _| {}).unwrap();
+        let r = algorithm_a(
+            &incs,
+            tr.dt_s,
+            mh_cfg_nf(s),
+            60.0,
+            |_, _| {},
+            &CancelToken::new(),
+        )
+        .unwrap();
         let (ea, eg, phi) = mh_errors(&r, tr, &ref_ba(), &ref_bg());
         println!(
             "T6 A {h:?}: b_a err {:.3?} μg, b_g err {:.5?} °/h, φ {:.2?} μrad",
@@ -662,7 +689,7 @@ fn t6_multiheading_noise_free_algorithm_a() {
         bias_frame: BiasFrame::Ned,
         ..mh_cfg_nf(tr.site)
     };
-    let fa = run_fine(&incs, tr.dt_s, cfg, &c0, |_, _| {});
+    let fa = run_fine(&incs, tr.dt_s, cfg, &c0, |_, _| {}, &CancelToken::new()).unwrap();
     let phi = attitude_error(&fa.c_b_n(), tr.c_b_n.last().unwrap());
     println!(
         "T6 negative (NED states, 0/180): φ = {:.1?} μrad",
@@ -685,7 +712,7 @@ fn algorithm_b_noise_free_signals() {
         )
         .unwrap();
         let cfg = reference_config(tr.site, 0.0, 0.0);
-        let r = algorithm_b(&incs, tr.dt_s, cfg, 60.0, ph);
+        let r = algorithm_b(&incs, tr.dt_s, cfg, 60.0, ph, &CancelToken::new());
         if h.len() == 1 {
             assert!(r.is_err());
             continue;
@@ -715,7 +742,15 @@ fn t7_multiheading_aviation_noise_monte_carlo() {
             .into_par_iter()
             .map(|run| {
                 let incs = corrupt(&tr.increments, tr.dt_s, &model, 9, run).unwrap();
-                let r = algorithm_a(&incs, tr.dt_s, mh_cfg(tr.site), 60.0, |_, _| {}).unwrap();
+                let r = algorithm_a(
+                    &incs,
+                    tr.dt_s,
+                    mh_cfg(tr.site),
+                    60.0,
+                    |_, _| {},
+                    &CancelToken::new(),
+                )
+                .unwrap();
                 mh_errors(&r, tr, &ref_ba(), &ref_bg())
             })
             .collect();
@@ -770,7 +805,7 @@ fn lasergyro_real_data_alignment() {
         let c0 = coarse_window(w, dt, 0, 6000, &site, CoarseMethod::TwoStep).unwrap();
         let mut cfg = reference_config(site, 20.0 * UG, 0.002 * DPSH);
         cfg.sigma_z_mps = 0.01; // parked vehicle: sway (spec §2.2)
-        let fa = run_fine(w, dt, cfg, &c0, |_, _| {});
+        let fa = run_fine(w, dt, cfg, &c0, |_, _| {}, &CancelToken::new()).unwrap();
         let e = [
             sdins_core::math::euler_from_c_b_n(&c2),
             sdins_core::math::euler_from_c_b_n(&c1),

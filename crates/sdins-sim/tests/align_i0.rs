@@ -8,6 +8,7 @@ use sdins_core::align::Site;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::euler_from_c_b_n;
 use sdins_sim::align::{coarse_window, i0_window};
+use sdins_sim::cancel::CancelToken;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
 
@@ -224,7 +225,8 @@ fn lasergyro_fine_from_i0_is_start_independent() {
     for w in [10.0, 30.0, 60.0, 120.0, 300.0] {
         let cfg = reference_config(site, 20.0 * UG, 0.002 * DPSH);
         let n = (w / dt).round() as usize;
-        let (fa, c0, sz) = fine_from_i0(&data.increments, dt, cfg, n, |_, _| {}).unwrap();
+        let (fa, c0, sz) =
+            fine_from_i0(&data.increments, dt, cfg, n, |_, _| {}, &CancelToken::new()).unwrap();
         let y = euler_from_c_b_n(&fa.c_b_n()).yaw_rad / D2R;
         println!(
             "start window {w} s: i0 start yaw {:.3}°, σ_z {:.4} m/s → fine yaw {y:.4}° (1σ {:.4}°), ε_E est {:.4} °/h",
@@ -285,7 +287,8 @@ fn fine_from_i0_moored_ship_nees() {
         .into_par_iter()
         .map(|run| {
             let incs = corrupt(&tr.increments[..n_all], dt, &model, 23, run).unwrap();
-            let (fa, _, sz) = fine_from_i0(&incs, dt, cfg, nw, |_, _| {}).unwrap();
+            let (fa, _, sz) =
+                fine_from_i0(&incs, dt, cfg, nw, |_, _| {}, &CancelToken::new()).unwrap();
             let phi = attitude_error(&fa.c_b_n(), &c_end);
             let p: SMatrix<f64, 3, 3> = fa.kf().p.fixed_view::<3, 3>(3, 3).into_owned();
             let nees = (phi.transpose() * p.try_inverse().unwrap() * phi)[(0, 0)];

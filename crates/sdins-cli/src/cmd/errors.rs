@@ -13,19 +13,11 @@
 //! ```
 
 use crate::error::CliError;
-use sdins_core::Vec3;
-use sdins_sim::error_analysis::grades::{grade_by_name, Grade, GRADES};
-use sdins_sim::error_analysis::linear_model::{
-    propagate, stationary_samples, EnvelopePoint, ErrorVector, ModelEarth, ModelOptions,
-    ProcessNoise, VerticalChannel,
-};
-use sdins_sim::error_analysis::nonlinear::NonlinearRun;
-use sdins_sim::error_analysis::periods::SchulerParams;
+use sdins_sim::error_analysis::grades::grade_by_name;
+use sdins_sim::error_analysis::linear_model::EnvelopePoint;
 use sdins_sim::error_analysis::schuler_share::{schuler_share_table_p2, ShareRow, T_STAR_S};
-use sdins_sim::error_analysis::stationary::{
-    StationaryClosedForm, StationaryErrors, StationarySolution,
-};
-use sdins_sim::error_analysis::{DEG_PER_HOUR, MICRO_G};
+use sdins_sim::error_analysis::stationary::{StationaryClosedForm, StationarySolution};
+use sdins_sim::errors_run::{errors, BudgetRow, ErrorsError, ErrorsOptions, ErrorsReport};
 
 /// Arguments of `sdins errors`.
 #[derive(clap::Args, Debug)]
@@ -67,276 +59,48 @@ pub struct Args {
     pub out: Option<std::path::PathBuf>,
 }
 
-/// Linear-model step [s] (see `linear_model` docs: Taylor-3 is accurate to < 1e-4 rad of
-/// Schuler phase over 24 h at this step).
-const DT_S: f64 = 10.0;
-
-/// One output epoch.
-#[derive(serde::Serialize)]
-struct Epoch {
-    t_h: f64,
-    closed_form: StationarySolution,
-    linear: EnvelopePoint,
-    /// the nonlinear free-inertial simulation at this epoch (`null` with `--no-nonlinear`)
-    nonlinear: Option<NonlinearPoint>,
-}
-
-/// Nonlinear-simulation errors at one epoch.
-#[derive(serde::Serialize, Clone, Copy)]
-struct NonlinearPoint {
-    /// position error N, E, D \[m\]
-    dp_n_m: [f64; 3],
-    /// attitude error ε (convention G) \[rad\]
-    phi: [f64; 3],
-}
-
-/// The nonlinear column: a full nonlinear free-inertial run
-/// ([`NonlinearRun`], spec §6 T9 set-up): stationary, body = NED at `lat_rad` (so the NED
-/// biases are the body biases, injected as a custom `ImuErrorModel` with fixed
-/// `gyro_bias_dph`/`accel_bias_ug`), spherical earth with the closed form's constants
-/// (R0, g, Ω), 20 Hz IMU, `songlee-complete` with N = 2, vertical channel held; run once
-/// to the last epoch and read at every epoch of `hours`.
-fn nonlinear_column(
-    lat_rad: f64,
-    params: &SchulerParams,
-    gyro_dph: &Vec3,
-    accel_ug: &Vec3,
-    hours: &[f64],
-) -> Result<Vec<Option<NonlinearPoint>>, CliError> {
-    let last = hours.iter().copied().fold(0.0, f64::max);
-    let mut run = NonlinearRun::stationary(lat_rad, params, last * 3600.0);
-    run.gyro_bias_dph = (*gyro_dph).into();
-    run.accel_bias_ug = (*accel_ug).into();
-    let errs = run.run().map_err(|e| CliError::Other(e.to_string()))?;
-    Ok(hours
-        .iter()
-        .map(|h| {
-            let t = h * 3600.0;
-            errs.iter()
-                .min_by(|a, b| (a.t_s - t).abs().total_cmp(&(b.t_s - t).abs()))
-                .filter(|e| (e.t_s - t).abs() <= 0.5 * run.every_s + 1e-6)
-                .map(|e| NonlinearPoint {
-                    dp_n_m: e.pos_err_ned_m,
-                    phi: e.att_err_rad,
-                })
-        })
-        .collect())
-}
-
-#[derive(serde::Serialize)]
-struct Report<'a> {
-    lat_deg: f64,
-    hours: f64,
-    grade: Option<&'a str>,
-    gyro_bias_dph_ned: [f64; 3],
-    accel_bias_ug_ned: [f64; 3],
-    params: SchulerParams,
-    epochs: Vec<Epoch>,
-}
-
-fn vec3(name: &str, v: &Option<Vec<f64>>) -> Result<Vec3, CliError> {
-    match v {
-        None => Ok(Vec3::zeros()),
-        Some(x) if x.len() == 3 && x.iter().all(|a| a.is_finite()) => {
-            Ok(Vec3::new(x[0], x[1], x[2]))
-        }
-        Some(x) => Err(CliError::bad(format!(
-            "--{name}: expected three finite numbers N,E,D, got {x:?}"
-        ))),
-    }
-}
-
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     if args.schuler_share {
         return print_share(args.json);
     }
-    if !(args.hours.is_finite() && args.hours > 0.0 && args.hours <= 240.0) {
-        return Err(CliError::bad(format!(
-            "--hours: must be in (0, 240], got {}",
-            args.hours
-        )));
-    }
-    if !(args.lat.is_finite() && args.lat.abs() <= 89.0) {
-        return Err(CliError::bad(format!(
-            "--lat: must be within ±89°, got {}",
-            args.lat
-        )));
-    }
-    let grade: Option<&Grade> = match &args.grade {
-        Some(name) => Some(grade_by_name(name).ok_or_else(|| {
-            let names: Vec<&str> = GRADES.iter().map(|g| g.name).collect();
-            CliError::bad(format!(
-                "--grade: unknown grade {name:?} (known: {})",
-                names.join(", ")
-            ))
-        })?),
-        None => None,
-    };
-    let (gyro_dph, accel_ug) = match grade {
-        Some(g) => (
-            Vec3::repeat(g.gyro_bias_turn_on_dph),
-            Vec3::repeat(g.accel_bias_turn_on_ug),
-        ),
-        None => (
-            vec3("gyro-bias-dph", &args.gyro_bias_dph)?,
-            vec3("accel-bias-ug", &args.accel_bias_ug)?,
-        ),
-    };
-    if grade.is_none() && args.gyro_bias_dph.is_none() && args.accel_bias_ug.is_none() {
-        return Err(CliError::bad(
-            "give --grade, --gyro-bias-dph/--accel-bias-ug, or --schuler-share",
-        ));
-    }
-    let lat = args.lat.to_radians();
-    let earth = sdins_core::earth::EarthModel::WGS84;
-    let params = SchulerParams::with_local_gravity(&earth, lat, 0.0);
-    let errors = StationaryErrors {
-        eps_n: gyro_dph * DEG_PER_HOUR,
-        da_n: accel_ug * MICRO_G,
-        ..Default::default()
-    };
-    let closed = StationaryClosedForm::new(lat, &errors, params);
-
-    // linear model on the same spherical earth: deterministic error from the biases, and a
-    // 1σ envelope with the biases as 1σ bias uncertainty plus the grade's ARW/VRW
-    let opts = ModelOptions {
-        earth: ModelEarth::Spherical(params),
-        vertical: VerticalChannel::Held,
-        bias_states: true,
-    };
-    let duration = args.hours * 3600.0;
-    let samples = stationary_samples(lat, 0.0, duration, DT_S, &opts.earth);
-    let ev = ErrorVector {
-        b_a: errors.da_n,
-        b_g: errors.eps_n,
-        ..Default::default()
-    };
-    let s0 = samples
-        .first()
-        .copied()
-        .ok_or_else(|| CliError::Other("no samples".into()))?;
-    let x0 = ev.to_state(&s0, &opts.earth);
-    let p0 = ev.to_diag_covariance(&s0, &opts.earth);
-    let noise = grade
-        .map(|g| ProcessNoise {
-            arw_rad_per_sqrt_s: Vec3::repeat(g.arw_si()),
-            vrw_mps_per_sqrt_s: Vec3::repeat(g.vrw_si()),
-            ..Default::default()
-        })
-        .unwrap_or_default();
-    let env =
-        propagate(&samples, &opts, &noise, &x0, &p0).map_err(|e| CliError::Other(e.to_string()))?;
-
-    let mut hours: Vec<f64> = [0.5, 1.0, 2.0, 4.0, 6.0, 12.0, 24.0, 48.0, 96.0, 168.0]
-        .into_iter()
-        .filter(|h| *h < args.hours - 1e-9)
-        .collect();
-    hours.push(args.hours);
-    let nonlinear = if args.no_nonlinear {
-        vec![None; hours.len()]
-    } else {
-        nonlinear_column(lat, &params, &gyro_dph, &accel_ug, &hours)?
-    };
-    let epochs: Vec<Epoch> = hours
-        .iter()
-        .zip(nonlinear)
-        .map(|(&h, nonlinear)| {
-            let t = h * 3600.0;
-            let k = ((t / DT_S).round() as usize).min(env.len().saturating_sub(1));
-            let linear = env.get(k).copied().unwrap_or_default();
-            Epoch {
-                t_h: h,
-                closed_form: closed.eval(t),
-                linear,
-                nonlinear,
-            }
-        })
-        .collect();
-
-    let report = Report {
-        lat_deg: args.lat,
+    let opts = ErrorsOptions {
+        grade: args.grade.clone(),
+        gyro_bias_dph: args.gyro_bias_dph.clone(),
+        accel_bias_ug: args.accel_bias_ug.clone(),
         hours: args.hours,
-        grade: grade.map(|g| g.name),
-        gyro_bias_dph_ned: gyro_dph.into(),
-        accel_bias_ug_ned: accel_ug.into(),
-        params,
-        epochs,
+        lat_deg: args.lat,
+        nonlinear: !args.no_nonlinear,
     };
+    let out = errors(&opts, &crate::progress::token()).map_err(|e| match e {
+        ErrorsError::BadOption { message, .. } => CliError::BadInput(message),
+        ErrorsError::Cancelled => CliError::Interrupted,
+        other => CliError::Other(other.to_string()),
+    })?;
+    let report = &out.report;
     if args.json {
-        let s =
-            serde_json::to_string_pretty(&report).map_err(|e| CliError::Other(e.to_string()))?;
+        let s = serde_json::to_string_pretty(report).map_err(|e| CliError::Other(e.to_string()))?;
         println!("{s}");
     } else {
-        print_table(&report);
+        print_table(report);
     }
-    let out = args
+    let dir = args
         .out
         .clone()
         .unwrap_or_else(|| std::path::PathBuf::from("sdins-out/errors"));
-    let budget = error_budget(lat, params, &gyro_dph, &accel_ug, duration);
-    write_folder(&out, &args, &report, &closed, &env, &budget)?;
+    write_folder(&dir, &args, report, &out.closed, &out.envelope, &out.budget)?;
     eprintln!(
         "wrote {0}/errors.csv, {0}/errors.png, {0}/budget.png, {0}/report.html, {0}/run.toml",
-        out.display()
+        dir.display()
     );
     Ok(())
-}
-
-/// One error source's share of the final position error.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BudgetRow {
-    /// source name, e.g. `gyro bias E`
-    pub source: String,
-    /// the source's value with unit
-    pub value: String,
-    /// its position error N, E at the final time \[m\]
-    pub dp_ne_m: [f64; 2],
-}
-
-/// Error budget at `t_s`: the closed form (docs/theory/error-analysis.md) with one nonzero bias component at a
-/// time. The closed form is linear in the errors, so the rows add up (as vectors) to the
-/// all-sources error.
-pub fn error_budget(
-    lat_rad: f64,
-    params: SchulerParams,
-    gyro_dph: &Vec3,
-    accel_ug: &Vec3,
-    t_s: f64,
-) -> Vec<BudgetRow> {
-    let axes = ["N", "E", "D"];
-    let mut rows = Vec::new();
-    for k in 0..3 {
-        for (gyro, v) in [(true, gyro_dph[k]), (false, accel_ug[k])] {
-            if v == 0.0 {
-                continue;
-            }
-            let mut e = StationaryErrors::default();
-            let (source, value) = if gyro {
-                e.eps_n[k] = v * DEG_PER_HOUR;
-                (format!("gyro bias {}", axes[k]), format!("{v} °/h"))
-            } else {
-                e.da_n[k] = v * MICRO_G;
-                (format!("accel bias {}", axes[k]), format!("{v} μg"))
-            };
-            let dp = StationaryClosedForm::new(lat_rad, &e, params)
-                .eval(t_s)
-                .dp_n;
-            rows.push(BudgetRow {
-                source,
-                value,
-                dp_ne_m: [dp[0], dp[1]],
-            });
-        }
-    }
-    rows
 }
 
 /// errors.csv, the figures, report.html and run.toml of `sdins errors`.
 fn write_folder(
     out: &std::path::Path,
     args: &Args,
-    r: &Report<'_>,
+    r: &ErrorsReport,
     closed: &StationaryClosedForm,
     env: &[EnvelopePoint],
     budget: &[BudgetRow],
@@ -419,7 +183,7 @@ fn write_folder(
         r.hours,
         r.gyro_bias_dph_ned,
         r.accel_bias_ug_ned,
-        r.grade.map(|g| format!(" (grade {g})")).unwrap_or_default()
+        r.grade.as_ref().map(|g| format!(" (grade {g})")).unwrap_or_default()
     ));
     let rows: Vec<Vec<String>> = r
         .epochs
@@ -502,7 +266,7 @@ fn write_folder(
     crate::report::write_run_toml(out, t)
 }
 
-fn print_table(r: &Report<'_>) {
+fn print_table(r: &ErrorsReport) {
     println!(
         "Stationary free-inertial errors, L = {:.3}°, vertical channel held, R0 = {:.0} m, g = {:.6} m/s²",
         r.lat_deg, r.params.r0_m, r.params.g_mps2
@@ -512,6 +276,7 @@ fn print_table(r: &Report<'_>) {
         r.gyro_bias_dph_ned,
         r.accel_bias_ug_ned,
         r.grade
+            .as_ref()
             .map(|g| format!(" (grade {g}, turn-on bias σ, ARW/VRW in σ)"))
             .unwrap_or_default()
     );
@@ -534,7 +299,7 @@ fn print_table(r: &Report<'_>) {
         "1σ φD"
     );
     for e in &r.epochs {
-        let nl = |f: &dyn Fn(&NonlinearPoint) -> String| {
+        let nl = |f: &dyn Fn(&sdins_sim::errors_run::NonlinearPoint) -> String| {
             e.nonlinear
                 .as_ref()
                 .map(f)
@@ -605,46 +370,6 @@ mod tests {
         }
     }
 
-    /// The budget rows add up (as vectors) to the all-sources closed form: the closed form
-    /// is linear in the biases, so only rounding separates them (|δp| ~ 1e4 m: 1e-7 m).
-    /// Dropping any one row would miss by at least that source's share (≥ 100 m here).
-    #[test]
-    fn error_budget_adds_up_to_the_total() {
-        let lat = 37.5_f64.to_radians();
-        let params =
-            SchulerParams::with_local_gravity(&sdins_core::earth::EarthModel::WGS84, lat, 0.0);
-        let g = Vec3::new(0.01, -0.02, 0.015);
-        let a = Vec3::new(50.0, -80.0, 30.0);
-        let t = 6.0 * 3600.0;
-        let rows = error_budget(lat, params, &g, &a, t);
-        assert_eq!(rows.len(), 6);
-        let all = StationaryClosedForm::new(
-            lat,
-            &StationaryErrors {
-                eps_n: g * DEG_PER_HOUR,
-                da_n: a * MICRO_G,
-                ..Default::default()
-            },
-            params,
-        )
-        .eval(t)
-        .dp_n;
-        for (k, total) in all.iter().take(2).enumerate() {
-            let sum: f64 = rows.iter().map(|r| r.dp_ne_m[k]).sum();
-            assert!((sum - total).abs() <= 1e-7, "axis {k}: {sum} vs {total}");
-        }
-        // every horizontal source matters; the down accelerometer bias has no effect
-        // (vertical channel held)
-        for r in &rows {
-            let m = r.dp_ne_m[0].hypot(r.dp_ne_m[1]);
-            if r.source == "accel bias D" {
-                assert_eq!(m, 0.0);
-            } else {
-                assert!(m >= 100.0, "{}: {m}", r.source);
-            }
-        }
-    }
-
     #[test]
     #[allow(clippy::unwrap_used)]
     fn output_folder_has_report_and_run_toml() {
@@ -701,42 +426,5 @@ mod tests {
         a.grade = Some("nope".into());
         assert!(matches!(run(a), Err(CliError::BadInput(_))));
         assert_eq!(CliError::bad("x").exit_code(), 2);
-    }
-
-    /// The nonlinear column follows the closed form (east gyro 0.01 °/h, 2 h: spec §6 T9
-    /// INS −2011 m, closed form −2013 m; tolerance 1 % of the peak + 50 m).
-    #[test]
-    #[allow(clippy::unwrap_used)]
-    fn nonlinear_column_matches_closed_form() {
-        let lat = 37.5_f64.to_radians();
-        let p = SchulerParams::T9;
-        let col = nonlinear_column(
-            lat,
-            &p,
-            &Vec3::new(0.0, 0.01, 0.0),
-            &Vec3::zeros(),
-            &[1.0, 2.0],
-        )
-        .unwrap();
-        let closed = StationaryClosedForm::new(
-            lat,
-            &StationaryErrors {
-                eps_n: Vec3::new(0.0, 0.01, 0.0) * DEG_PER_HOUR,
-                ..Default::default()
-            },
-            p,
-        );
-        for (h, n) in [1.0, 2.0].iter().zip(&col) {
-            let n = n.unwrap();
-            let c = closed.eval(h * 3600.0);
-            assert!((n.dp_n_m[0] - c.dp_n[0]).abs() < 0.01 * 2013.0 + 50.0);
-            assert!(
-                (n.phi[2] - c.phi[2]).abs() < 2e-5,
-                "{} vs {}",
-                n.phi[2],
-                c.phi[2]
-            );
-        }
-        assert!((col[1].unwrap().dp_n_m[0] + 2011.0).abs() < 5.0);
     }
 }

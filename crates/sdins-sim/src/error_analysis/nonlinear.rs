@@ -85,6 +85,17 @@ impl NonlinearRun {
 
     /// Run; one [`NavError`] per output epoch, the first at t = 0.
     pub fn run(&self) -> Result<Vec<NavError>, ScenarioError> {
+        Ok(self
+            .run_cancellable(&crate::cancel::CancelToken::new())?
+            .unwrap_or_default())
+    }
+
+    /// [`Self::run`], polling `token` every [`crate::cancel::POLL_EVERY_SAMPLES`] updates;
+    /// `Ok(None)` when it was set.
+    pub fn run_cancellable(
+        &self,
+        token: &crate::cancel::CancelToken,
+    ) -> Result<Option<Vec<NavError>>, ScenarioError> {
         let text = format!(
             "name = \"nonlinear-stationary\"\n[start]\nlat_deg = {}\nlon_deg = 127.0\nroll_deg = {}\npitch_deg = {}\nyaw_deg = {}\n[imu]\nrate_hz = {}\n[[segment]]\ntype = \"static\"\nduration_s = {}\n",
             self.lat_rad.to_degrees(),
@@ -151,10 +162,13 @@ impl NonlinearRun {
             mech.update(&buf);
             mech.hold_vertical(end.h_m, end.v_n_mps.z);
             k += 1;
+            if k.is_multiple_of(crate::cancel::POLL_EVERY_SAMPLES) && token.is_cancelled() {
+                return Ok(None);
+            }
             if k.is_multiple_of(every) {
                 out.push(nav_error(&self.earth, &mech.state(), &end));
             }
         }
-        Ok(out)
+        Ok(Some(out))
     }
 }
