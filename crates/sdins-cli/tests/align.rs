@@ -172,3 +172,28 @@ fn align_i0_moored_ship_and_sigma_z_validation() {
     assert_eq!(code, 2);
     assert!(err.contains("--sigma-z"), "{err}");
 }
+
+/// A stationary-only method on a moving scenario exits 2 naming the time and speed and
+/// suggesting i0; i0 runs.
+#[test]
+fn align_refuses_a_moving_scenario() {
+    let (code, _, err) = sdins(&["align", "mach1-east", "--method", "coarse2", "--json"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("truth speed is 340.")
+            && err.contains("t = 0.")
+            && err.contains("--method i0"),
+        "{err}"
+    );
+    let (code, out, err) = sdins(&[
+        "align",
+        "moored-ship",
+        "--method",
+        "i0",
+        "--window-s",
+        "300",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("\"method\": \"i0\""));
+}
