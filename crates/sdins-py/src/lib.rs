@@ -9,8 +9,10 @@
 
 use pyo3::prelude::*;
 
+mod align;
 mod arrays;
 mod error;
+mod fuse;
 mod imu;
 mod interrupt;
 mod mc;
@@ -33,5 +35,8 @@ fn _sdins(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(nav::run, m)?)?;
     m.add_function(wrap_pyfunction!(mc::montecarlo, m)?)?;
     m.add_function(wrap_pyfunction!(mc::merge, m)?)?;
+    m.add_function(wrap_pyfunction!(align::align, m)?)?;
+    m.add_function(wrap_pyfunction!(align::errors, m)?)?;
+    m.add_function(wrap_pyfunction!(fuse::fuse, m)?)?;
     Ok(())
 }
