@@ -18,6 +18,9 @@ import numpy as np
 from . import _sdins
 from ._results import (
     AlgorithmRun,
+    AlignResult,
+    ErrorAnalysis,
+    FuseResult,
     AllanResult,
     Errors,
     ImuRecord,
@@ -51,6 +54,13 @@ __all__ = [
     "allan",
     "montecarlo",
     "merge",
+    "AlignResult",
+    "ErrorAnalysis",
+    "FuseResult",
+    "align",
+    "errors",
+    "fuse",
+    "schuler_share",
 ]
 
 
@@ -223,3 +233,104 @@ def merge(states: Iterable[McState], allow_partial: Optional[bool] = None) -> Mc
     (``sdins merge``). Missing blocks are an error unless ``allow_partial=True``."""
     merged, stats = _sdins.merge(list(states), allow_partial)
     return McStatistics(stats, merged)
+
+
+def align(
+    scenario: Optional[Union[Scenario, str]] = None,
+    imu: Optional[Any] = None,
+    format: Optional[str] = None,
+    method: Optional[str] = None,
+    alg: Optional[str] = None,
+    start: Optional[str] = None,
+    lat_deg: Optional[float] = None,
+    h_m: Optional[float] = None,
+    window_s: Optional[float] = None,
+    duration_s: Optional[float] = None,
+    run: Optional[int] = None,
+    sigma_z_mps: Optional[float] = None,
+    vrw_ug_per_sqrt_hz: Optional[float] = None,
+    arw_deg_per_sqrt_h: Optional[float] = None,
+) -> AlignResult:
+    """Initial alignment (``sdins align``) of a scenario (with run ``run`` of its IMU
+    error model, default 0) or an IMU file ``imu`` (``format``: auto (default), sdins,
+    psins, psins-csv, kfgins, navego).
+
+    ``method``: coarse1, coarse2, i0, fine (default) or multiheading; ``alg``: a
+    (default) or b (multi-heading); ``start``: i0 (default) or coarse2 (fine filter
+    start); ``lat_deg`` [deg] / ``h_m`` [m]: site (files without a PSINS header need
+    ``lat_deg``; for scenarios it overrides the start latitude); ``window_s``: coarse/i0
+    window [s] (default 60); ``duration_s``: use only the first seconds; ``sigma_z_mps``:
+    zero-velocity σ [m/s] (default 1e-3, a floor with start=i0); ``vrw_ug_per_sqrt_hz``,
+    ``arw_deg_per_sqrt_h``: filter noise (default: the scenario's, else aviation grade).
+
+    Stationary-only methods (all but i0) raise :class:`SdinsError` on a scenario whose
+    truth speed exceeds 0.5 m/s in the alignment window, and add a warning to
+    ``warnings`` for a file that seems to move. Attitude errors in convention G
+    (Ĉ = (I + [φ×]) C, NED); biases in body axes (FRD), μg and °/h.
+    """
+    scn = None if scenario is None else _scenario(scenario)
+    return AlignResult(
+        _sdins.align(
+            scn, None if imu is None else str(imu), format, method, alg, start, lat_deg,
+            h_m, window_s, duration_s, run, sigma_z_mps, vrw_ug_per_sqrt_hz,
+            arw_deg_per_sqrt_h,
+        )
+    )
+
+
+def errors(
+    grade: Optional[str] = None,
+    gyro_bias_dph: Optional[Sequence[float]] = None,
+    accel_bias_ug: Optional[Sequence[float]] = None,
+    hours: Optional[float] = None,
+    lat_deg: Optional[float] = None,
+    nonlinear: Optional[bool] = None,
+) -> ErrorAnalysis:
+    """Stationary free-inertial error analysis (``sdins errors``): closed form, 15-state
+    linear model with 1σ envelope, nonlinear INS column, error budget.
+
+    ``grade`` (marine, aviation, intermediate, tactical, consumer: its turn-on bias σ on
+    every NED axis and its ARW/VRW), or ``gyro_bias_dph`` [°/h] and/or ``accel_bias_ug``
+    [μg] as N, E, D; ``hours`` (default 24, ≤ 240); ``lat_deg`` (default 37.5);
+    ``nonlinear``: run the nonlinear column (default True).
+    """
+    g = None if gyro_bias_dph is None else [float(x) for x in gyro_bias_dph]
+    a = None if accel_bias_ug is None else [float(x) for x in accel_bias_ug]
+    return ErrorAnalysis(_sdins.errors(grade, g, a, hours, lat_deg, nonlinear))
+
+
+def schuler_share() -> List[Dict[str, Any]]:
+    """The Schuler-share table (``sdins errors --schuler-share``, reconstruction of
+    [P2] Table 1) as a list of dicts (grade, accel_bias_ug, gyro_bias_dph, share_pct)."""
+    import json
+
+    return json.loads(_sdins.schuler_share_json())
+
+
+def fuse(
+    scenario: Union[Scenario, str],
+    algo: Optional[str] = None,
+    samples: Optional[int] = None,
+    run: Optional[int] = None,
+    cov_rate_hz: Optional[float] = None,
+    gate: Optional[bool] = None,
+    exact_start: Optional[bool] = None,
+    zupt_sigma_mps: Optional[float] = None,
+    nhc_sigma_mps: Optional[float] = None,
+    until_s: Optional[float] = None,
+) -> FuseResult:
+    """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``); the scenario's
+    ``[gnss]`` table sets the receiver.
+
+    Every parameter defaults to the library's ``FuseOptions::default()``: ``algo``
+    songlee-complete, ``samples`` the scenario's N (as the CLI), ``run`` 0 (IMU/GNSS/
+    initial-error streams), ``cov_rate_hz`` 10, ``gate`` True (χ² 99.9 % NIS gate),
+    ``exact_start`` False (initial errors drawn from P0), ``zupt_sigma_mps`` /
+    ``nhc_sigma_mps`` None (off), ``until_s`` None (whole scenario).
+    """
+    return FuseResult(
+        _sdins.fuse(
+            _scenario(scenario), algo, samples, run, cov_rate_hz, gate, exact_start,
+            zupt_sigma_mps, nhc_sigma_mps, until_s,
+        )
+    )

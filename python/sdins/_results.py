@@ -278,3 +278,139 @@ class AllanResult:
             {c: self.adev[:, k] for k, c in enumerate(self.CHANNELS)},
             index=pd.Index(self.tau_s, name="tau_s"),
         )
+
+
+class AlignResult:
+    """Alignment result (``sdins.align``). Attributes as ``sdins align --json``:
+    ``method``; ``roll_deg``, ``pitch_deg``, ``yaw_deg`` (NED, yaw clockwise from north);
+    ``c_b_n`` (3, 3); for the filters ``accel_bias_ug``/``accel_bias_sigma_ug`` (body
+    FRD, μg), ``gyro_bias_dph``/``gyro_bias_sigma_dph`` (°/h); fine:
+    ``attitude_sigma_urad`` (1σ φ N/E/D, μrad); scenarios: ``phi_urad`` (attitude error
+    against the truth, convention G, μrad), ``true_accel_bias_ug``,
+    ``true_gyro_bias_dph``; absent values are None. Also ``samples``, ``dt_s``,
+    ``lat_deg``, ``h_m``, ``g_mps2``, ``sigma_z_used_mps``, ``warnings`` and ``history``
+    (filters: a dict of arrays per Kalman update: ``t_s`` (n,), ``euler_deg``,
+    ``attitude_sigma_urad``, ``accel_bias_ug``, ``accel_bias_sigma_ug``,
+    ``gyro_bias_dph``, ``gyro_bias_sigma_dph``, ``phi_urad`` (n, 3) or None)."""
+
+    def __init__(self, d: Dict[str, Any]):
+        self._d = d
+        for k, v in d.items():
+            setattr(self, k, v)
+
+    def as_dict(self) -> Dict[str, Any]:
+        """The fields of ``sdins align --json`` (same keys, None for absent ones)."""
+        keys = (
+            "method", "roll_deg", "pitch_deg", "yaw_deg", "accel_bias_ug",
+            "accel_bias_sigma_ug", "gyro_bias_dph", "gyro_bias_sigma_dph",
+            "attitude_sigma_urad", "phi_urad", "true_accel_bias_ug", "true_gyro_bias_dph",
+        )
+        return {k: self._d[k] for k in keys}
+
+    def to_pandas(self):
+        """The filter history as a DataFrame indexed by ``t_s`` (None for coarse/i0)."""
+        h = self._d.get("history")
+        if h is None:
+            return None
+        cols = [
+            ("euler_deg", h["euler_deg"], ("roll", "pitch", "yaw")),
+            ("sigma_phi_urad", h["attitude_sigma_urad"], "ned"),
+            ("ba_ug", h["accel_bias_ug"], "xyz"),
+            ("sigma_ba_ug", h["accel_bias_sigma_ug"], "xyz"),
+            ("bg_dph", h["gyro_bias_dph"], "xyz"),
+            ("sigma_bg_dph", h["gyro_bias_sigma_dph"], "xyz"),
+        ]
+        if h["phi_urad"] is not None:
+            cols.append(("phi_urad", h["phi_urad"], "ned"))
+        return _frame(h["t_s"], cols)
+
+
+class ErrorAnalysis:
+    """Stationary error analysis (``sdins.errors``): ``report`` (the ``sdins errors
+    --json`` object as a dict: lat_deg, hours, grade, biases, params, epochs with
+    closed_form / linear / nonlinear), ``t_s`` (n,) and the linear model's ``dp_n_m``
+    (n, 3) position error N, E, D [m] and ``sigma_p_m`` (n, 3) 1σ [m] every 10 s,
+    ``budget`` (list of (source, value, (δN, δE) [m]) at the final time)."""
+
+    def __init__(self, d: Dict[str, Any]):
+        import json
+
+        self.report: Dict[str, Any] = json.loads(d["report_json"])
+        self.t_s: np.ndarray = d["t_s"]
+        self.dp_n_m: np.ndarray = d["dp_n_m"]
+        self.sigma_p_m: np.ndarray = d["sigma_p_m"]
+        self.budget: List[Tuple[str, str, Tuple[float, float]]] = [
+            (a, b, (c[0], c[1])) for a, b, c in d["budget"]
+        ]
+
+    def to_pandas(self):
+        """The linear model's time history as a DataFrame indexed by ``t_s``."""
+        return _frame(self.t_s, [("dp_m", self.dp_n_m, "ned"), ("sigma_p_m", self.sigma_p_m, "ned")])
+
+
+class FuseResult:
+    """INS/GNSS filter run (``sdins.fuse``). Per covariance epoch: ``t_s`` (n,);
+    ``error`` (n, 15) true error in state coordinates (δL, δλ [rad], δh [m], δv NED
+    [m/s], φ NED [rad], accelerometer bias [m/s²], gyro bias [rad/s]); ``pos_error_ned_m``
+    (n, 3) position error in metres NED, ``vel_error_ned_mps`` (n, 3) [m/s] and
+    ``att_error_rad`` (n, 3) attitude error φ NED (convention G) [rad] in user units
+    (the CLI's nav.csv); ``sigma`` (n, 15) filter 1σ in user units
+    (position in metres NED, the rest as ``error``); ``nees`` (n, 3) NEES of the
+    position, velocity and attitude blocks (3 dof each). ``innovations``: dict of arrays
+    per measurement update: ``t_s``, ``kind`` (gnss, zupt, nhc), ``dof``, ``nis``,
+    ``accepted``, ``forced``, ``innovation`` (m, 6; first ``dof`` used). Summary:
+    ``fixes``, ``rejected``, ``nav_updates``, ``accel_bias_est_mps2``,
+    ``accel_bias_true_mps2``, ``gyro_bias_est_rps``, ``gyro_bias_true_rps``, ``samples``,
+    ``run``."""
+
+    def __init__(self, d: Dict[str, Any]):
+        self.t_s: np.ndarray = d["t_s"]
+        self.error: np.ndarray = d["error"]
+        self.pos_error_ned_m: np.ndarray = d["pos_error_ned_m"]
+        self.vel_error_ned_mps: np.ndarray = d["vel_error_ned_mps"]
+        self.att_error_rad: np.ndarray = d["att_error_rad"]
+        self.sigma: np.ndarray = d["sigma"]
+        self.nees: np.ndarray = d["nees"]
+        inn = d["innovations"]
+        self.innovations: Dict[str, Any] = {
+            "t_s": inn["t_s"],
+            "kind": np.array(inn["kind"]),
+            "dof": np.asarray(inn["dof"], dtype=np.int64),
+            "nis": inn["nis"],
+            "accepted": np.asarray(inn["accepted"], dtype=bool),
+            "forced": np.asarray(inn["forced"], dtype=bool),
+            "innovation": inn["innovation"],
+        }
+        for k in (
+            "fixes", "rejected", "nav_updates", "accel_bias_est_mps2", "accel_bias_true_mps2",
+            "gyro_bias_est_rps", "gyro_bias_true_rps", "samples", "run",
+        ):
+            setattr(self, k, d[k])
+
+    def rms(self) -> Dict[str, List[float]]:
+        """RMS over the epochs of the position [m], velocity [m/s] and attitude [rad]
+        errors, N, E, D (``sdins fuse --json``: rms_pos_ned_m, rms_vel_ned_mps,
+        rms_att_ned_rad)."""
+        sq = np.zeros(9)
+        blocks = np.concatenate(
+            [self.pos_error_ned_m, self.vel_error_ned_mps, self.att_error_rad], axis=1
+        )
+        n = max(len(self.t_s), 1)
+        for row in blocks:
+            sq += row * row
+        r = [float(np.sqrt(x / n)) for x in sq]
+        return {"rms_pos_ned_m": r[0:3], "rms_vel_ned_mps": r[3:6], "rms_att_ned_rad": r[6:9]}
+
+    def to_pandas(self):
+        """Errors and 1σ per epoch as a DataFrame indexed by ``t_s``."""
+        return _frame(
+            self.t_s,
+            [
+                ("err_pos_m", self.pos_error_ned_m, "ned"),
+                ("err_vel_mps", self.vel_error_ned_mps, "ned"),
+                ("err_att_rad", self.att_error_rad, "ned"),
+                ("sigma_pos_m", self.sigma[:, 0:3], "ned"),
+                ("sigma_vel_mps", self.sigma[:, 3:6], "ned"),
+                ("sigma_att_rad", self.sigma[:, 6:9], "ned"),
+            ],
+        )

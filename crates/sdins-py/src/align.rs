@@ -249,3 +249,10 @@ pub fn errors<'py>(
     res.set_item("budget", budget)?;
     Ok(res)
 }
+
+/// The Schuler-share table (`sdins errors --schuler-share --json`) as JSON text.
+#[pyfunction]
+pub fn schuler_share_json() -> PyResult<String> {
+    serde_json::to_string(&sdins_sim::error_analysis::schuler_share::schuler_share_table_p2())
+        .map_err(err)
+}

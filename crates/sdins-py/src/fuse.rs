@@ -77,6 +77,8 @@ pub fn fuse<'py>(
         t: Vec<f64>,
         err: Vec<f64>,
         pos_m: Vec<f64>,
+        vel_mps: Vec<f64>,
+        att_rad: Vec<f64>,
         sigma: Vec<f64>,
         nees: Vec<f64>,
         it: Vec<f64>,
@@ -94,6 +96,8 @@ pub fn fuse<'py>(
                 a.t.push(e.t_s);
                 a.err.extend(e.err.iter());
                 a.pos_m.extend(e.nav.pos_err_ned_m);
+                a.vel_mps.extend(e.nav.vel_err_ned_mps);
+                a.att_rad.extend(e.nav.att_err_rad);
                 a.sigma.extend((0..NX).map(|i| e.sigma(i)));
                 a.nees.extend([
                     e.nees_block(I_POS),
@@ -126,6 +130,8 @@ pub fn fuse<'py>(
     out.set_item("t_s", vector(py, acc.t))?;
     out.set_item("error", matrix(py, acc.err, NX)?)?;
     out.set_item("pos_error_ned_m", matrix(py, acc.pos_m, 3)?)?;
+    out.set_item("vel_error_ned_mps", matrix(py, acc.vel_mps, 3)?)?;
+    out.set_item("att_error_rad", matrix(py, acc.att_rad, 3)?)?;
     out.set_item("sigma", matrix(py, acc.sigma, NX)?)?;
     out.set_item("nees", matrix(py, acc.nees, 3)?)?;
     let inn = PyDict::new(py);
