@@ -361,7 +361,8 @@ pub struct AlignOutcome {
     pub warnings: Vec<String>,
 }
 
-fn check_site(lat_deg: Option<f64>, h_m: Option<f64>) -> Result<(), AlignRunError> {
+/// Check a site override: latitude within ±89.99°, height in [−1 km, 100 km].
+pub fn check_site(lat_deg: Option<f64>, h_m: Option<f64>) -> Result<(), AlignRunError> {
     for (option, flag, v, lo, hi) in [
         ("lat_deg", "--lat", lat_deg, -89.99, 89.99),
         ("h_m", "--h", h_m, -1000.0, 100_000.0),

@@ -23,8 +23,8 @@ use sdins_core::align::Site;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{c_b_n_from_euler, Euler, Mat3, Vec3};
 use sdins_sim::align_run::{
-    align, check_options, AlignInput, AlignMethod, AlignOptions, AlignOutcome, AlignRunError,
-    FineStart, MultiheadingAlg,
+    align, check_options, check_site, AlignInput, AlignMethod, AlignOptions, AlignOutcome,
+    AlignRunError, FineStart, MultiheadingAlg,
 };
 use sdins_sim::imu_error::{DPH, DPSH, UG};
 use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
@@ -249,6 +249,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let opts = args.options();
     check_options(&opts).map_err(run_error)?;
+    check_site(args.lat, args.h).map_err(run_error)?;
     let inp = load(&args)?;
     let res = align(&inp, &opts, &crate::progress::token()).map_err(run_error)?;
     for w in &res.warnings {

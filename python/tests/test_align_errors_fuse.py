@@ -1,0 +1,123 @@
+"""sdins.align, sdins.errors and sdins.fuse give the CLI's numbers to the last bit (the
+CLI's JSON floats are shortest round-trip decimals, so every comparison is `==`), and
+bad input raises SdinsError with the CLI's located message."""
+
+import json
+
+import numpy as np
+import pytest
+
+import sdins
+
+ALIGN_KEYS = (
+    "method", "roll_deg", "pitch_deg", "yaw_deg", "accel_bias_ug", "accel_bias_sigma_ug",
+    "gyro_bias_dph", "gyro_bias_sigma_dph", "attitude_sigma_urad", "phi_urad",
+    "true_accel_bias_ug", "true_gyro_bias_dph",
+)
+
+
+@pytest.mark.parametrize(
+    "args,kw",
+    [
+        (["alignment", "--method", "coarse2", "--duration-s", "300"],
+         dict(scenario="alignment", method="coarse2", duration_s=300.0)),
+        (["alignment", "--method", "fine", "--duration-s", "300", "--run", "2"],
+         dict(scenario="alignment", method="fine", duration_s=300.0, run=2)),
+        (["moored-ship", "--method", "i0", "--window-s", "300"],
+         dict(scenario="moored-ship", method="i0", window_s=300.0)),
+    ],
+)
+def test_align_equals_cli_json(cli, args, kw):
+    code, out, err = cli(*["align", *args, "--json"])
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.align(**kw)
+    d = r.as_dict()
+    for k in ALIGN_KEYS:
+        if k in js:
+            assert d[k] == js[k], k
+        else:
+            assert d[k] is None, k
+    if kw["method"] == "fine":
+        h = r.history
+        assert h["t_s"].shape[0] == h["euler_deg"].shape[0] > 10
+        assert h["phi_urad"].shape == h["euler_deg"].shape
+
+
+def test_align_refuses_motion_and_names_the_option(cli):
+    with pytest.raises(sdins.SdinsError, match=r"truth speed is 340\.\d+ m/s at t = 0\.\d+ s.*--method i0"):
+        sdins.align("mach1-east", method="coarse2")
+    code, _, err = cli(*["align", "mach1-east", "--method", "coarse2"])
+    assert code == 2
+    with pytest.raises(sdins.SdinsError) as e:
+        sdins.align("alignment", sigma_z_mps=-1.0)
+    assert "--sigma-z -1: expected a positive velocity σ in m/s" in str(e.value)
+    code, _, err = cli(*["align", "alignment", "--sigma-z=-1"])
+    assert code == 2 and "--sigma-z -1: expected a positive velocity σ in m/s" in err
+    with pytest.raises(sdins.SdinsError, match="method"):
+        sdins.align("alignment", method="nope")
+
+
+def test_errors_equals_cli_json(cli, tmp_path):
+    args = ["errors", "--gyro-bias-dph", "0,0.01,0", "--accel-bias-ug", "30,0,0",
+            "--hours", "3", "--json", "--out", str(tmp_path / "e")]
+    code, out, err = cli(*args)
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.errors(gyro_bias_dph=[0, 0.01, 0], accel_bias_ug=[30, 0, 0], hours=3.0)
+    assert r.report == js
+    assert r.t_s.shape == (3 * 360 + 1,) and r.dp_n_m.shape == (r.t_s.shape[0], 3)
+    # the linear model at an epoch is the report's
+    k = int(round(js["epochs"][-1]["t_h"] * 3600 / 10))
+    assert list(r.dp_n_m[k]) == js["epochs"][-1]["linear"]["dp_n_m"]
+    assert len(r.budget) == 2
+
+
+def test_errors_bad_input(cli):
+    with pytest.raises(sdins.SdinsError, match=r"--hours: must be in \(0, 240\], got -1"):
+        sdins.errors(grade="aviation", hours=-1.0)
+    with pytest.raises(sdins.SdinsError, match="unknown grade"):
+        sdins.errors(grade="nope")
+    code, _, err = cli(*["errors", "--grade", "nope"])
+    assert code == 2 and "unknown grade" in err
+
+
+def test_schuler_share_equals_cli(cli):
+    code, out, _ = cli(*["errors", "--schuler-share", "--json"])
+    assert code == 0
+    assert sdins.schuler_share() == json.loads(out)
+
+
+def test_fuse_equals_cli_json(cli, tmp_path):
+    code, out, err = cli(*["fuse", "dq-paper", "--json", "--out", str(tmp_path / "f")])
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.fuse("dq-paper")
+    assert r.fixes == js["fixes"] and r.rejected == js["rejected"]
+    for k in ("accel_bias_est_mps2", "accel_bias_true_mps2", "gyro_bias_est_rps", "gyro_bias_true_rps"):
+        assert r.__dict__[k] == js[k], k
+    rms = r.rms()
+    for k in ("rms_pos_ned_m", "rms_vel_ned_mps", "rms_att_ned_rad"):
+        assert rms[k] == js[k], k
+    n = r.t_s.shape[0]
+    assert r.error.shape == (n, 15) and r.sigma.shape == (n, 15) and r.nees.shape == (n, 3)
+    assert np.all(r.sigma[:, :3] > 0) and np.all(np.isfinite(r.nees))
+    # nav.csv of the CLI: position error and its σ in metres, to the last bit
+    with open(tmp_path / "f" / "nav.csv") as f:
+        rows = [l.strip().split(",") for l in f][1:]
+    assert len(rows) == n
+    for k in (0, n // 2, n - 1):
+        row = [float(x) for x in rows[k]]
+        assert row[0] == r.t_s[k]
+        assert row[1:4] == list(r.pos_error_ned_m[k])
+        assert row[4:7] == list(r.sigma[k, 0:3])
+    inn = r.innovations
+    assert (inn["kind"] == "gnss").sum() == js["fixes"]
+    assert (~inn["accepted"]).sum() == js["rejected"]
+
+
+def test_fuse_bad_input():
+    with pytest.raises(sdins.SdinsError, match="cov_rate_hz"):
+        sdins.fuse("dq-paper", cov_rate_hz=-1.0)
+    with pytest.raises(sdins.SdinsError, match="algo"):
+        sdins.fuse("dq-paper", algo="nope")
