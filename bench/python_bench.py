@@ -56,6 +56,18 @@ def main():
         nav = sdins.navigate(t.dtheta_rad, t.dv_mps, t.dt_s, init, samples=3)
         py.append(time.perf_counter() - t0)
         rust.append(nav.wall_s)
+    # the same work in Rust alone (arrays in, state columns with Euler angles and q_b_n
+    # out): examples/navigate_arrays, run alternately with the Python calls so that both
+    # see the same load
+    ex = ROOT / "target" / "release" / "examples" / "navigate_arrays"
+    ref, py_alt = [], []
+    if ex.exists():
+        for _ in range(a.repeat):
+            out = subprocess.run([str(ex)], capture_output=True, text=True, check=True).stdout
+            ref.append(float(out.split(":")[1].split("ms")[0]) / 1e3)
+            t0 = time.perf_counter()
+            sdins.navigate(t.dtheta_rad, t.dv_mps, t.dt_s, init, samples=3)
+            py_alt.append(time.perf_counter() - t0)
     cli = []
     if os.path.exists(a.sdins):
         with tempfile.TemporaryDirectory() as d:
@@ -76,6 +88,11 @@ def main():
     print(f"navigate, {n} samples, {nav.updates} updates (songlee-complete, N = 3), median of {a.repeat}:")
     print(f"  Python call sdins.navigate        {med(py) * 1e3:8.1f} ms")
     print(f"  Rust loop inside that call        {med(rust) * 1e3:8.1f} ms   ratio {med(py) / med(rust):.2f}")
+    if ref:
+        print(f"  Rust alone, examples/navigate_arrays {med(ref) * 1e3:5.1f} ms   "
+              f"Python call alternating with it {med(py_alt) * 1e3:.1f} ms: ratio {med(py_alt) / med(ref):.2f}")
+    else:
+        print(f"  (build the reference: cargo build --release -p sdins-sim --example navigate_arrays)")
     if cli:
         print(f"  Rust alone, sdins nav --json      {med(cli) * 1e3:8.1f} ms   ratio {med(py) / med(cli):.2f}")
     print("peak memory of sdins.truth('mach1-east', ...), fresh process:")

@@ -34,16 +34,24 @@ pub fn increments(
         (Ok(x), Ok(y)) => (x, y),
         _ => return Err(err("dtheta and dv: expected C-contiguous float64 arrays")),
     };
-    let mut out = Vec::with_capacity(a[0]);
-    for (k, (p, q)) in x.chunks_exact(3).zip(y.chunks_exact(3)).enumerate() {
-        if !(p.iter().all(|v| v.is_finite()) && q.iter().all(|v| v.is_finite())) {
-            return Err(err(format!("dtheta/dv row {k}: not finite")));
-        }
-        out.push(Increment {
+    // one branch-free finiteness pass over each flat slice, then one conversion pass
+    // (the work of examples/navigate_arrays); the row is located only on failure
+    if !(x.iter().all(|v| v.is_finite()) && y.iter().all(|v| v.is_finite())) {
+        let k = x
+            .chunks_exact(3)
+            .zip(y.chunks_exact(3))
+            .position(|(p, q)| !(p.iter().chain(q).all(|v| v.is_finite())))
+            .unwrap_or(0);
+        return Err(err(format!("dtheta/dv row {k}: not finite")));
+    }
+    let out: Vec<Increment> = x
+        .chunks_exact(3)
+        .zip(y.chunks_exact(3))
+        .map(|(p, q)| Increment {
             dtheta_b_rad: Vec3::new(p[0], p[1], p[2]),
             dv_b_mps: Vec3::new(q[0], q[1], q[2]),
-        });
-    }
+        })
+        .collect();
     Ok(out)
 }
 
