@@ -15,6 +15,10 @@
 //!   whenever the truth is not at rest; both at the covariance rate.
 //! * The observer sees every covariance epoch (true error in the filter's state
 //!   coordinates and P, after that epoch's measurements) and every measurement report.
+//! * With [`FuseOptions::smooth`], the covariance epochs are logged
+//!   ([`crate::smoother::SmootherLog`]) and, after the forward pass, the
+//!   Rauch–Tung–Striebel smoother's epochs arrive as [`FuseEvent::Smoothed`] in time
+//!   order (true error of the smoothed state and the smoothed covariance).
 
 use crate::cancel::{CancelToken, Cancelled};
 use crate::gnss::{GnssConfig, GnssConfigError, GnssSimulator};
@@ -23,17 +27,19 @@ use crate::imu_error::{ImuErrorModel, ImuErrorState, DEG, DPH, DPHPSH, DPSH, MPS
 use crate::imu_error::{UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ};
 use crate::pipeline::nav_error;
 use crate::scenario::Scenario;
+use crate::smoother::{SmootherError, SmootherLog};
 use crate::truth::{lon_diff, TruthConfig, TruthGenerator, TruthSample};
 use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
 use sdins_core::aiding::ekf::{
-    Ekf, EkfConfig, FilterError, GnssMeasurement, NoiseModel, UpdateReport, CHI2_999,
+    correct_nav_state, Ekf, EkfConfig, FilterError, GnssMeasurement, NoiseModel, UpdateReport,
+    CHI2_999,
 };
 use sdins_core::aiding::error_model::{StateMat, StateVec, I_ATT, I_BA, I_BG, I_POS, I_VEL};
 use sdins_core::coning::Increment;
 use sdins_core::math::{Quat, Vec3};
-use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, Mechanization};
+use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, NavState};
 
 /// Initial 1σ errors of position \[m NED\], velocity \[m/s NED\], attitude \[rad NED\].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,6 +85,8 @@ pub struct FuseOptions {
     pub model_lever_arm: bool,
     /// stop after this time \[s\]
     pub until_s: Option<f64>,
+    /// run the Rauch–Tung–Striebel smoother after the forward pass
+    pub smooth: bool,
 }
 
 impl Default for FuseOptions {
@@ -94,6 +102,7 @@ impl Default for FuseOptions {
             nhc_sigma_mps: None,
             model_lever_arm: true,
             until_s: None,
+            smooth: false,
         }
     }
 }
@@ -114,6 +123,9 @@ pub enum FuseError {
     /// The filter failed (names the epoch).
     #[error(transparent)]
     Filter(#[from] FilterError),
+    /// The smoother failed (names the epoch).
+    #[error(transparent)]
+    Smoother(#[from] SmootherError),
     /// Cancelled.
     #[error("cancelled")]
     Cancelled(#[from] Cancelled),
@@ -163,11 +175,14 @@ impl FuseEpoch {
 
 /// What the observer receives.
 #[derive(Clone, Copy, Debug)]
+#[non_exhaustive]
 pub enum FuseEvent<'a> {
-    /// a covariance epoch
+    /// a covariance epoch of the forward filter
     Epoch(&'a FuseEpoch),
     /// a measurement update (GNSS, ZUPT, NHC)
     Update(&'a UpdateReport),
+    /// a smoothed epoch (after the forward pass, in time order)
+    Smoothed(&'a FuseEpoch),
 }
 
 /// Summary of a fused run.
@@ -369,6 +384,19 @@ pub fn fuse_scenario_with(
     );
     let mut incs = [Increment::default(); 4];
     let mut pending: Vec<GnssFix> = Vec::with_capacity(8);
+    // forward records for the smoother: the log, and per epoch the forward state, its
+    // bias estimates and the truth
+    let mut smooth = opts.smooth.then(|| {
+        let epochs = (total / cov_updates as u64 + 2) as usize;
+        (
+            SmootherLog::with_capacity(epochs),
+            Vec::<(NavState, (Vec3, Vec3), TruthSample)>::with_capacity(epochs),
+        )
+    });
+    if let Some((log, fwd)) = smooth.as_mut() {
+        log.push(&ekf.initial_epoch())?;
+        fwd.push((ekf.state(), ekf.biases(), prev_truth));
+    }
     let mut fixes = 0u64;
     let mut last_cur = prev_truth;
     for k in 0..total {
@@ -421,12 +449,40 @@ pub fn fuse_scenario_with(
                 observe(FuseEvent::Update(&rep));
             }
         }
-        if ekf.take_epoch().is_some() {
-            let e = epoch_of(&ekf, &cur, &earth, true_ba, true_bg);
+        if let Some(ep) = ekf.take_epoch() {
+            let e = epoch_of(
+                &ekf.state(),
+                ekf.biases(),
+                ekf.covariance(),
+                &cur,
+                &earth,
+                true_ba,
+                true_bg,
+            );
             observe(FuseEvent::Epoch(&e));
+            if let Some((log, fwd)) = smooth.as_mut() {
+                log.push(&ep)?;
+                fwd.push((ekf.state(), ekf.biases(), cur));
+            }
         }
     }
     let _ = last_cur;
+    if let Some((log, fwd)) = smooth {
+        let mut out: Vec<Option<FuseEpoch>> = vec![None; fwd.len()];
+        log.smooth(cancel, |k, _, sm| {
+            if let (Some((st, (ba, bg), tr)), Some(slot)) = (fwd.get(k), out.get_mut(k)) {
+                let s_state = correct_nav_state(st, &sm.dx);
+                let b = (
+                    ba + sm.dx.fixed_rows::<3>(I_BA),
+                    bg + sm.dx.fixed_rows::<3>(I_BG),
+                );
+                *slot = Some(epoch_of(&s_state, b, &sm.p, tr, &earth, true_ba, true_bg));
+            }
+        })?;
+        for e in out.iter().flatten() {
+            observe(FuseEvent::Smoothed(e));
+        }
+    }
     let (ba, bg) = ekf.biases();
     Ok(FuseSummary {
         fixes,
@@ -438,20 +494,20 @@ pub fn fuse_scenario_with(
     })
 }
 
-fn epoch_of<M: Mechanization>(
-    ekf: &Ekf<M>,
+fn epoch_of(
+    st: &NavState,
+    (ba, bg): (Vec3, Vec3),
+    p: &StateMat,
     truth: &TruthSample,
     earth: &sdins_core::earth::EarthModel,
     true_ba: Vec3,
     true_bg: Vec3,
 ) -> FuseEpoch {
-    let st = ekf.state();
-    let ne = nav_error(earth, &st, truth);
+    let ne = nav_error(earth, st, truth);
     let mut err = StateVec::zeros();
     err[I_POS] = st.lat_rad - truth.lat_rad;
     err[I_POS + 1] = lon_diff(st.lon_rad, truth.lon_rad);
     err[I_POS + 2] = st.h_m - truth.h_m;
-    let (ba, bg) = ekf.biases();
     for i in 0..3 {
         err[I_VEL + i] = ne.vel_err_ned_mps[i];
         err[I_ATT + i] = ne.att_err_rad[i];
@@ -462,7 +518,7 @@ fn epoch_of<M: Mechanization>(
     FuseEpoch {
         t_s: st.t_s,
         err,
-        p: *ekf.covariance(),
+        p: *p,
         pos_scale: Vec3::new(
             r.r_m_m + truth.h_m,
             (r.r_n_m + truth.h_m) * truth.lat_rad.cos(),

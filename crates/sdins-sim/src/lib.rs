@@ -61,6 +61,7 @@ pub mod navego_params;
 pub mod pipeline;
 pub mod run_setup;
 pub mod scenario;
+pub mod smoother;
 pub mod trajectory;
 pub mod truth;
 pub mod truth_file;

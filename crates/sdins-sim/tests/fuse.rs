@@ -63,6 +63,7 @@ fn short_run_every_algorithm_stays_consistent() {
                         nis.push(r.nis);
                     }
                 }
+                _ => {}
             })
             .unwrap();
             let e = last.unwrap();
@@ -107,6 +108,7 @@ const Z99: f64 = 2.575_829_303_548_901;
 
 struct Run {
     epochs: Vec<FuseEpoch>,
+    smoothed: Vec<FuseEpoch>,
     gnss: Vec<(f64, f64, bool)>,
     #[allow(dead_code)]
     summary: FuseSummary,
@@ -118,6 +120,7 @@ fn run_mc(scn: &Scenario, gnss: &GnssConfig, opts: &FuseOptions, runs: u64) -> V
         .into_par_iter()
         .map(|r| {
             let mut epochs = Vec::new();
+            let mut smoothed = Vec::new();
             let mut g = Vec::new();
             let summary = fuse_scenario_with(
                 scn,
@@ -133,11 +136,14 @@ fn run_mc(scn: &Scenario, gnss: &GnssConfig, opts: &FuseOptions, runs: u64) -> V
                             g.push((u.t_s, u.nis, u.accepted));
                         }
                     }
+                    FuseEvent::Smoothed(e) => smoothed.push(*e),
+                    _ => {}
                 },
             )
             .unwrap();
             Run {
                 epochs,
+                smoothed,
                 gnss: g,
                 summary,
             }
@@ -271,7 +277,11 @@ fn mc_outage_60s_tactical() {
         outages_s: vec![[300.0, 360.0]],
         ..Default::default()
     };
-    let runs = run_mc(&scn, &gnss, &no_gate(), 100);
+    let opts = FuseOptions {
+        smooth: true,
+        ..no_gate()
+    };
+    let runs = run_mc(&scn, &gnss, &opts, 100);
     let k_end = runs[0]
         .epochs
         .iter()
@@ -286,20 +296,92 @@ fn mc_outage_60s_tactical() {
         chi2_mean_quantile(2.0, 100.0, -Z95),
         chi2_mean_quantile(2.0, 100.0, Z95),
     );
-    let rms_h = (runs
-        .iter()
-        .map(|r| {
-            let p = r.epochs[k_end].nav.pos_err_ned_m;
-            p[0] * p[0] + p[1] * p[1]
-        })
-        .sum::<f64>()
-        / 100.0)
-        .sqrt();
+    let rms_h = |ep: &dyn Fn(&Run) -> &FuseEpoch| {
+        (runs
+            .iter()
+            .map(|r| {
+                let p = ep(r).nav.pos_err_ned_m;
+                p[0] * p[0] + p[1] * p[1]
+            })
+            .sum::<f64>()
+            / 100.0)
+            .sqrt()
+    };
     println!(
-        "outage end t = {:.2} s: horizontal NEES {nees_h:.3} (band [{lo:.2}, {hi:.2}]), RMS horizontal error {rms_h:.2} m",
-        runs[0].epochs[k_end].t_s
+        "outage end t = {:.2} s: horizontal NEES {nees_h:.3} (band [{lo:.2}, {hi:.2}]), RMS horizontal error {:.2} m",
+        runs[0].epochs[k_end].t_s,
+        rms_h(&|r: &Run| &r.epochs[k_end])
     );
     assert!((lo..=hi).contains(&nees_h), "horizontal NEES {nees_h}");
+
+    // smoother: one smoothed epoch per forward epoch (plus the initial one), P_s ≤ P_f
+    let mut worst = f64::INFINITY;
+    for r in &runs {
+        assert_eq!(r.smoothed.len(), r.epochs.len() + 1);
+        for (f, s) in r.epochs.iter().zip(&r.smoothed[1..]) {
+            assert_eq!(f.t_s, s.t_s);
+            let d = f.p - s.p;
+            let min_eig = d.symmetric_eigenvalues().min();
+            worst = worst.min(min_eig / f.p.norm());
+        }
+    }
+    println!("smallest eigenvalue of P_f − P_s over ‖P_f‖: {worst:.3e}");
+    assert!(worst >= -1e-12, "P_f − P_s has eigenvalue {worst} ‖P_f‖");
+    // smoothed NEES through the outage: the consistency criteria on the outage epochs
+    let in_outage = |e: &FuseEpoch| e.t_s > 300.0 && e.t_s < 360.0;
+    let idx: Vec<usize> = (0..runs[0].smoothed.len())
+        .filter(|&k| in_outage(&runs[0].smoothed[k]))
+        .collect();
+    let mean_at = |k: usize, f: &dyn Fn(&FuseEpoch) -> f64| {
+        runs.iter().map(|r| f(&r.smoothed[k])).sum::<f64>() / runs.len() as f64
+    };
+    let h: Vec<f64> = idx
+        .iter()
+        .map(|&k| mean_at(k, &|e| e.nees_horizontal()))
+        .collect();
+    check_band("smoothed horizontal NEES in the outage", &h, 2.0, 100.0);
+    for (name, i0) in [
+        ("position", I_POS),
+        ("velocity", I_VEL),
+        ("attitude", I_ATT),
+    ] {
+        let m: Vec<f64> = idx
+            .iter()
+            .map(|&k| mean_at(k, &|e| e.nees_block(i0)))
+            .collect();
+        check_band(
+            &format!("smoothed NEES {name} in the outage"),
+            &m,
+            3.0,
+            100.0,
+        );
+    }
+    // ratio of forward to smoothed maximum RMS horizontal error in the outage
+    let max_rms = |get: &dyn Fn(&Run, usize) -> &FuseEpoch, ks: &[usize]| {
+        ks.iter()
+            .map(|&k| {
+                (runs
+                    .iter()
+                    .map(|r| {
+                        let p = get(r, k).nav.pos_err_ned_m;
+                        p[0] * p[0] + p[1] * p[1]
+                    })
+                    .sum::<f64>()
+                    / 100.0)
+                    .sqrt()
+            })
+            .fold(0.0, f64::max)
+    };
+    let kf: Vec<usize> = (0..runs[0].epochs.len())
+        .filter(|&k| in_outage(&runs[0].epochs[k]))
+        .collect();
+    let f_max = max_rms(&|r, k| &r.epochs[k], &kf);
+    let s_max = max_rms(&|r, k| &r.smoothed[k], &idx);
+    println!(
+        "outage: max RMS horizontal error forward {f_max:.3} m, smoothed {s_max:.3} m, ratio {:.2}",
+        f_max / s_max
+    );
+    assert!(s_max < f_max);
 }
 
 /// Time-averaged position error along C_b^n l̂ per run (after 30 s).
@@ -464,6 +546,7 @@ fn gating_rejects_a_100m_outlier_and_the_solution_is_unaffected() {
                     rejected_at.push((i, u.t_s, u.nis));
                 }
             }
+            _ => {}
         })
         .unwrap();
         assert_eq!(s.rejected, i as u64);

@@ -147,6 +147,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 }
                 writeln!(inn.writer(), "{line}")
             }
+            _ => Ok(()),
         };
         if let Err(e) = r {
             werr.get_or_insert(e);
