@@ -49,6 +49,8 @@ pub mod cancel;
 pub mod envelope;
 pub mod error_analysis;
 pub mod fuse;
+pub mod fuse_files;
+pub mod fuse_records;
 pub mod gnss;
 pub mod gnss_file;
 pub mod gnss_fix;
