@@ -451,13 +451,7 @@ pub fn fuse_records(
         gate_chi2: opts.gate_chi2,
         max_consecutive_rejections: opts.max_consecutive_rejections,
     };
-    let mut ekf = Ekf::new(
-        mech,
-        cfg,
-        p0,
-        model.accel_bias0_mps2,
-        model.gyro_bias0_rps,
-    );
+    let mut ekf = Ekf::new(mech, cfg, p0, model.accel_bias0_mps2, model.gyro_bias0_rps);
     let samples = &imu.increments[start_k.min(imu.increments.len())..];
     let total = samples.len() / n;
     let mut log_and_track = opts.smooth.then(|| {
@@ -601,9 +595,7 @@ pub struct TruthComparison {
 }
 
 /// Axis names of [`TruthComparison`], in order.
-pub const COMPARISON_AXES: [&str; 9] = [
-    "roll", "pitch", "yaw", "v_N", "v_E", "v_D", "N", "E", "D",
-];
+pub const COMPARISON_AXES: [&str; 9] = ["roll", "pitch", "yaw", "v_N", "v_E", "v_D", "N", "E", "D"];
 
 impl TruthComparison {
     /// Compare against `truth` (times on the IMU clock, increasing); the ±3σ fractions
@@ -713,10 +705,7 @@ fn from_fix(
                 (f1.lon_rad - f0.lon_rad) * sc.y,
                 -(f1.h_m - f0.h_m),
             );
-            (
-                d / dt,
-                (f0.pos_cov_ned_m2 + f1.pos_cov_ned_m2) / (dt * dt),
-            )
+            (d / dt, (f0.pos_cov_ned_m2 + f1.pos_cov_ned_m2) / (dt * dt))
         }
         _ => {
             return Err(opt_err(
@@ -762,7 +751,12 @@ mod tests {
             ];
             for i in 0..3 {
                 // O(h) truncation plus rounding ε/h
-                assert!((d[i] - m[(i, j)]).abs() < 1e-6, "({i},{j}) {} vs {}", d[i], m[(i, j)]);
+                assert!(
+                    (d[i] - m[(i, j)]).abs() < 1e-6,
+                    "({i},{j}) {} vs {}",
+                    d[i],
+                    m[(i, j)]
+                );
             }
         }
     }

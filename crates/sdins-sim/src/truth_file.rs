@@ -335,7 +335,14 @@ pub fn parse_navego_ref(path: &Path, text: &str) -> Result<Vec<TruthSample>, Tru
             check_range(path, line, &cols, 3, r[3], H_RANGE_M)?;
         }
         let c = c_b_n_from_euler(&Euler::new(r[7], r[8], r[9]));
-        out.push(sample(r[0], r[1], r[2], r[3], Vec3::new(r[4], r[5], r[6]), c));
+        out.push(sample(
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            Vec3::new(r[4], r[5], r[6]),
+            c,
+        ));
     }
     Ok(out)
 }

@@ -55,10 +55,8 @@ fn run(d: &Path, imu: &str) -> ([f64; 9], [f64; 9], [f64; 9], [f64; 9]) {
 
 /// docs/validation.md, "NaveGo INS/GNSS": RMSE over all 200 Hz epochs, roll, pitch, yaw
 /// [deg], v_N, v_E, v_D [m/s], N, E, D [m]; (imu, forward, smoothed).
-const TABLE: [(&str, [f64; 9], [f64; 9]); 2] = [
-    ("imu1", IMU1_FWD, IMU1_SMO),
-    ("imu2", IMU2_FWD, IMU2_SMO),
-];
+const TABLE: [(&str, [f64; 9], [f64; 9]); 2] =
+    [("imu1", IMU1_FWD, IMU1_SMO), ("imu2", IMU2_FWD, IMU2_SMO)];
 include!("navego_fuse_table.rs");
 
 #[test]
@@ -83,11 +81,24 @@ fn navego_imu1_imu2_forward_and_smoothed() {
                 "{imu} {:>5}: RMSE forward {:.6e} smoothed {:.6e}; inside ±3σ after 30 s: forward {:.4}, smoothed {:.4}",
                 COMPARISON_AXES[i], fr[i], sr[i], fi[i], si[i]
             );
-            assert!(fi[i] >= 0.95 && si[i] >= 0.95, "{imu} {}: inside 3σ {} / {}", COMPARISON_AXES[i], fi[i], si[i]);
-            assert!(sr[i] <= fr[i], "{imu} {}: smoothed RMSE above forward", COMPARISON_AXES[i]);
+            assert!(
+                fi[i] >= 0.95 && si[i] >= 0.95,
+                "{imu} {}: inside 3σ {} / {}",
+                COMPARISON_AXES[i],
+                fi[i],
+                si[i]
+            );
+            assert!(
+                sr[i] <= fr[i],
+                "{imu} {}: smoothed RMSE above forward",
+                COMPARISON_AXES[i]
+            );
         }
         for (name, v) in [("FWD", fr), ("SMO", sr)] {
-            out.push_str(&format!("const {}_{name}: [f64; 9] = {v:?};\n", imu.to_uppercase()));
+            out.push_str(&format!(
+                "const {}_{name}: [f64; 9] = {v:?};\n",
+                imu.to_uppercase()
+            ));
         }
         for (name, v) in [("forward", fr), ("smoothed", sr)] {
             md.push_str(&format!("| {imu} | {name} |"));
@@ -100,12 +111,26 @@ fn navego_imu1_imu2_forward_and_smoothed() {
             for (got, want) in [(fr, want_f), (sr, want_s)] {
                 for i in 0..9 {
                     let rel = (got[i] - want[i]).abs() / want[i].abs();
-                    assert!(rel <= 1e-9, "{imu} {}: {} vs table {} (rel {rel:e})", COMPARISON_AXES[i], got[i], want[i]);
+                    assert!(
+                        rel <= 1e-9,
+                        "{imu} {}: {} vs table {} (rel {rel:e})",
+                        COMPARISON_AXES[i],
+                        got[i],
+                        want[i]
+                    );
                 }
             }
         }
     }
     println!("{md}");
+    let doc = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/validation.md"),
+    )
+    .unwrap();
+    assert!(
+        doc.contains(&md),
+        "docs/validation.md does not hold the table:\n{md}"
+    );
     if write {
         std::fs::write(
             Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/navego_fuse_table.rs"),

@@ -6,6 +6,7 @@ pub mod allan;
 pub mod demo;
 pub mod errors;
 pub mod fuse;
+pub mod fuse_files;
 pub mod merge;
 pub mod montecarlo;
 pub mod nav;
