@@ -66,7 +66,12 @@ fn fuse_on_recorded_files_and_bad_gnss_files() {
     std::fs::write(&scn, SCN).unwrap();
     let rec = dir.join("rec");
     let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
-        .args(["truth", scn.to_str().unwrap(), "--out", rec.to_str().unwrap()])
+        .args([
+            "truth",
+            scn.to_str().unwrap(),
+            "--out",
+            rec.to_str().unwrap(),
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -98,7 +103,14 @@ fn fuse_on_recorded_files_and_bad_gnss_files() {
             .output()
             .unwrap()
     };
-    let o = run(&gnss, &["--truth", rec.join("truth.csv").to_str().unwrap(), "--smooth"]);
+    let o = run(
+        &gnss,
+        &[
+            "--truth",
+            rec.join("truth.csv").to_str().unwrap(),
+            "--smooth",
+        ],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["fixes_used"], 60);
@@ -118,15 +130,31 @@ fn fuse_on_recorded_files_and_bad_gnss_files() {
     let cases = [
         ("empty", String::new(), "g-empty.csv"),
         ("header only", header.to_string(), "g-header.csv:1"),
-        ("NaN", format!("{header}1,37.5,127,0,1,1,nan\n"), "g-nan.csv:2"),
+        (
+            "NaN",
+            format!("{header}1,37.5,127,0,1,1,nan\n"),
+            "g-nan.csv:2",
+        ),
         (
             "time backwards",
             format!("{header}2,37.5,127,0,1,1,2\n1,37.5,127,0,1,1,2\n"),
             "g-back.csv:3",
         ),
-        ("sigma <= 0", format!("{header}1,37.5,127,0,0,1,2\n"), "g-sigma.csv:2"),
-        ("latitude", format!("{header}1,95,127,0,1,1,2\n"), "g-lat.csv:2"),
-        ("no overlap", format!("{header}1000,37.5,127,0,1,1,2\n"), "g-late.csv"),
+        (
+            "sigma <= 0",
+            format!("{header}1,37.5,127,0,0,1,2\n"),
+            "g-sigma.csv:2",
+        ),
+        (
+            "latitude",
+            format!("{header}1,95,127,0,1,1,2\n"),
+            "g-lat.csv:2",
+        ),
+        (
+            "no overlap",
+            format!("{header}1000,37.5,127,0,1,1,2\n"),
+            "g-late.csv",
+        ),
     ];
     for (what, text, want) in cases {
         let name = want.split(':').next().unwrap();

@@ -462,25 +462,30 @@ pub fn fuse_records(
             Vec::<((Vec3, Vec3), Mat3, Vec3)>::with_capacity(epochs),
         )
     });
-    let point = |ekf: &Ekf<AnyMechanization>| {
+    // σ change only at covariance epochs and updates: computed there, reused in between
+    let sig_of = |ekf: &Ekf<AnyMechanization>| {
         let s = ekf.state();
-        let (nav, eul, b) = sigmas(ekf.covariance(), &s.c_b_n, &scale_at(&earth, &s));
+        sigmas(ekf.covariance(), &s.c_b_n, &scale_at(&earth, &s))
+    };
+    let point = |ekf: &Ekf<AnyMechanization>, sig: &([f64; 9], [f64; 3], [f64; 6])| {
+        let s = ekf.state();
         RecordPoint {
             t_s: t_start + s.t_s,
             state: s,
             bias: ekf.biases(),
-            sigma_nav: nav,
-            sigma_euler_rad: eul,
-            sigma_bias: b,
+            sigma_nav: sig.0,
+            sigma_euler_rad: sig.1,
+            sigma_bias: sig.2,
         }
     };
+    let mut sig_now = sig_of(&ekf);
     if let Some((log, track, bias)) = log_and_track.as_mut() {
         log.push(&ekf.initial_epoch())?;
         track.push(Compact::of(&ekf.state()));
         let s = ekf.state();
         bias.push((ekf.biases(), s.c_b_n, scale_at(&earth, &s)));
     }
-    observe(RecordEvent::Forward(&point(&ekf)));
+    observe(RecordEvent::Forward(&point(&ekf, &sig_now)));
     let mut next_fix = skip_fixes;
     // fixes before the navigation start are not used
     while next_fix < fixes.len() && fixes[next_fix].t_s - t_start <= 1e-9 {
@@ -517,6 +522,7 @@ pub fn fuse_records(
         let ep = ekf.take_epoch();
         if ep.is_some() {
             cov_epochs += 1;
+            sig_now = sig_of(&ekf);
         }
         if let (Some(ep), Some((log, _, bias))) = (ep, log_and_track.as_mut()) {
             log.push(&ep)?;
@@ -526,7 +532,7 @@ pub fn fuse_records(
         if let Some((_, track, _)) = log_and_track.as_mut() {
             track.push(Compact::of(&ekf.state()));
         }
-        observe(RecordEvent::Forward(&point(&ekf)));
+        observe(RecordEvent::Forward(&point(&ekf, &sig_now)));
     }
     let mut smoother_bytes = 0;
     if let Some((log, track, bias)) = log_and_track {
@@ -760,4 +766,61 @@ mod tests {
             }
         }
     }
+}
+
+/// A recorded data set simulated from a scenario: the IMU record (the scenario's IMU
+/// errors of run `run`, FRD increments stamped at sample ends, `t0_s = δt`) and the GNSS
+/// fixes of `gnss` (same clock), without keeping the truth in memory. The input of
+/// [`fuse_records`] for benchmarks and for tests on a known truth (regenerate it with
+/// `fuse::scenario_truth`).
+pub fn record_from_scenario(
+    scn: &crate::scenario::Scenario,
+    gnss: &crate::gnss::GnssConfig,
+    run: u64,
+) -> Result<(ImuData, Vec<GnssFix>), FuseError> {
+    use crate::truth::{TruthConfig, TruthGenerator, TruthSample};
+    let earth = scn.nav.earth.model();
+    let dt = scn.imu.dt_s();
+    let cfg = TruthConfig {
+        earth,
+        dt_s: dt,
+        lat0_rad: scn.start.lat_rad,
+        lon0_rad: scn.start.lon_rad,
+        h0_m: scn.start.h_m,
+        substeps: scn.nav.substeps,
+    };
+    let generator = TruthGenerator::new(&scn.trajectory, cfg);
+    let init = generator.initial_state();
+    let n = generator.len_samples() as usize;
+    let mut sensor = crate::imu_error::ImuErrorState::new(&scn.imu.model, scn.imu.seed, run)
+        .map_err(|e| FuseError::Imu(e.to_string()))?;
+    let mut gsim = crate::gnss::GnssSimulator::new(gnss, earth, run)?;
+    let mut prev = TruthSample::new(
+        0.0,
+        Increment::default(),
+        init.lat_rad,
+        init.lon_rad,
+        init.h_m,
+        init.v_n_mps,
+        init.c_b_n,
+    );
+    let mut incs = Vec::with_capacity(n);
+    let mut fixes = Vec::new();
+    for ts in generator {
+        incs.push(sensor.apply(&ts.inc, dt));
+        gsim.step(&scn.trajectory, &prev, &ts, &mut fixes);
+        prev = ts;
+    }
+    Ok((
+        ImuData {
+            format: crate::imu_file::ImuFormat::Sdins,
+            dt_s: dt,
+            t0_s: dt,
+            increments: incs,
+            psins: None,
+            detection: None,
+            warnings: Vec::new(),
+        },
+        fixes,
+    ))
 }
