@@ -25,7 +25,13 @@ fn fuse_writes_outputs_and_rejects_bad_options() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["fixes"], 60);
-    for f in ["nav.csv", "innovations.csv", "run.toml"] {
+    for f in [
+        "nav.csv",
+        "innovations.csv",
+        "run.toml",
+        "report.html",
+        "fuse_nis.svg",
+    ] {
         assert!(out.join(f).exists(), "{f}");
     }
     let nav = std::fs::read_to_string(out.join("nav.csv")).unwrap();
@@ -115,7 +121,16 @@ fn fuse_on_recorded_files_and_bad_gnss_files() {
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["fixes_used"], 60);
     assert_eq!(j["rejected"], 0);
-    for f in ["nav.csv", "smoothed.csv", "innovations.csv", "run.toml"] {
+    for f in [
+        "nav.csv",
+        "smoothed.csv",
+        "innovations.csv",
+        "run.toml",
+        "report.html",
+        "fuse_forward.png",
+        "fuse_smoothed.png",
+        "fuse_nis.png",
+    ] {
         assert!(dir.join("out").join(f).exists(), "{f}");
     }
     // 60 fixes of σ 1 m: the position RMSE is well inside the fix σ

@@ -117,12 +117,14 @@ pub struct FilesResult {
     pub smoothed: Option<TruthComparison>,
 }
 
-/// Run it; `observe` sees every forward and smoothed point and every update.
+/// Run it; `observe` sees every forward and smoothed point and every update, with the
+/// point's errors against the reference (roll, pitch, yaw \[rad\], v_N, v_E, v_D \[m/s\],
+/// N, E, D \[m\]) when one is given and matches the point's time.
 pub fn fuse_files(
     input: &FilesInput,
     opts: &RecordOptions,
     cancel: &CancelToken,
-    mut observe: impl FnMut(RecordEvent<'_>),
+    mut observe: impl FnMut(RecordEvent<'_>, Option<&[f64; 9]>),
 ) -> Result<FilesResult, FilesError> {
     let imu = read_imu_file(&input.imu.0, input.imu.1)?;
     let gnss = read_gnss_file(&input.gnss.0, input.gnss.1, &input.gnss_options)?;
@@ -181,20 +183,12 @@ pub fn fuse_files(
         None
     };
     let summary = fuse_records(&imu, &clip.fixes, &model, &init, opts, cancel, |ev| {
-        match ev {
-            RecordEvent::Forward(p) => {
-                if let Some(c) = fwd.as_mut() {
-                    c.add(p);
-                }
-            }
-            RecordEvent::Smoothed(p) => {
-                if let Some(c) = smo.as_mut() {
-                    c.add(p);
-                }
-            }
-            _ => {}
-        }
-        observe(ev);
+        let err = match ev {
+            RecordEvent::Forward(p) => fwd.as_mut().and_then(|c| c.add(p)),
+            RecordEvent::Smoothed(p) => smo.as_mut().and_then(|c| c.add(p)),
+            _ => None,
+        };
+        observe(ev, err.as_ref());
     })?;
     Ok(FilesResult {
         summary,

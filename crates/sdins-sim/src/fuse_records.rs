@@ -651,8 +651,8 @@ impl TruthComparison {
             p.sigma_nav[1],
             p.sigma_nav[2],
         ];
-        for i in 0..9 {
-            self.sq[i] += e[i] * e[i];
+        for (sq, ei) in self.sq.iter_mut().zip(&e) {
+            *sq += ei * ei;
         }
         self.n += 1;
         if p.t_s > self.t_check_s {
@@ -733,41 +733,6 @@ fn from_fix(
     ))
 }
 
-#[cfg(test)]
-#[allow(clippy::unwrap_used)]
-mod tests {
-    use super::*;
-
-    /// M against a numerical Jacobian of the Euler angles of (I + [ε×]) C.
-    #[test]
-    fn euler_error_matrix_matches_numerical_jacobian() {
-        let c = c_b_n_from_euler(&Euler::new(0.3, -0.4, 2.5));
-        let m = euler_error_matrix(&c);
-        let e0 = sdins_core::math::euler_from_c_b_n(&c);
-        let h = 1e-7;
-        for j in 0..3 {
-            let mut eps = Vec3::zeros();
-            eps[j] = h;
-            let cp = Quat::from_rotvec(&eps).to_dcm() * c;
-            let e = sdins_core::math::euler_from_c_b_n(&cp);
-            let d = [
-                (e.roll_rad - e0.roll_rad) / h,
-                (e.pitch_rad - e0.pitch_rad) / h,
-                (e.yaw_rad - e0.yaw_rad) / h,
-            ];
-            for i in 0..3 {
-                // O(h) truncation plus rounding ε/h
-                assert!(
-                    (d[i] - m[(i, j)]).abs() < 1e-6,
-                    "({i},{j}) {} vs {}",
-                    d[i],
-                    m[(i, j)]
-                );
-            }
-        }
-    }
-}
-
 /// A recorded data set simulated from a scenario: the IMU record (the scenario's IMU
 /// errors of run `run`, FRD increments stamped at sample ends, `t0_s = δt`) and the GNSS
 /// fixes of `gnss` (same clock), without keeping the truth in memory. The input of
@@ -823,4 +788,39 @@ pub fn record_from_scenario(
         },
         fixes,
     ))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// M against a numerical Jacobian of the Euler angles of (I + [ε×]) C.
+    #[test]
+    fn euler_error_matrix_matches_numerical_jacobian() {
+        let c = c_b_n_from_euler(&Euler::new(0.3, -0.4, 2.5));
+        let m = euler_error_matrix(&c);
+        let e0 = sdins_core::math::euler_from_c_b_n(&c);
+        let h = 1e-7;
+        for j in 0..3 {
+            let mut eps = Vec3::zeros();
+            eps[j] = h;
+            let cp = Quat::from_rotvec(&eps).to_dcm() * c;
+            let e = sdins_core::math::euler_from_c_b_n(&cp);
+            let d = [
+                (e.roll_rad - e0.roll_rad) / h,
+                (e.pitch_rad - e0.pitch_rad) / h,
+                (e.yaw_rad - e0.yaw_rad) / h,
+            ];
+            for i in 0..3 {
+                // O(h) truncation plus rounding ε/h
+                assert!(
+                    (d[i] - m[(i, j)]).abs() < 1e-6,
+                    "({i},{j}) {} vs {}",
+                    d[i],
+                    m[(i, j)]
+                );
+            }
+        }
+    }
 }

@@ -101,7 +101,7 @@ impl SmootherLog {
     /// Append an epoch (from `Ekf::initial_epoch` first, then `Ekf::take_epoch`).
     pub fn push(&mut self, e: &CovEpoch) -> Result<(), SmootherError> {
         if let Some(prev) = self.recs.last() {
-            if !(e.t_s > prev.t_s) {
+            if e.t_s.partial_cmp(&prev.t_s) != Some(std::cmp::Ordering::Greater) {
                 return Err(SmootherError::Order {
                     t_s: e.t_s,
                     prev_s: prev.t_s,

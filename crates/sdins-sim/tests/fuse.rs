@@ -58,11 +58,7 @@ fn short_run_every_algorithm_stays_consistent() {
                     }
                     last = Some(*e);
                 }
-                FuseEvent::Update(r) => {
-                    if r.kind == MeasKind::Gnss {
-                        nis.push(r.nis);
-                    }
-                }
+                FuseEvent::Update(r) if r.kind == MeasKind::Gnss => nis.push(r.nis),
                 _ => {}
             })
             .unwrap();
@@ -131,10 +127,8 @@ fn run_mc(scn: &Scenario, gnss: &GnssConfig, opts: &FuseOptions, runs: u64) -> V
                 &CancelToken::new(),
                 |ev| match ev {
                     FuseEvent::Epoch(e) => epochs.push(*e),
-                    FuseEvent::Update(u) => {
-                        if u.kind == MeasKind::Gnss {
-                            g.push((u.t_s, u.nis, u.accepted));
-                        }
+                    FuseEvent::Update(u) if u.kind == MeasKind::Gnss => {
+                        g.push((u.t_s, u.nis, u.accepted))
                     }
                     FuseEvent::Smoothed(e) => smoothed.push(*e),
                     _ => {}
@@ -541,11 +535,7 @@ fn gating_rejects_a_100m_outlier_and_the_solution_is_unaffected() {
     for (i, g) in [&clean, &bad].into_iter().enumerate() {
         let s = fuse_scenario(&scn, g, &opts, 0, &CancelToken::new(), |ev| match ev {
             FuseEvent::Epoch(e) => epochs[i].push(*e),
-            FuseEvent::Update(u) => {
-                if !u.accepted {
-                    rejected_at.push((i, u.t_s, u.nis));
-                }
-            }
+            FuseEvent::Update(u) if !u.accepted => rejected_at.push((i, u.t_s, u.nis)),
             _ => {}
         })
         .unwrap();

@@ -3,6 +3,7 @@
 //! and prints.
 
 use super::fuse::Args;
+use super::fuse_report::{ErrRow, FuseReportData, Thin};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
@@ -56,6 +57,35 @@ fn point_row(p: &RecordPoint) -> String {
         line.push_str(&format!(",{:.4e}", v.to_degrees()));
     }
     line
+}
+
+fn err_row(p: &RecordPoint, e: &[f64; 9]) -> ErrRow {
+    let d = f64::to_degrees;
+    (
+        p.t_s,
+        [
+            e[6],
+            e[7],
+            e[8],
+            e[3],
+            e[4],
+            e[5],
+            d(e[0]),
+            d(e[1]),
+            d(e[2]),
+        ],
+        [
+            p.sigma_nav[0],
+            p.sigma_nav[1],
+            p.sigma_nav[2],
+            p.sigma_nav[3],
+            p.sigma_nav[4],
+            p.sigma_nav[5],
+            d(p.sigma_euler_rad[0]),
+            d(p.sigma_euler_rad[1]),
+            d(p.sigma_euler_rad[2]),
+        ],
+    )
 }
 
 const NAV_HEADER: &str = "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg,sigma_n_m,sigma_e_m,sigma_d_m,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg";
@@ -204,7 +234,17 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
     let mut werr: Option<(&'static str, std::io::Error)> = None;
     let mut last_fwd: Option<RecordPoint> = None;
     let mut t_start = None;
-    let res = fuse_files(&input, &opts, &crate::progress::token(), |ev| {
+    let mut fwd_rows = Thin::<ErrRow>::new();
+    let mut smo_rows = Thin::<ErrRow>::new();
+    let mut gnss_rows: Vec<(f64, f64, usize, bool)> = Vec::new();
+    let res = fuse_files(&input, &opts, &crate::progress::token(), |ev, err| {
+        if let Some(e) = err {
+            match ev {
+                RecordEvent::Forward(p) => fwd_rows.push(err_row(p, e)),
+                RecordEvent::Smoothed(p) => smo_rows.push(err_row(p, e)),
+                _ => {}
+            }
+        }
         let r = match ev {
             RecordEvent::Forward(p) => {
                 t_start.get_or_insert(p.t_s);
@@ -234,6 +274,9 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
                 );
                 for v in u.innovation {
                     line.push_str(&format!(",{v:e}"));
+                }
+                if u.kind == MeasKind::Gnss {
+                    gnss_rows.push((t_start.unwrap_or(0.0) + u.t_s, u.nis, u.dof, u.accepted));
                 }
                 writeln!(inn.writer(), "{line}").map_err(|e| ("innovations.csv", e))
             }
@@ -306,6 +349,62 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
     fields.insert("cov_rate_hz".into(), args.cov_rate_hz.into());
     fields.insert("gate".into(), (!args.no_gate).into());
     fields.insert("smooth".into(), args.smooth.into());
+    let rm = |c: &Option<sdins_sim::fuse_records::TruthComparison>, name: &str| {
+        c.as_ref().map(|c| {
+            let v = c.rmse();
+            (
+                name.to_string(),
+                [
+                    v[6],
+                    v[7],
+                    v[8],
+                    v[3],
+                    v[4],
+                    v[5],
+                    v[0].to_degrees(),
+                    v[1].to_degrees(),
+                    v[2].to_degrees(),
+                ],
+            )
+        })
+    };
+    let rmse: Vec<(String, [f64; 9])> = [rm(&r.forward, "forward"), rm(&r.smoothed, "smoothed")]
+        .into_iter()
+        .flatten()
+        .collect();
+    if !fwd_rows.pts.is_empty() || !gnss_rows.is_empty() {
+        let fix_interval = gnss_rows
+            .windows(2)
+            .map(|w| w[1].0 - w[0].0)
+            .fold(f64::INFINITY, f64::min);
+        super::fuse_report::write(
+            &out,
+            &FuseReportData {
+                title: format!("sdins fuse: {}", imu.display()),
+                intro: format!(
+                    "{} ({} samples at {} Hz) with {} ({} fixes used, {} rejected), algorithm {} N = {samples}, covariance at {} Hz{}.",
+                    imu.display(),
+                    r.imu_samples,
+                    1.0 / r.imu_dt_s,
+                    gnss.display(),
+                    r.summary.fixes_used,
+                    r.summary.rejected,
+                    args.algo,
+                    args.cov_rate_hz,
+                    match &args.truth {
+                        Some(t) => format!("; reference {}", t.display()),
+                        None => "; no reference: the error plots are empty, give --truth".into(),
+                    }
+                ),
+                att_names: ["roll", "pitch", "yaw"],
+                forward: &fwd_rows,
+                smoothed: args.smooth.then_some(&smo_rows),
+                gnss: &gnss_rows,
+                fix_interval_s: if fix_interval.is_finite() { fix_interval } else { 1.0 },
+                rmse,
+            },
+        )?;
+    }
     crate::report::write_run_toml(&out, fields)?;
     for w in &r.imu_warnings {
         eprintln!("warning: {}: {w}", imu.display());

@@ -7,6 +7,7 @@ pub mod demo;
 pub mod errors;
 pub mod fuse;
 pub mod fuse_files;
+pub mod fuse_report;
 pub mod merge;
 pub mod montecarlo;
 pub mod nav;
