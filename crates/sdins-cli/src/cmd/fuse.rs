@@ -65,6 +65,10 @@ pub struct Args {
     /// run the Rauch–Tung–Striebel smoother after the forward filter (smoothed.csv)
     #[arg(long)]
     pub smooth: bool,
+    /// scenario: in-motion alignment from an unknown heading (start at the first fix at
+    /// ≥ 5 m/s, heading from the GNSS track)
+    #[arg(long)]
+    pub in_motion: bool,
     /// output folder (default ./sdins-out/fuse-<scenario>)
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -189,6 +193,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         zupt: args.zupt_sigma_mps.map(|s| (s, 1e-3)),
         nhc_sigma_mps: args.nhc_sigma_mps,
         smooth: args.smooth,
+        in_motion: args.in_motion.then(sdins_sim::fuse::InMotionInit::default),
         ..FuseOptions::default()
     };
     let out = args

@@ -96,6 +96,11 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         .gnss
         .clone()
         .ok_or_else(|| CliError::bad("--imu needs --gnss FILE"))?;
+    if args.in_motion {
+        return Err(CliError::bad(
+            "--in-motion applies to scenarios; on recorded data give --attitude-deg (the heading from the first fixes' track) or --init",
+        ));
+    }
     let imu_format: ImuFormat = args.imu_format.parse().map_err(CliError::bad)?;
     let gnss_format: GnssFormat = args.gnss_format.parse().map_err(CliError::bad)?;
     let samples = args.samples.unwrap_or(2);
