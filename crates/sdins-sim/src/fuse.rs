@@ -304,6 +304,36 @@ pub fn fuse_scenario_with(
     cancel: &CancelToken,
     mut observe: impl FnMut(FuseEvent<'_>),
 ) -> Result<FuseSummary, FuseError> {
+    if scn.mounting.imu.is_some() {
+        return Err(FuseError::Option(
+            "mounting",
+            "the filter's body frame is the IMU and fuse compares with the truth at the vehicle reference point: remove [mounting] imu_lever_arm_m / imu_mount_deg, and give the antenna's lever arm from the IMU".into(),
+        ));
+    }
+    // the antenna lever arm: [gnss] lever_arm_b_m, or [mounting] gnss_lever_arm_m (the IMU
+    // sits at the reference point here, so both are arms from the IMU)
+    let gnss_eff;
+    let gnss = match scn.mounting.gnss_lever_arm_b_m {
+        Some(l) => {
+            let own = Vec3::from(gnss.lever_arm_b_m);
+            if own != Vec3::zeros() && own != l {
+                return Err(FuseError::Option(
+                    "mounting.gnss_lever_arm_m",
+                    format!(
+                        "differs from [gnss] lever_arm_b_m ({:?} m against {:?} m): give one",
+                        [l.x, l.y, l.z],
+                        gnss.lever_arm_b_m
+                    ),
+                ));
+            }
+            gnss_eff = GnssConfig {
+                lever_arm_b_m: [l.x, l.y, l.z],
+                ..gnss.clone()
+            };
+            &gnss_eff
+        }
+        None => gnss,
+    };
     let earth = scn.nav.earth.model();
     let dt = scn.imu.dt_s();
     let n = opts.algo.samples.clamp(1, 4);

@@ -739,3 +739,61 @@ fn mc_in_motion_alignment_from_unknown_heading() {
         100.0 * in95
     );
 }
+
+/// `[mounting]`: the antenna arm from `[mounting] gnss_lever_arm_m` acts as `[gnss]
+/// lever_arm_b_m` (bit-identical runs); conflicting arms and an IMU lever arm are refused
+/// by fuse and by the Monte Carlo (they would silently be ignored).
+#[test]
+fn mounting_gnss_arm_is_used_and_imu_mounting_is_refused() {
+    let base = "name = \"m\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nspeed_mps = 10.0\n[imu]\nrate_hz = 100.0\ngrade = \"tactical\"\n[nav]\nsamples = 2\n[[segment]]\ntype = \"turn\"\nrate_dps = 5.0\nduration_s = 20.0\n";
+    let run = |toml: &str, gnss: &GnssConfig| {
+        let scn = Scenario::from_toml(toml, "m.toml").unwrap();
+        let mut last = None;
+        let r = fuse_scenario(
+            &scn,
+            gnss,
+            &FuseOptions::default(),
+            0,
+            &CancelToken::new(),
+            |ev| {
+                if let FuseEvent::Epoch(e) = ev {
+                    last = Some(e.err)
+                }
+            },
+        );
+        r.map(|_| last.unwrap())
+    };
+    let arm = GnssConfig {
+        lever_arm_b_m: [1.0, 0.2, -0.5],
+        ..Default::default()
+    };
+    let a = run(base, &arm).unwrap();
+    let with_mount = format!("{base}[mounting]\ngnss_lever_arm_m = [1.0, 0.2, -0.5]\n");
+    let b = run(&with_mount, &GnssConfig::default()).unwrap();
+    assert_eq!(a, b);
+    let other = GnssConfig {
+        lever_arm_b_m: [0.5, 0.0, 0.0],
+        ..Default::default()
+    };
+    let e = run(&with_mount, &other).unwrap_err().to_string();
+    assert!(e.contains("gnss_lever_arm_m"), "{e}");
+    let imu_arm = format!("{base}[mounting]\nimu_lever_arm_m = [0.5, 0.0, 0.0]\n");
+    let e = run(&imu_arm, &GnssConfig::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("mounting"), "{e}");
+    let scn = Scenario::from_toml(&imu_arm, "m.toml").unwrap();
+    let mc = sdins_sim::montecarlo::McOptions {
+        runs: 16,
+        seed: 1,
+        algo: AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 2),
+        every_s: 1.0,
+        until_s: None,
+        block: 16,
+        vertical_hold: true,
+    };
+    let e = sdins_sim::montecarlo::runner::job(&scn, &mc)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("[mounting]"), "{e}");
+}
