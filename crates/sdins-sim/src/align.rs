@@ -288,7 +288,7 @@ pub fn run_fine<F: FnMut(usize, &FineAlign)>(
 ) -> Result<FineAlign, Cancelled> {
     let mut fa = FineAlign::new(cfg, c0);
     for (j, inc) in incs.iter().enumerate() {
-        if j as u64 % POLL_EVERY_SAMPLES == 0 {
+        if (j as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
             token.check()?;
         }
         if fa.step(inc, dt_s) {
@@ -367,7 +367,7 @@ pub fn algorithm_b(
     let ends: Vec<usize> = phases.iter().map(|p| idx(p.0 + p.1)).collect();
     let mut last_t = 0.0;
     for (j, inc) in incs.iter().enumerate() {
-        if j as u64 % POLL_EVERY_SAMPLES == 0 {
+        if (j as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
             token.check()?;
         }
         if starts.contains(&j) && j > 0 {
