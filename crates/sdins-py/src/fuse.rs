@@ -119,6 +119,8 @@ pub fn fuse<'py>(
                 a.forced.push(u.forced);
                 a.nu.extend(u.innovation);
             }
+            // smoothed epochs (RTS) are not requested by these options
+            _ => {}
         });
         r.map(|s| (a, s))
     })?
