@@ -34,6 +34,7 @@ from ._sdins import McState, Scenario, SdinsError
 __version__: str = _sdins.__version__
 
 __all__ = [
+    "fuse_files",
     "SdinsError",
     "Scenario",
     "McState",
@@ -318,6 +319,8 @@ def fuse(
     zupt_sigma_mps: Optional[float] = None,
     nhc_sigma_mps: Optional[float] = None,
     until_s: Optional[float] = None,
+    smooth: Optional[bool] = None,
+    in_motion: Optional[bool] = None,
 ) -> FuseResult:
     """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``); the scenario's
     ``[gnss]`` table sets the receiver.
@@ -326,11 +329,62 @@ def fuse(
     songlee-complete, ``samples`` the scenario's N (as the CLI), ``run`` 0 (IMU/GNSS/
     initial-error streams), ``cov_rate_hz`` 10, ``gate`` True (χ² 99.9 % NIS gate),
     ``exact_start`` False (initial errors drawn from P0), ``zupt_sigma_mps`` /
-    ``nhc_sigma_mps`` None (off), ``until_s`` None (whole scenario).
+    ``nhc_sigma_mps`` None (off), ``until_s`` None (whole scenario), ``smooth`` False
+    (True: the Rauch–Tung–Striebel smoother; ``result.smoothed`` then holds the smoothed
+    epochs with the same fields as the forward ones), ``in_motion`` False (True: in-motion
+    alignment from an unknown heading, started at the first fix at ≥ 5 m/s).
     """
     return FuseResult(
         _sdins.fuse(
             _scenario(scenario), algo, samples, run, cov_rate_hz, gate, exact_start,
-            zupt_sigma_mps, nhc_sigma_mps, until_s,
+            zupt_sigma_mps, nhc_sigma_mps, until_s, smooth, in_motion,
         )
+    )
+
+
+def fuse_files(
+    imu: str,
+    gnss: str,
+    imu_format: Optional[str] = None,
+    gnss_format: Optional[str] = None,
+    grade: Optional[str] = None,
+    navego_params: Optional[str] = None,
+    init: Optional[str] = None,
+    attitude_deg: Optional[Sequence[float]] = None,
+    attitude_sigma_deg: Optional[Sequence[float]] = None,
+    static_s: Optional[float] = None,
+    lever_arm_m: Optional[Sequence[float]] = None,
+    truth: Optional[str] = None,
+    smooth: Optional[bool] = None,
+    algo: Optional[str] = None,
+    samples: Optional[int] = None,
+    cov_rate_hz: Optional[float] = None,
+    gate: Optional[bool] = None,
+    nhc_sigma_mps: Optional[float] = None,
+    gnss_offset_s: Optional[float] = None,
+) -> Dict[str, Any]:
+    """INS/GNSS filter (and smoother) on recorded files (``sdins fuse --imu --gnss``).
+
+    The IMU's error model comes from ``grade`` (a preset) or ``navego_params`` (a NaveGo
+    ``imuN_params.txt``); the initial state from ``init`` (``"lat_deg,lon_deg,h_m,v_n,v_e,
+    v_d,roll_deg,pitch_deg,yaw_deg"``), ``attitude_deg`` (roll, pitch, yaw with the first
+    fix's position and velocity; σ ``attitude_sigma_deg``, default 1, 1, 2°), ``static_s``
+    (coarse alignment at rest), or, with NaveGo parameters, their ``ini_align``. Defaults
+    are the library's (``RecordOptions::default()``: songlee-complete N = 2, covariance
+    10 Hz, χ² 99.9 % gate). Returns a dict: ``forward`` (and with ``smooth`` ``smoothed``)
+    with per navigation update ``t_s`` (IMU clock) [s], ``lat_rad``, ``lon_rad``, ``h_m``,
+    ``v_ned_mps`` (n, 3), ``euler_rad`` (n, 3: roll, pitch, yaw), ``sigma_nav`` (n, 9:
+    N, E, D [m], v N, E, D [m/s], ε N, E, D [rad]), ``sigma_euler_rad`` (n, 3), ``bias``
+    (n, 6: accelerometer [m/s²], gyro [rad/s]); ``innovations`` (t_s, nis, dof,
+    accepted); ``fixes_used``, ``rejected``, ``fixes_outside`` (before, after),
+    ``imu_samples``; with ``truth``: ``forward_rmse`` / ``smoothed_rmse`` (roll, pitch,
+    yaw [rad], v N, E, D [m/s], N, E, D [m]) and their ``*_inside_3sigma`` fractions.
+    """
+    return _sdins.fuse_files(
+        imu, gnss, imu_format, gnss_format, grade, navego_params, init,
+        None if attitude_deg is None else [float(x) for x in attitude_deg],
+        None if attitude_sigma_deg is None else [float(x) for x in attitude_sigma_deg],
+        static_s,
+        None if lever_arm_m is None else [float(x) for x in lever_arm_m],
+        truth, smooth, algo, samples, cov_rate_hz, gate, nhc_sigma_mps, gnss_offset_s,
     )

@@ -381,6 +381,7 @@ class FuseResult:
             "forced": np.asarray(inn["forced"], dtype=bool),
             "innovation": inn["innovation"],
         }
+        self.smoothed: Optional[Dict[str, Any]] = d.get("smoothed")
         for k in (
             "fixes", "rejected", "nav_updates", "accel_bias_est_mps2", "accel_bias_true_mps2",
             "gyro_bias_est_rps", "gyro_bias_true_rps", "samples", "run",

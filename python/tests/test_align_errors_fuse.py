@@ -121,3 +121,59 @@ def test_fuse_bad_input():
         sdins.fuse("dq-paper", cov_rate_hz=-1.0)
     with pytest.raises(sdins.SdinsError, match="algo"):
         sdins.fuse("dq-paper", algo="nope")
+
+
+def test_fuse_smooth_equals_cli_smoothed_csv(cli, tmp_path):
+    out = tmp_path / "f"
+    code, _, err = cli("fuse", "dq-paper", "--smooth", "--out", str(out), "--json")
+    assert code == 0, err
+    rows = np.loadtxt(out / "smoothed.csv", delimiter=",", skiprows=1, ndmin=2)
+    r = sdins.fuse("dq-paper", smooth=True)
+    s = r.smoothed
+    assert s is not None and len(s["t_s"]) == rows.shape[0]
+    # the CSV prints shortest round-trip decimals ({:e}): equal to the last bit
+    assert np.array_equal(s["pos_error_ned_m"][:, 0], rows[:, 1])
+    assert np.array_equal(s["sigma"][:, 0], rows[:, 4])
+    # the smoother never has a larger σ than the forward filter at the same epoch
+    assert np.all(s["sigma"][1:, :9] <= r.sigma[:, :9] * (1 + 1e-12))
+
+
+def test_fuse_files_navego_equals_cli(cli, tmp_path):
+    import pathlib
+
+    d = pathlib.Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "csv" / "navego"
+    if not d.is_dir():
+        pytest.skip(f"{d} not found")
+    args = dict(
+        imu=str(d / "imu2.csv"), gnss=str(d / "gnss.csv"),
+        navego_params=str(d / "imu2_params.txt"), truth=str(d / "ref.csv"), smooth=True,
+    )
+    code, out, err = cli(
+        "fuse", "--imu", args["imu"], "--gnss", args["gnss"], "--navego-params",
+        args["navego_params"], "--truth", args["truth"], "--smooth", "--json",
+        "--out", str(tmp_path / "n"),
+    )
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.fuse_files(**args)
+    assert r["fixes_used"] == js["fixes_used"] and r["rejected"] == js["rejected"]
+    names = ["roll", "pitch", "yaw", "v_N", "v_E", "v_D", "N", "E", "D"]
+    for i, n in enumerate(names):
+        want = js["smoothed_vs_truth"][n]["rmse"]
+        got = r["smoothed_rmse"][i]
+        assert (np.degrees(got) if i < 3 else got) == want, n
+        assert r["smoothed_rmse"][i] <= r["forward_rmse"][i], n
+    assert len(r["smoothed"]["t_s"]) == len(r["forward"]["t_s"])
+
+
+def test_fuse_files_bad_input_raises_located_error(tmp_path):
+    g = tmp_path / "g.csv"
+    g.write_text("t_s,lat_deg,lon_deg,h_m,sigma_n_m,sigma_e_m,sigma_d_m\n1,95,127,0,1,1,2\n")
+    imu = tmp_path / "i.csv"
+    imu.write_text("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n"
+                   + "".join(f"{0.01 * (k + 1)},0,0,0,0,0,-0.098\n" for k in range(300)))
+    with pytest.raises(sdins.SdinsError, match="g.csv:2"):
+        sdins.fuse_files(str(imu), str(g), gnss_format="sdins", grade="tactical",
+                         init="37.5,127,0,0,0,0,0,0,0")
+    with pytest.raises(sdins.SdinsError, match="--grade"):
+        sdins.fuse_files(str(imu), str(g), init="37.5,127,0,0,0,0,0,0,0")

@@ -19,7 +19,7 @@ use crate::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use crate::navego_params::{read_navego_imu_params, NavegoImuParams, ParamsError};
 use crate::truth_file::{read_truth, TruthFileError};
 use sdins_core::nav::InitialState;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Where the filter's sensor model comes from.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +44,65 @@ pub enum InitSource {
     FirstFixNavegoAttitude,
     /// at rest for the given seconds: coarse alignment
     StaticCoarse(f64),
+}
+
+impl SensorModelSource {
+    /// From the two user options (a grade preset name, a NaveGo parameter file): exactly
+    /// one must be given. The message names the option (`--grade`, `--navego-params`).
+    pub fn from_options(grade: Option<&str>, navego_params: Option<&Path>) -> Result<Self, String> {
+        match (grade, navego_params) {
+            (Some(_), Some(_)) => Err("give either --grade or --navego-params, not both".into()),
+            (None, Some(p)) => Ok(SensorModelSource::NavegoParams(p.to_path_buf())),
+            (Some(g), None) => crate::imu_error::presets::preset(g)
+                .map(|m| SensorModelSource::Model(Box::new(m)))
+                .map_err(|e| format!("--grade: {e}")),
+            (None, None) => Err(
+                "the filter needs the IMU's error model: give --grade NAME or --navego-params FILE"
+                    .into(),
+            ),
+        }
+    }
+}
+
+impl InitSource {
+    /// From the user options (at most one of `init` (the `--init` text), `attitude_deg`
+    /// with its optional σ (default 1, 1, 2°), `static_s`); none given: NaveGo's
+    /// `ini_align` when `navego` is true, else an error. Messages name the options.
+    pub fn from_options(
+        init: Option<&str>,
+        attitude_deg: Option<[f64; 3]>,
+        attitude_sigma_deg: Option<[f64; 3]>,
+        static_s: Option<f64>,
+        navego: bool,
+    ) -> Result<Self, String> {
+        match (init, attitude_deg, static_s) {
+            (Some(s), None, None) => crate::initial::parse_initial_state(s)
+                .map(|st| InitSource::Given(st, InitSigma::default()))
+                .map_err(|e| format!("--init: {e}")),
+            (None, Some(a), None) => {
+                let sig = attitude_sigma_deg.unwrap_or([1.0, 1.0, 2.0]);
+                if sig.iter().any(|x| !(x.is_finite() && *x > 0.0 && *x <= 10.0)) {
+                    return Err("--attitude-sigma-deg: each σ must be in (0, 10] deg (the linearised filter's limit)".into());
+                }
+                if a.iter().any(|x| !x.is_finite()) || a[1].abs() >= 90.0 {
+                    return Err("--attitude-deg: roll, pitch, yaw must be finite and |pitch| < 90°".into());
+                }
+                Ok(InitSource::FirstFix(
+                    a.map(f64::to_radians),
+                    sig.map(f64::to_radians),
+                ))
+            }
+            (None, None, Some(w)) => {
+                if !(w.is_finite() && w > 0.0 && w <= 3600.0) {
+                    return Err(format!("--static-s: must be in (0, 3600] s, got {w}"));
+                }
+                Ok(InitSource::StaticCoarse(w))
+            }
+            (None, None, None) if navego => Ok(InitSource::FirstFixNavegoAttitude),
+            (None, None, None) => Err("the initial state: give --init, --attitude-deg (position and velocity from the first fix) or --static-s (coarse alignment at rest)".into()),
+            _ => Err("give only one of --init, --attitude-deg, --static-s".into()),
+        }
+    }
 }
 
 /// The inputs of a fused run on files.

@@ -8,7 +8,7 @@ use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
 use sdins_core::nav::AlgorithmSpec;
-use sdins_sim::fuse::{FuseError, InitSigma};
+use sdins_sim::fuse::FuseError;
 use sdins_sim::fuse_files::{fuse_files, FilesError, FilesInput, InitSource, SensorModelSource};
 use sdins_sim::fuse_records::{RecordEvent, RecordOptions, RecordPoint, COMPARISON_AXES};
 use sdins_sim::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
@@ -112,60 +112,24 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
     let algo = AlgorithmSpec::from_name(&args.algo, samples)
         .ok_or_else(|| CliError::bad(format!("--algo: unknown algorithm `{}`", args.algo)))?;
     let sensor =
-        match (&args.navego_params, &args.grade) {
-            (Some(_), Some(_)) => {
-                return Err(CliError::bad(
-                    "give either --navego-params or --grade, not both",
-                ))
-            }
-            (Some(p), None) => SensorModelSource::NavegoParams(p.clone()),
-            (None, Some(g)) => SensorModelSource::Model(Box::new(
-                sdins_sim::imu_error::presets::preset(g)
-                    .map_err(|e| CliError::bad(format!("--grade: {e}")))?,
-            )),
-            (None, None) => return Err(CliError::bad(
-                "the filter needs the IMU's error model: give --grade NAME or --navego-params FILE",
-            )),
-        };
-    let deg = |v: [f64; 3]| v.map(f64::to_radians);
-    let init = match (&args.init, &args.attitude_deg, args.static_s) {
-        (Some(s), None, None) => {
-            let st = sdins_sim::initial::parse_initial_state(s)
-                .map_err(|e| CliError::bad(format!("--init: {e}")))?;
-            InitSource::Given(st, InitSigma::default())
-        }
-        (None, Some(a), None) => {
-            let sig = match &args.attitude_sigma_deg {
-                Some(s) => triple("--attitude-sigma-deg", s)?,
-                None => [1.0, 1.0, 2.0],
-            };
-            if sig.iter().any(|x| *x <= 0.0 || *x > 10.0) {
-                return Err(CliError::bad(
-                    "--attitude-sigma-deg: each σ must be in (0, 10] deg (the linearised filter's limit)",
-                ));
-            }
-            InitSource::FirstFix(deg(triple("--attitude-deg", a)?), deg(sig))
-        }
-        (None, None, Some(w)) => {
-            if !(w.is_finite() && w > 0.0 && w <= 3600.0) {
-                return Err(CliError::bad(format!(
-                    "--static-s: must be in (0, 3600] s, got {w}"
-                )));
-            }
-            InitSource::StaticCoarse(w)
-        }
-        (None, None, None) if args.navego_params.is_some() => InitSource::FirstFixNavegoAttitude,
-        (None, None, None) => {
-            return Err(CliError::bad(
-                "the initial state: give --init, --attitude-deg (position and velocity from the first fix) or --static-s (coarse alignment at rest)",
-            ))
-        }
-        _ => {
-            return Err(CliError::bad(
-                "give only one of --init, --attitude-deg, --static-s",
-            ))
-        }
+        SensorModelSource::from_options(args.grade.as_deref(), args.navego_params.as_deref())
+            .map_err(CliError::bad)?;
+    let attitude = match &args.attitude_deg {
+        Some(a) => Some(triple("--attitude-deg", a)?),
+        None => None,
     };
+    let attitude_sigma = match &args.attitude_sigma_deg {
+        Some(s) => Some(triple("--attitude-sigma-deg", s)?),
+        None => None,
+    };
+    let init = InitSource::from_options(
+        args.init.as_deref(),
+        attitude,
+        attitude_sigma,
+        args.static_s,
+        args.navego_params.is_some(),
+    )
+    .map_err(CliError::bad)?;
     let lever = match &args.lever_arm_m {
         Some(s) => triple("--lever-arm-m", s)?,
         None => [0.0; 3],
