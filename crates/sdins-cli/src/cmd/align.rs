@@ -462,6 +462,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let phi = c_true_end.map(|c| attitude_error(&res.c_b_n, &c));
     let e = euler_from_c_b_n(&res.c_b_n);
     if let Some(dir) = &args.out {
+        crate::output::claim(dir)?;
         write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi))?;
         let mut svgs = None;
         if matches!(args.method, Method::Fine | Method::Multiheading) && args.alg == Alg::A

@@ -279,10 +279,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(match args.shard {
-            None => format!("sdins-out/mc-{}", scn.name),
-            Some(_) => format!("sdins-out/mc-{}-shard{}", scn.name, shard.index),
+            None => crate::output::default_dir("mc-", &scn.name),
+            Some(_) => crate::output::default_dir("mc-", &format!("{}-shard{}", scn.name, shard.index)),
         })
     });
+    crate::output::claim(&out)?;
     let total = shard_runs(&opts, shard);
     let bar = Mutex::new((Progress::new(total, "runs", args.quiet), 0_u64));
     let on_run = || {

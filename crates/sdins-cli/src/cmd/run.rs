@@ -214,7 +214,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/run-{}", scn.name)));
+        .unwrap_or_else(|| crate::output::default_dir("run-", &scn.name));
+    crate::output::claim(&out)?;
     let mut nav_files = Vec::new();
     let mut err_files = Vec::new();
     for a in &algos {

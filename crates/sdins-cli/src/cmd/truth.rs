@@ -34,7 +34,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let out = args
         .out
-        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/truth-{}", scn.name)));
+        .unwrap_or_else(|| crate::output::default_dir("truth-", &scn.name));
+    crate::output::claim(&out)?;
     let cfg = TruthConfig {
         earth: scn.nav.earth.model(),
         dt_s: scn.imu.dt_s(),
