@@ -408,3 +408,102 @@ pub fn finish(result: Result<(), CliError>) -> Result<(), CliError> {
         }
     }
 }
+
+/// Largest number of data rows sdins writes to one output file.
+pub const MAX_ROWS_PER_FILE: f64 = 1e8;
+/// Largest estimated size of one output file \[bytes\] (20 GiB).
+pub const MAX_BYTES_PER_FILE: f64 = 20.0 * 1024.0 * 1024.0 * 1024.0;
+
+/// Refuse (exit 2), before anything is written, an output file that would hold more than
+/// [`MAX_ROWS_PER_FILE`] rows or an estimated [`MAX_BYTES_PER_FILE`] bytes (`rows` ×
+/// `bytes_per_row`); the message gives the estimate and what to change (`option`).
+pub fn check_size(file: &str, rows: f64, bytes_per_row: f64, option: &str) -> Result<(), CliError> {
+    let bytes = rows * bytes_per_row;
+    if rows.is_finite() && rows <= MAX_ROWS_PER_FILE && bytes <= MAX_BYTES_PER_FILE {
+        return Ok(());
+    }
+    Err(CliError::bad(format!(
+        "{file} would hold about {rows:.3e} rows ({:.1} GiB), more than the cap of {MAX_ROWS_PER_FILE:.0e} rows or {:.0} GiB per file: {option}",
+        bytes / (1024.0 * 1024.0 * 1024.0),
+        MAX_BYTES_PER_FILE / (1024.0 * 1024.0 * 1024.0)
+    )))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d =
+            std::env::temp_dir().join(format!("sdins-output-unit-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        d
+    }
+
+    #[test]
+    fn default_dirs_and_names_cannot_leave_the_output_folder() {
+        assert_eq!(
+            default_dir("run-", "turn-90dps"),
+            Path::new("sdins-out/run-turn-90dps")
+        );
+        for evil in ["../../etc", "/etc/passwd", "a/b", "..", "", "x\\..\\y"] {
+            let p = default_dir("", evil);
+            assert_eq!(
+                p.parent(),
+                Some(Path::new("sdins-out")),
+                "{evil} → {}",
+                p.display()
+            );
+            let last = p.file_name().unwrap().to_string_lossy().into_owned();
+            assert!(
+                !last.starts_with('.') && !last.contains('/'),
+                "{evil} → {last}"
+            );
+        }
+        let root = tmp("route");
+        claim(&root).unwrap();
+        for bad in ["../x.csv", "a/../../x.csv"] {
+            let e = route(&root.join(bad)).unwrap_err();
+            assert_eq!(e.exit_code(), 2, "{bad}");
+        }
+        let ok = route(&root.join("sub/x.csv")).unwrap();
+        assert!(ok.starts_with(&root) && ok.to_string_lossy().contains(STAGE_PREFIX));
+        abort_all();
+        assert!(!root.exists(), "a folder the failed run created is removed");
+    }
+
+    #[test]
+    fn a_write_that_hits_dev_full_leaves_the_previous_run() {
+        let root = tmp("devfull");
+        claim(&root).unwrap();
+        write_string(&root.join("a.csv"), "old a\n").unwrap();
+        commit_all().unwrap();
+        let before_a = std::fs::read_to_string(root.join("a.csv")).unwrap();
+        let before_toml = std::fs::read_to_string(root.join("run.toml")).unwrap();
+
+        claim(&root).unwrap();
+        write_string(&root.join("a.csv"), "new a\n").unwrap();
+        // the next staged file's temporary name is a symbolic link to /dev/full: its
+        // writes fail with ENOSPC, as on a full disk
+        let staged = route(&root.join("b.csv")).unwrap();
+        let tmp_name = staged.with_file_name(format!(".b.csv.tmp-{}", std::process::id()));
+        std::os::unix::fs::symlink("/dev/full", &tmp_name).unwrap();
+        let e = finish(write_string(&root.join("b.csv"), &"x".repeat(1 << 21))).unwrap_err();
+        assert!(e.to_string().contains("No space left"), "{e}");
+        assert_eq!(
+            std::fs::read_to_string(root.join("a.csv")).unwrap(),
+            before_a
+        );
+        assert_eq!(
+            std::fs::read_to_string(root.join("run.toml")).unwrap(),
+            before_toml
+        );
+        let names: Vec<String> = std::fs::read_dir(&root)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 2, "{names:?}");
+        let _ = std::fs::remove_dir_all(&root);
+    }
+}

@@ -687,20 +687,35 @@ mod tests {
     fn bad_inputs_exit_2() {
         let mut a = args();
         a.hours = -1.0;
-        assert!(matches!(crate::output::finish(run(a)), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         let mut a = args();
         a.lat = 91.0;
-        assert!(matches!(crate::output::finish(run(a)), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         let mut a = args();
         a.gyro_bias_dph = Some(vec![1.0]);
-        assert!(matches!(crate::output::finish(run(a)), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         let mut a = args();
         a.gyro_bias_dph = None;
-        assert!(matches!(crate::output::finish(run(a)), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         let mut a = args();
         a.gyro_bias_dph = None;
         a.grade = Some("nope".into());
-        assert!(matches!(crate::output::finish(run(a)), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         assert_eq!(CliError::bad("x").exit_code(), 2);
     }
 
