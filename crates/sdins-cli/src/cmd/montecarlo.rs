@@ -277,13 +277,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         None => Shard::ALL,
         Some(s) => Shard::parse(s).map_err(|e| CliError::bad(format!("--shard: {e}")))?,
     };
-    let out = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from(match args.shard {
-            None => crate::output::default_dir("mc-", &scn.name),
-            Some(_) => {
-                crate::output::default_dir("mc-", &format!("{}-shard{}", scn.name, shard.index))
-            }
-        })
+    let out = args.out.clone().unwrap_or_else(|| match args.shard {
+        None => crate::output::default_dir("mc-", &scn.name),
+        Some(_) => crate::output::default_dir("mc-", &format!("{}-shard{}", scn.name, shard.index)),
     });
     crate::output::check_size(
         "mc_stats.csv",
