@@ -170,7 +170,8 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> CliError + '_ {
 }
 
 /// Files below `dir`, as `/`-separated relative names with sizes, sorted; staging folders
-/// are skipped.
+/// and sub-folders holding their own manifest (`sdins montecarlo --out mc/shard0` inside
+/// an `mc` run folder) are skipped.
 fn list_files(dir: &Path) -> Result<Vec<(String, u64)>, CliError> {
     fn walk(base: &Path, rel: &str, out: &mut Vec<(String, u64)>) -> Result<(), CliError> {
         let here = if rel.is_empty() {
@@ -191,7 +192,11 @@ fn list_files(dir: &Path) -> Result<Vec<(String, u64)>, CliError> {
             };
             let ft = e.file_type().map_err(io(&e.path()))?;
             if ft.is_dir() {
-                walk(base, &r, out)?;
+                // a nested folder of another sdins run (its own manifest) is neither this
+                // run's nor a user's: left alone
+                if read_manifest(&e.path()).is_none() {
+                    walk(base, &r, out)?;
+                }
             } else {
                 let len = e.metadata().map(|m| m.len()).unwrap_or(0);
                 out.push((r, len));

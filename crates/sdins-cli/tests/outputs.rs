@@ -183,6 +183,47 @@ fn a_folder_with_files_no_manifest_lists_is_refused_and_kept() {
     assert!(err.contains("data.csv"), "{err}");
     assert_eq!(std::fs::read_to_string(d2.join("data.csv")).unwrap(), "x");
     assert_eq!(std::fs::read_dir(&d2).unwrap().count(), 1);
+    // a nested folder of another run (its own manifest) is neither foreign nor replaced
+    let d3 = tmp("nested");
+    let (code, err) = run(
+        &[
+            "truth",
+            &scenario(&d3, 1.0),
+            "--out",
+            d3.to_str().unwrap(),
+            "--quiet",
+        ],
+        None,
+    );
+    assert_eq!(code, 0, "{err}");
+    let inner = d3.join("shard0");
+    let (code, err) = run(
+        &[
+            "truth",
+            &scenario(&d3, 1.0),
+            "--out",
+            inner.to_str().unwrap(),
+            "--quiet",
+        ],
+        None,
+    );
+    assert_eq!(code, 0, "{err}");
+    let inner_before = snapshot(&inner);
+    let (code, err) = run(
+        &[
+            "truth",
+            &scenario(&d3, 2.0),
+            "--out",
+            d3.to_str().unwrap(),
+            "--quiet",
+        ],
+        None,
+    );
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(snapshot(&inner), inner_before);
+    assert!(!manifest(&d3).keys().any(|k| k.starts_with("shard0")));
+    let _ = std::fs::remove_dir_all(&d3);
+    let _ = std::fs::remove_dir_all(d3.with_extension("in"));
     for p in [&d, &d2] {
         let _ = std::fs::remove_dir_all(p);
         let _ = std::fs::remove_dir_all(p.with_extension("in"));
