@@ -99,6 +99,24 @@ const RULES: &[Rule] = &[
         Replace(" lasergyro.imu", " ../shared/data/psins/lasergyro.imu"),
     ),
     rule("lasergyro.imu", NeedsData("psins/lasergyro.imu")),
+    // the NaveGo example of `sdins fuse --help`
+    rule(
+        "imu1_params.txt",
+        Replace(" imu1.csv", " ../shared/data/csv/navego/imu1.csv"),
+    ),
+    rule(
+        "imu1_params.txt",
+        Replace(" gnss.csv", " ../shared/data/csv/navego/gnss.csv"),
+    ),
+    rule(
+        "imu1_params.txt",
+        Replace(" ref.csv", " ../shared/data/csv/navego/ref.csv"),
+    ),
+    rule(
+        "imu1_params.txt",
+        Replace(" imu1_params.txt", " ../shared/data/csv/navego/imu1_params.txt"),
+    ),
+    rule("csv/navego/", NeedsData("csv/navego/imu1.csv")),
     rule("../shared/data", NeedsData("")),
 ];
 

@@ -15,6 +15,10 @@
 //!   whenever the truth is not at rest; both at the covariance rate.
 //! * The observer sees every covariance epoch (true error in the filter's state
 //!   coordinates and P, after that epoch's measurements) and every measurement report.
+//! * With [`FuseOptions::smooth`], the covariance epochs are logged
+//!   ([`crate::smoother::SmootherLog`]) and, after the forward pass, the
+//!   Rauch–Tung–Striebel smoother's epochs arrive as [`FuseEvent::Smoothed`] in time
+//!   order (true error of the smoothed state and the smoothed covariance).
 
 use crate::cancel::{CancelToken, Cancelled};
 use crate::gnss::{GnssConfig, GnssConfigError, GnssSimulator};
@@ -23,17 +27,19 @@ use crate::imu_error::{ImuErrorModel, ImuErrorState, DEG, DPH, DPHPSH, DPSH, MPS
 use crate::imu_error::{UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ};
 use crate::pipeline::nav_error;
 use crate::scenario::Scenario;
+use crate::smoother::{SmootherError, SmootherLog};
 use crate::truth::{lon_diff, TruthConfig, TruthGenerator, TruthSample};
 use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
 use sdins_core::aiding::ekf::{
-    Ekf, EkfConfig, FilterError, GnssMeasurement, NoiseModel, UpdateReport, CHI2_999,
+    correct_nav_state, Ekf, EkfConfig, FilterError, GnssMeasurement, NoiseModel, UpdateReport,
+    CHI2_999,
 };
 use sdins_core::aiding::error_model::{StateMat, StateVec, I_ATT, I_BA, I_BG, I_POS, I_VEL};
 use sdins_core::coning::Increment;
-use sdins_core::math::{Quat, Vec3};
-use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, Mechanization};
+use sdins_core::math::{Mat3, Quat, Vec3};
+use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, NavState};
 
 /// Initial 1σ errors of position \[m NED\], velocity \[m/s NED\], attitude \[rad NED\].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,6 +85,42 @@ pub struct FuseOptions {
     pub model_lever_arm: bool,
     /// stop after this time \[s\]
     pub until_s: Option<f64>,
+    /// run the Rauch–Tung–Striebel smoother after the forward pass
+    pub smooth: bool,
+    /// in-motion alignment from the GNSS track instead of a known initial attitude
+    pub in_motion: Option<InMotionInit>,
+}
+
+/// In-motion alignment for a ground vehicle from an unknown heading: the filter starts at
+/// the first GNSS fix whose horizontal speed is at least `min_speed_mps`. Heading from the
+/// GNSS track, `ψ = atan2(v_E, v_N)` (the velocity of a car points along its body x axis
+/// up to sideslip: the non-holonomic constraint), advanced to the start sample with the
+/// measured z rate; pitch `θ = atan2(−v_D, |v_h|)`, roll 0 (level road); position and
+/// velocity from the fix (lever arm removed). σ: heading
+/// `√(σ_track² + (σ_vN² sin²ψ + σ_vE² cos²ψ)/|v_h|²)`, roll and pitch `tilt_sigma_rad`,
+/// mapped to the attitude-error covariance with the Euler-error matrix
+/// (`fuse_records::euler_error_matrix`). This "coarse heading from the track, then the
+/// linear filter" formulation is valid for any initial heading because the coarse step
+/// leaves errors of a fraction of a degree, inside the linearised filter's range; it needs
+/// motion without large sideslip (not a hovering or crabbing vehicle).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InMotionInit {
+    /// smallest horizontal speed of the starting fix \[m/s\]
+    pub min_speed_mps: f64,
+    /// roll and pitch σ of the level assumption \[rad\]
+    pub tilt_sigma_rad: f64,
+    /// heading σ of the track-to-heading assumption (sideslip, mounting) \[rad\]
+    pub track_sigma_rad: f64,
+}
+
+impl Default for InMotionInit {
+    fn default() -> Self {
+        Self {
+            min_speed_mps: 5.0,
+            tilt_sigma_rad: 1.0 * DEG,
+            track_sigma_rad: 0.2 * DEG,
+        }
+    }
 }
 
 impl Default for FuseOptions {
@@ -94,6 +136,8 @@ impl Default for FuseOptions {
             nhc_sigma_mps: None,
             model_lever_arm: true,
             until_s: None,
+            smooth: false,
+            in_motion: None,
         }
     }
 }
@@ -114,6 +158,9 @@ pub enum FuseError {
     /// The filter failed (names the epoch).
     #[error(transparent)]
     Filter(#[from] FilterError),
+    /// The smoother failed (names the epoch).
+    #[error(transparent)]
+    Smoother(#[from] SmootherError),
     /// Cancelled.
     #[error("cancelled")]
     Cancelled(#[from] Cancelled),
@@ -163,11 +210,14 @@ impl FuseEpoch {
 
 /// What the observer receives.
 #[derive(Clone, Copy, Debug)]
+#[non_exhaustive]
 pub enum FuseEvent<'a> {
-    /// a covariance epoch
+    /// a covariance epoch of the forward filter
     Epoch(&'a FuseEpoch),
     /// a measurement update (GNSS, ZUPT, NHC)
     Update(&'a UpdateReport),
+    /// a smoothed epoch (after the forward pass, in time order)
+    Smoothed(&'a FuseEpoch),
 }
 
 /// Summary of a fused run.
@@ -254,6 +304,36 @@ pub fn fuse_scenario_with(
     cancel: &CancelToken,
     mut observe: impl FnMut(FuseEvent<'_>),
 ) -> Result<FuseSummary, FuseError> {
+    if scn.mounting.imu.is_some() {
+        return Err(FuseError::Option(
+            "mounting",
+            "the filter's body frame is the IMU and fuse compares with the truth at the vehicle reference point: remove [mounting] imu_lever_arm_m / imu_mount_deg, and give the antenna's lever arm from the IMU".into(),
+        ));
+    }
+    // the antenna lever arm: [gnss] lever_arm_b_m, or [mounting] gnss_lever_arm_m (the IMU
+    // sits at the reference point here, so both are arms from the IMU)
+    let gnss_eff;
+    let gnss = match scn.mounting.gnss_lever_arm_b_m {
+        Some(l) => {
+            let own = Vec3::from(gnss.lever_arm_b_m);
+            if own != Vec3::zeros() && own != l {
+                return Err(FuseError::Option(
+                    "mounting.gnss_lever_arm_m",
+                    format!(
+                        "differs from [gnss] lever_arm_b_m ({:?} m against {:?} m): give one",
+                        [l.x, l.y, l.z],
+                        gnss.lever_arm_b_m
+                    ),
+                ));
+            }
+            gnss_eff = GnssConfig {
+                lever_arm_b_m: [l.x, l.y, l.z],
+                ..gnss.clone()
+            };
+            &gnss_eff
+        }
+        None => gnss,
+    };
     let earth = scn.nav.earth.model();
     let dt = scn.imu.dt_s();
     let n = opts.algo.samples.clamp(1, 4);
@@ -300,6 +380,73 @@ pub fn fuse_scenario_with(
     let (true_bg, true_ba) = sensor.constant_bias();
     let (noise, s_ba, s_bg, known_ba, known_bg) = noise_from_model(&scn.imu.model);
 
+    let mut prev_truth = TruthSample::new(
+        0.0,
+        Increment::default(),
+        init_true.lat_rad,
+        init_true.lon_rad,
+        init_true.h_m,
+        init_true.v_n_mps,
+        init_true.c_b_n,
+    );
+    let mut pending: Vec<GnssFix> = Vec::with_capacity(8);
+    // in-motion start: run the sensors and the receiver until the first fix at speed
+    let mut skipped = 0u64;
+    let mut moving_start = None;
+    if let Some(im) = &opts.in_motion {
+        if !(im.min_speed_mps.is_finite()
+            && im.min_speed_mps > 0.0
+            && im.tilt_sigma_rad > 0.0
+            && im.tilt_sigma_rad <= 10.0 * DEG
+            && im.track_sigma_rad > 0.0
+            && im.track_sigma_rad <= 10.0 * DEG)
+        {
+            return Err(FuseError::Option(
+                "in_motion",
+                "min speed must be > 0, tilt and track σ in (0, 10°]".into(),
+            ));
+        }
+        loop {
+            let Some(ts) = truth.next() else {
+                return Err(FuseError::Option(
+                    "in_motion",
+                    format!(
+                        "no GNSS fix with a velocity and a horizontal speed of at least {} m/s in the scenario",
+                        im.min_speed_mps
+                    ),
+                ));
+            };
+            let meas = sensor.apply(&ts.inc, dt);
+            gsim.step(&scn.trajectory, &prev_truth, &ts, &mut pending);
+            prev_truth = ts;
+            skipped += 1;
+            let found = pending.iter().position(|f| {
+                f.vel
+                    .is_some_and(|(v, _)| v.x.hypot(v.y) >= im.min_speed_mps)
+            });
+            match found {
+                Some(i) => {
+                    let f = pending[i];
+                    pending.drain(..=i);
+                    moving_start = Some((f, ts, meas));
+                    break;
+                }
+                None => pending.clear(),
+            }
+        }
+    }
+    let t_start = prev_truth.t_s;
+    let init_true = if moving_start.is_some() {
+        InitialState {
+            lat_rad: prev_truth.lat_rad,
+            lon_rad: prev_truth.lon_rad,
+            h_m: prev_truth.h_m,
+            v_n_mps: prev_truth.v_n_mps,
+            c_b_n: prev_truth.c_b_n,
+        }
+    } else {
+        init_true
+    };
     // initial errors
     let r0 = earth.radii(init_true.lat_rad);
     let t0 = Vec3::new(
@@ -325,6 +472,7 @@ pub fn fuse_scenario_with(
         v_n_mps: init_true.v_n_mps + dv,
         c_b_n: Quat::from_rotvec(&eps).to_dcm() * init_true.c_b_n,
     };
+    let mut init = init;
     let mut p0 = StateMat::zeros();
     for i in 0..3 {
         p0[(I_POS + i, I_POS + i)] = (s.pos_ned_m[i] / t0[i]).powi(2);
@@ -332,6 +480,52 @@ pub fn fuse_scenario_with(
         p0[(I_ATT + i, I_ATT + i)] = s.att_rad[i].powi(2);
         p0[(I_BA + i, I_BA + i)] = s_ba[i].powi(2);
         p0[(I_BG + i, I_BG + i)] = s_bg[i].powi(2);
+    }
+    if let (Some((f, ts, meas)), Some(im)) = (moving_start, opts.in_motion) {
+        let (v_a, cv) = f.vel.unwrap_or((Vec3::zeros(), Mat3::identity()));
+        let vh = v_a.x.hypot(v_a.y);
+        let w_z = meas.dtheta_b_rad.z / dt;
+        let yaw = v_a.y.atan2(v_a.x) + w_z * (ts.t_s - f.t_s);
+        let pitch = (-v_a.z).atan2(vh);
+        let c = sdins_core::math::c_b_n_from_euler(&sdins_core::math::Euler::new(0.0, pitch, yaw));
+        let l = Vec3::from(gnss.lever_arm_b_m);
+        let w_b = meas.dtheta_b_rad / dt;
+        let v = v_a - c * w_b.cross(&l);
+        let cl = c * l;
+        let r = earth.radii(f.lat_rad);
+        let sc = sdins_core::aiding::error_model::position_scale(
+            r.r_m_m,
+            r.r_n_m,
+            f.lat_rad.cos(),
+            f.h_m,
+        );
+        // the fix is at t_f ≤ t_start: advance by the velocity over the gap
+        let gap = ts.t_s - f.t_s;
+        init = InitialState {
+            lat_rad: f.lat_rad + (v.x * gap - cl.x) / sc.x,
+            lon_rad: f.lon_rad + (v.y * gap - cl.y) / sc.y,
+            h_m: f.h_m - v.z * gap + cl.z,
+            v_n_mps: v,
+            c_b_n: c,
+        };
+        let (sy, cy) = yaw.sin_cos();
+        let s_psi2 =
+            im.track_sigma_rad.powi(2) + (cv[(0, 0)] * sy * sy + cv[(1, 1)] * cy * cy) / (vh * vh);
+        let m = crate::fuse_records::euler_error_matrix(&c);
+        let mi = m.try_inverse().unwrap_or_else(Mat3::identity);
+        let d = Mat3::from_diagonal(&Vec3::new(
+            im.tilt_sigma_rad.powi(2),
+            im.tilt_sigma_rad.powi(2),
+            s_psi2,
+        ));
+        let pa = mi * d * mi.transpose();
+        for i in 0..3 {
+            for j in 0..3 {
+                p0[(I_POS + i, I_POS + j)] = f.pos_cov_ned_m2[(i, j)] / (sc[i] * sc[j]);
+                p0[(I_VEL + i, I_VEL + j)] = cv[(i, j)];
+                p0[(I_ATT + i, I_ATT + j)] = pa[(i, j)];
+            }
+        }
     }
     let mech = AnyMechanization::new(&opts.algo, earth, dt, &init);
     let ekf_cfg = EkfConfig {
@@ -349,26 +543,29 @@ pub fn fuse_scenario_with(
     };
     let mut ekf = Ekf::new(mech, ekf_cfg, p0, known_ba, known_bg);
 
-    let mut total = len_samples / n as u64;
+    let mut total = len_samples.saturating_sub(skipped) / n as u64;
     if let Some(t) = opts.until_s {
-        total = total.min((t * nav_rate).round() as u64);
+        total = total.min(((t - t_start).max(0.0) * nav_rate).round() as u64);
     }
     let latency_fix = if gnss.latency_modelled {
         gnss.latency_s
     } else {
         0.0
     };
-    let mut prev_truth = TruthSample::new(
-        0.0,
-        Increment::default(),
-        init_true.lat_rad,
-        init_true.lon_rad,
-        init_true.h_m,
-        init_true.v_n_mps,
-        init_true.c_b_n,
-    );
     let mut incs = [Increment::default(); 4];
-    let mut pending: Vec<GnssFix> = Vec::with_capacity(8);
+    // forward records for the smoother: the log, and per epoch the forward state, its
+    // bias estimates and the truth
+    let mut smooth = opts.smooth.then(|| {
+        let epochs = (total / cov_updates as u64 + 2) as usize;
+        (
+            SmootherLog::with_capacity(epochs),
+            Vec::<(NavState, (Vec3, Vec3), TruthSample)>::with_capacity(epochs),
+        )
+    });
+    if let Some((log, fwd)) = smooth.as_mut() {
+        log.push(&ekf.initial_epoch())?;
+        fwd.push((ekf.state(), ekf.biases(), prev_truth));
+    }
     let mut fixes = 0u64;
     let mut last_cur = prev_truth;
     for k in 0..total {
@@ -393,18 +590,19 @@ pub fn fuse_scenario_with(
         // fixes available by now (tag ≤ t_nav), in time order
         let mut i = 0;
         while i < pending.len() {
-            if pending[i].t_s <= t_nav + 1e-9 {
+            if pending[i].t_s <= t_start + t_nav + 1e-9 {
                 let f = pending.remove(i);
                 fixes += 1;
                 let m = GnssMeasurement {
-                    t_s: f.t_s - latency_fix,
+                    t_s: f.t_s - latency_fix - t_start,
                     lat_rad: f.lat_rad,
                     lon_rad: f.lon_rad,
                     h_m: f.h_m,
                     pos_cov_ned_m2: f.pos_cov_ned_m2,
                     vel: f.vel,
                 };
-                let rep = ekf.update_gnss(&m)?;
+                let mut rep = ekf.update_gnss(&m)?;
+                rep.t_s += t_start;
                 observe(FuseEvent::Update(&rep));
             } else {
                 i += 1;
@@ -414,19 +612,52 @@ pub fn fuse_scenario_with(
         if epoch_now {
             let at_rest = opts.zupt.is_some_and(|(_, thr)| cur.v_n_mps.norm() < thr);
             if let (true, Some((sig, _))) = (at_rest, opts.zupt) {
-                let rep = ekf.update_zupt(sig)?;
+                let mut rep = ekf.update_zupt(sig)?;
+                rep.t_s += t_start;
                 observe(FuseEvent::Update(&rep));
             } else if let Some(sig) = opts.nhc_sigma_mps {
-                let rep = ekf.update_nhc(sig)?;
+                let mut rep = ekf.update_nhc(sig)?;
+                rep.t_s += t_start;
                 observe(FuseEvent::Update(&rep));
             }
         }
-        if ekf.take_epoch().is_some() {
-            let e = epoch_of(&ekf, &cur, &earth, true_ba, true_bg);
+        if let Some(ep) = ekf.take_epoch() {
+            let mut e = epoch_of(
+                &ekf.state(),
+                ekf.biases(),
+                ekf.covariance(),
+                &cur,
+                &earth,
+                true_ba,
+                true_bg,
+            );
+            e.t_s += t_start;
             observe(FuseEvent::Epoch(&e));
+            if let Some((log, fwd)) = smooth.as_mut() {
+                log.push(&ep)?;
+                fwd.push((ekf.state(), ekf.biases(), cur));
+            }
         }
     }
     let _ = last_cur;
+    if let Some((log, fwd)) = smooth {
+        let mut out: Vec<Option<FuseEpoch>> = vec![None; fwd.len()];
+        log.smooth(cancel, |k, _, sm| {
+            if let (Some((st, (ba, bg), tr)), Some(slot)) = (fwd.get(k), out.get_mut(k)) {
+                let s_state = correct_nav_state(st, &sm.dx);
+                let b = (
+                    ba + sm.dx.fixed_rows::<3>(I_BA),
+                    bg + sm.dx.fixed_rows::<3>(I_BG),
+                );
+                let mut e = epoch_of(&s_state, b, &sm.p, tr, &earth, true_ba, true_bg);
+                e.t_s += t_start;
+                *slot = Some(e);
+            }
+        })?;
+        for e in out.iter().flatten() {
+            observe(FuseEvent::Smoothed(e));
+        }
+    }
     let (ba, bg) = ekf.biases();
     Ok(FuseSummary {
         fixes,
@@ -438,20 +669,20 @@ pub fn fuse_scenario_with(
     })
 }
 
-fn epoch_of<M: Mechanization>(
-    ekf: &Ekf<M>,
+fn epoch_of(
+    st: &NavState,
+    (ba, bg): (Vec3, Vec3),
+    p: &StateMat,
     truth: &TruthSample,
     earth: &sdins_core::earth::EarthModel,
     true_ba: Vec3,
     true_bg: Vec3,
 ) -> FuseEpoch {
-    let st = ekf.state();
-    let ne = nav_error(earth, &st, truth);
+    let ne = nav_error(earth, st, truth);
     let mut err = StateVec::zeros();
     err[I_POS] = st.lat_rad - truth.lat_rad;
     err[I_POS + 1] = lon_diff(st.lon_rad, truth.lon_rad);
     err[I_POS + 2] = st.h_m - truth.h_m;
-    let (ba, bg) = ekf.biases();
     for i in 0..3 {
         err[I_VEL + i] = ne.vel_err_ned_mps[i];
         err[I_ATT + i] = ne.att_err_rad[i];
@@ -462,7 +693,7 @@ fn epoch_of<M: Mechanization>(
     FuseEpoch {
         t_s: st.t_s,
         err,
-        p: *ekf.covariance(),
+        p: *p,
         pos_scale: Vec3::new(
             r.r_m_m + truth.h_m,
             (r.r_n_m + truth.h_m) * truth.lat_rad.cos(),

@@ -307,14 +307,57 @@ pub fn read_psins_avp(path: &Path) -> Result<Vec<TruthSample>, TruthFileError> {
     parse_psins_avp(path, &read_text(path)?)
 }
 
-/// Parse either format, told apart by the header (`pitch_rad` → PSINS avp).
+/// Column names of a NaveGo reference trajectory (`ref.csv` as converted from NaveGo's
+/// `ref.mat`: NED velocity, ZYX Euler angles of body FRD to NED, radians).
+pub const NAVEGO_REF_COLUMNS: [&str; 10] = [
+    "t_s",
+    "lat_rad",
+    "lon_rad",
+    "h_m",
+    "v_n_mps",
+    "v_e_mps",
+    "v_d_mps",
+    "roll_rad",
+    "pitch_rad",
+    "yaw_rad",
+];
+
+/// Parse the text of a NaveGo reference trajectory (see [`NAVEGO_REF_COLUMNS`]).
+pub fn parse_navego_ref(path: &Path, text: &str) -> Result<Vec<TruthSample>, TruthFileError> {
+    let cols = NAVEGO_REF_COLUMNS;
+    let rows = parse_rows(path, text, &cols)?;
+    let lat_max = MAX_LAT_DEG * D2R;
+    let mut out = Vec::with_capacity(rows.len());
+    for (k, r) in rows.iter().enumerate() {
+        if r[1].abs() > lat_max || !(H_RANGE_M.0..=H_RANGE_M.1).contains(&r[3]) {
+            let line = data_line(text, k);
+            check_range(path, line, &cols, 1, r[1], (-lat_max, lat_max))?;
+            check_range(path, line, &cols, 3, r[3], H_RANGE_M)?;
+        }
+        let c = c_b_n_from_euler(&Euler::new(r[7], r[8], r[9]));
+        out.push(sample(
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            Vec3::new(r[4], r[5], r[6]),
+            c,
+        ));
+    }
+    Ok(out)
+}
+
+/// Parse any of the formats, told apart by the header (`pitch_rad` first → PSINS avp,
+/// `lat_rad` second → NaveGo, else sdins).
 pub fn parse_truth_str(path: &Path, text: &str) -> Result<Vec<TruthSample>, TruthFileError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    if text
+    let header = text
         .lines()
         .find(|l| !l.trim().is_empty() && !l.starts_with('#'))
-        .is_some_and(|l| l.contains("pitch_rad"))
-    {
+        .unwrap_or("");
+    if header.trim_start().starts_with("t_s,lat_rad") {
+        parse_navego_ref(path, text)
+    } else if header.contains("pitch_rad") {
         parse_psins_avp(path, text)
     } else {
         parse_sdins_truth(path, text)

@@ -58,11 +58,8 @@ fn short_run_every_algorithm_stays_consistent() {
                     }
                     last = Some(*e);
                 }
-                FuseEvent::Update(r) => {
-                    if r.kind == MeasKind::Gnss {
-                        nis.push(r.nis);
-                    }
-                }
+                FuseEvent::Update(r) if r.kind == MeasKind::Gnss => nis.push(r.nis),
+                _ => {}
             })
             .unwrap();
             let e = last.unwrap();
@@ -107,6 +104,7 @@ const Z99: f64 = 2.575_829_303_548_901;
 
 struct Run {
     epochs: Vec<FuseEpoch>,
+    smoothed: Vec<FuseEpoch>,
     gnss: Vec<(f64, f64, bool)>,
     #[allow(dead_code)]
     summary: FuseSummary,
@@ -118,6 +116,7 @@ fn run_mc(scn: &Scenario, gnss: &GnssConfig, opts: &FuseOptions, runs: u64) -> V
         .into_par_iter()
         .map(|r| {
             let mut epochs = Vec::new();
+            let mut smoothed = Vec::new();
             let mut g = Vec::new();
             let summary = fuse_scenario_with(
                 scn,
@@ -128,16 +127,17 @@ fn run_mc(scn: &Scenario, gnss: &GnssConfig, opts: &FuseOptions, runs: u64) -> V
                 &CancelToken::new(),
                 |ev| match ev {
                     FuseEvent::Epoch(e) => epochs.push(*e),
-                    FuseEvent::Update(u) => {
-                        if u.kind == MeasKind::Gnss {
-                            g.push((u.t_s, u.nis, u.accepted));
-                        }
+                    FuseEvent::Update(u) if u.kind == MeasKind::Gnss => {
+                        g.push((u.t_s, u.nis, u.accepted))
                     }
+                    FuseEvent::Smoothed(e) => smoothed.push(*e),
+                    _ => {}
                 },
             )
             .unwrap();
             Run {
                 epochs,
+                smoothed,
                 gnss: g,
                 summary,
             }
@@ -271,7 +271,11 @@ fn mc_outage_60s_tactical() {
         outages_s: vec![[300.0, 360.0]],
         ..Default::default()
     };
-    let runs = run_mc(&scn, &gnss, &no_gate(), 100);
+    let opts = FuseOptions {
+        smooth: true,
+        ..no_gate()
+    };
+    let runs = run_mc(&scn, &gnss, &opts, 100);
     let k_end = runs[0]
         .epochs
         .iter()
@@ -286,20 +290,92 @@ fn mc_outage_60s_tactical() {
         chi2_mean_quantile(2.0, 100.0, -Z95),
         chi2_mean_quantile(2.0, 100.0, Z95),
     );
-    let rms_h = (runs
-        .iter()
-        .map(|r| {
-            let p = r.epochs[k_end].nav.pos_err_ned_m;
-            p[0] * p[0] + p[1] * p[1]
-        })
-        .sum::<f64>()
-        / 100.0)
-        .sqrt();
+    let rms_h = |ep: &dyn Fn(&Run) -> &FuseEpoch| {
+        (runs
+            .iter()
+            .map(|r| {
+                let p = ep(r).nav.pos_err_ned_m;
+                p[0] * p[0] + p[1] * p[1]
+            })
+            .sum::<f64>()
+            / 100.0)
+            .sqrt()
+    };
     println!(
-        "outage end t = {:.2} s: horizontal NEES {nees_h:.3} (band [{lo:.2}, {hi:.2}]), RMS horizontal error {rms_h:.2} m",
-        runs[0].epochs[k_end].t_s
+        "outage end t = {:.2} s: horizontal NEES {nees_h:.3} (band [{lo:.2}, {hi:.2}]), RMS horizontal error {:.2} m",
+        runs[0].epochs[k_end].t_s,
+        rms_h(&|r: &Run| &r.epochs[k_end])
     );
     assert!((lo..=hi).contains(&nees_h), "horizontal NEES {nees_h}");
+
+    // smoother: one smoothed epoch per forward epoch (plus the initial one), P_s ≤ P_f
+    let mut worst = f64::INFINITY;
+    for r in &runs {
+        assert_eq!(r.smoothed.len(), r.epochs.len() + 1);
+        for (f, s) in r.epochs.iter().zip(&r.smoothed[1..]) {
+            assert_eq!(f.t_s, s.t_s);
+            let d = f.p - s.p;
+            let min_eig = d.symmetric_eigenvalues().min();
+            worst = worst.min(min_eig / f.p.norm());
+        }
+    }
+    println!("smallest eigenvalue of P_f − P_s over ‖P_f‖: {worst:.3e}");
+    assert!(worst >= -1e-12, "P_f − P_s has eigenvalue {worst} ‖P_f‖");
+    // smoothed NEES through the outage: the consistency criteria on the outage epochs
+    let in_outage = |e: &FuseEpoch| e.t_s > 300.0 && e.t_s < 360.0;
+    let idx: Vec<usize> = (0..runs[0].smoothed.len())
+        .filter(|&k| in_outage(&runs[0].smoothed[k]))
+        .collect();
+    let mean_at = |k: usize, f: &dyn Fn(&FuseEpoch) -> f64| {
+        runs.iter().map(|r| f(&r.smoothed[k])).sum::<f64>() / runs.len() as f64
+    };
+    let h: Vec<f64> = idx
+        .iter()
+        .map(|&k| mean_at(k, &|e| e.nees_horizontal()))
+        .collect();
+    check_band("smoothed horizontal NEES in the outage", &h, 2.0, 100.0);
+    for (name, i0) in [
+        ("position", I_POS),
+        ("velocity", I_VEL),
+        ("attitude", I_ATT),
+    ] {
+        let m: Vec<f64> = idx
+            .iter()
+            .map(|&k| mean_at(k, &|e| e.nees_block(i0)))
+            .collect();
+        check_band(
+            &format!("smoothed NEES {name} in the outage"),
+            &m,
+            3.0,
+            100.0,
+        );
+    }
+    // ratio of forward to smoothed maximum RMS horizontal error in the outage
+    let max_rms = |get: &dyn Fn(&Run, usize) -> &FuseEpoch, ks: &[usize]| {
+        ks.iter()
+            .map(|&k| {
+                (runs
+                    .iter()
+                    .map(|r| {
+                        let p = get(r, k).nav.pos_err_ned_m;
+                        p[0] * p[0] + p[1] * p[1]
+                    })
+                    .sum::<f64>()
+                    / 100.0)
+                    .sqrt()
+            })
+            .fold(0.0, f64::max)
+    };
+    let kf: Vec<usize> = (0..runs[0].epochs.len())
+        .filter(|&k| in_outage(&runs[0].epochs[k]))
+        .collect();
+    let f_max = max_rms(&|r, k| &r.epochs[k], &kf);
+    let s_max = max_rms(&|r, k| &r.smoothed[k], &idx);
+    println!(
+        "outage: max RMS horizontal error forward {f_max:.3} m, smoothed {s_max:.3} m, ratio {:.2}",
+        f_max / s_max
+    );
+    assert!(s_max < f_max);
 }
 
 /// Time-averaged position error along C_b^n l̂ per run (after 30 s).
@@ -459,11 +535,8 @@ fn gating_rejects_a_100m_outlier_and_the_solution_is_unaffected() {
     for (i, g) in [&clean, &bad].into_iter().enumerate() {
         let s = fuse_scenario(&scn, g, &opts, 0, &CancelToken::new(), |ev| match ev {
             FuseEvent::Epoch(e) => epochs[i].push(*e),
-            FuseEvent::Update(u) => {
-                if !u.accepted {
-                    rejected_at.push((i, u.t_s, u.nis));
-                }
-            }
+            FuseEvent::Update(u) if !u.accepted => rejected_at.push((i, u.t_s, u.nis)),
+            _ => {}
         })
         .unwrap();
         assert_eq!(s.rejected, i as u64);
@@ -576,4 +649,151 @@ fn gnss_scenario_section_parses_and_bad_values_name_the_key() {
     }
     let e = Scenario::from_toml(&format!("{base}[gnss]\nrate_hzz = 1.0\n"), "g.toml").unwrap_err();
     assert!(e.to_string().contains("rate_hzz"), "{e}");
+}
+
+/// In-motion alignment from an unknown heading (GNSS track, then the filter with NHC):
+/// ground vehicle at 10 m/s, tactical grade, 1 Hz GNSS, initial heading uniform over
+/// ±180° (a stratified grid, one per run), 200 runs. At most 2 runs above 0.5° heading
+/// error 60 s after the start of motion; attitude NEES in band from handover + 60 s.
+#[test]
+#[ignore]
+fn mc_in_motion_alignment_from_unknown_heading() {
+    use sdins_sim::fuse::InMotionInit;
+    let runs = 200u64;
+    let opts = FuseOptions {
+        in_motion: Some(InMotionInit::default()),
+        ..no_gate()
+    };
+    let gnss = GnssConfig::default();
+    let results: Vec<Run> = (0..runs)
+        .into_par_iter()
+        .map(|r| {
+            let yaw = -180.0 + 360.0 * (r as f64 + 0.5) / runs as f64;
+            let mut segs = String::new();
+            for _ in 0..3 {
+                segs.push_str("[[segment]]\ntype = \"cruise\"\nduration_s = 10.0\n[[segment]]\ntype = \"turn\"\nrate_dps = 9.0\nduration_s = 10.0\n[[segment]]\ntype = \"accelerate\"\naccel_mps2 = 0.5\nduration_s = 10.0\n[[segment]]\ntype = \"turn\"\nrate_dps = -9.0\nduration_s = 10.0\n[[segment]]\ntype = \"accelerate\"\naccel_mps2 = -0.5\nduration_s = 10.0\n[[segment]]\ntype = \"sturn\"\namplitude_dps = 5.0\nduration_s = 10.0\n");
+            }
+            let toml = format!("name = \"in-motion\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nspeed_mps = 10.0\nyaw_deg = {yaw}\n[imu]\nrate_hz = 100.0\nseed = 21\ngrade = \"tactical\"\n[nav]\nsamples = 2\n{segs}");
+            let scn = Scenario::from_toml(&toml, "in-motion.toml").unwrap();
+            let mut epochs = Vec::new();
+            let summary = fuse_scenario(&scn, &gnss, &opts, r, &CancelToken::new(), |ev| {
+                if let FuseEvent::Epoch(e) = ev {
+                    epochs.push(*e)
+                }
+            })
+            .unwrap();
+            Run {
+                epochs,
+                smoothed: Vec::new(),
+                gnss: Vec::new(),
+                summary,
+            }
+        })
+        .collect();
+    let t_hand = results[0].epochs[0].t_s;
+    // heading error 60 s after the start of motion (t = 0)
+    let k60 = results[0]
+        .epochs
+        .iter()
+        .position(|e| e.t_s >= 60.0 - 1e-9)
+        .unwrap();
+    let errs: Vec<f64> = results
+        .iter()
+        .map(|r| r.epochs[k60].nav.euler_err_rad[2].to_degrees().abs())
+        .collect();
+    let above = errs.iter().filter(|e| **e > 0.5).count();
+    let max = errs.iter().copied().fold(0.0, f64::max);
+    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
+    let sig = results[0].epochs[k60].sigma(I_ATT + 2).to_degrees();
+    println!(
+        "in-motion: handover at t = {t_hand:.2} s; heading error at 60 s: RMS {rms:.4}°, max {max:.4}°, runs above 0.5°: {above} of {runs}; filter σ_ψ (run 0) {sig:.4}°"
+    );
+    assert!(above <= 2, "{above} runs above 0.5°");
+    for k in [k60, results[0].epochs.len() - 1] {
+        let z: Vec<f64> = (0..9)
+            .map(|i| {
+                results
+                    .iter()
+                    .map(|r| (r.epochs[k].err[i] / r.epochs[k].p[(i, i)].sqrt()).powi(2))
+                    .sum::<f64>()
+                    / runs as f64
+            })
+            .collect();
+        println!(
+            "t = {:.1} s: mean (err/σ)² pos, vel, att: {z:.2?}",
+            results[0].epochs[k].t_s
+        );
+    }
+    let m: Vec<f64> = run_means(&results, t_hand + 60.0, |e| e.nees_block(I_ATT))
+        .iter()
+        .map(|x| x.1)
+        .collect();
+    let in95 = check_band(
+        "in-motion attitude NEES from handover + 60 s",
+        &m,
+        3.0,
+        runs as f64,
+    );
+    println!(
+        "in-motion attitude NEES: {:.1} % of epochs in the 95 % band",
+        100.0 * in95
+    );
+}
+
+/// `[mounting]`: the antenna arm from `[mounting] gnss_lever_arm_m` acts as `[gnss]
+/// lever_arm_b_m` (bit-identical runs); conflicting arms and an IMU lever arm are refused
+/// by fuse and by the Monte Carlo (they would silently be ignored).
+#[test]
+fn mounting_gnss_arm_is_used_and_imu_mounting_is_refused() {
+    let base = "name = \"m\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nspeed_mps = 10.0\n[imu]\nrate_hz = 100.0\ngrade = \"tactical\"\n[nav]\nsamples = 2\n[[segment]]\ntype = \"turn\"\nrate_dps = 5.0\nduration_s = 20.0\n";
+    let run = |toml: &str, gnss: &GnssConfig| {
+        let scn = Scenario::from_toml(toml, "m.toml").unwrap();
+        let mut last = None;
+        let r = fuse_scenario(
+            &scn,
+            gnss,
+            &FuseOptions::default(),
+            0,
+            &CancelToken::new(),
+            |ev| {
+                if let FuseEvent::Epoch(e) = ev {
+                    last = Some(e.err)
+                }
+            },
+        );
+        r.map(|_| last.unwrap())
+    };
+    let arm = GnssConfig {
+        lever_arm_b_m: [1.0, 0.2, -0.5],
+        ..Default::default()
+    };
+    let a = run(base, &arm).unwrap();
+    let with_mount = format!("{base}[mounting]\ngnss_lever_arm_m = [1.0, 0.2, -0.5]\n");
+    let b = run(&with_mount, &GnssConfig::default()).unwrap();
+    assert_eq!(a, b);
+    let other = GnssConfig {
+        lever_arm_b_m: [0.5, 0.0, 0.0],
+        ..Default::default()
+    };
+    let e = run(&with_mount, &other).unwrap_err().to_string();
+    assert!(e.contains("gnss_lever_arm_m"), "{e}");
+    let imu_arm = format!("{base}[mounting]\nimu_lever_arm_m = [0.5, 0.0, 0.0]\n");
+    let e = run(&imu_arm, &GnssConfig::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("mounting"), "{e}");
+    let scn = Scenario::from_toml(&imu_arm, "m.toml").unwrap();
+    let mc = sdins_sim::montecarlo::McOptions {
+        runs: 16,
+        seed: 1,
+        algo: AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 2),
+        every_s: 1.0,
+        until_s: None,
+        block: 16,
+        vertical_hold: true,
+    };
+    let e = sdins_sim::montecarlo::runner::job(&scn, &mc)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("[mounting]"), "{e}");
 }

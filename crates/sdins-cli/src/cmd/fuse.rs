@@ -2,6 +2,7 @@
 //! errors with ±3σ). The work is `sdins_sim::fuse::fuse_scenario`; this only parses and
 //! writes.
 
+use super::fuse_report::{ErrRow, FuseReportData, Thin};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
@@ -16,11 +17,58 @@ use std::path::PathBuf;
 /// Arguments of `sdins fuse`.
 #[derive(clap::Args, Debug)]
 #[command(
-    after_help = "The scenario's [gnss] table sets the receiver (default: 1 Hz, σ 1/1/2 m, 0.05/0.05/0.1 m/s).\n\nExample:\n  sdins fuse dq-paper --out out/fuse --json"
+    after_help = "The scenario's [gnss] table sets the receiver (default: 1 Hz, σ 1/1/2 m, 0.05/0.05/0.1 m/s).\n\nExample:\n  sdins fuse dq-paper --out out/fuse --json\n  sdins fuse --imu imu1.csv --gnss gnss.csv --navego-params imu1_params.txt --truth ref.csv --samples 1 --smooth"
 )]
 pub struct Args {
-    /// built-in scenario name or scenario file
-    pub scenario: String,
+    /// built-in scenario name or scenario file (or give --imu and --gnss)
+    #[arg(required_unless_present = "imu", conflicts_with = "imu")]
+    pub scenario: Option<String>,
+    /// recorded IMU file (with --gnss: fuse recorded data instead of a scenario)
+    #[arg(long)]
+    pub imu: Option<PathBuf>,
+    /// IMU file format (auto, sdins, psins, psins-csv, kfgins, navego)
+    #[arg(long, default_value = "auto")]
+    pub imu_format: String,
+    /// GNSS file (sdins CSV, NaveGo gnss.csv, KF-GINS text, RTKLIB .pos)
+    #[arg(long, requires = "imu")]
+    pub gnss: Option<PathBuf>,
+    /// GNSS file format (auto, sdins, navego, kfgins, rtklib)
+    #[arg(long, default_value = "auto")]
+    pub gnss_format: String,
+    /// t_imu − t_gnss [s] when the two files' clocks differ by a constant
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub gnss_offset_s: f64,
+    /// the filter's IMU model from a grade preset (consumer, industrial, tactical, aviation, ...)
+    #[arg(long)]
+    pub grade: Option<String>,
+    /// the filter's IMU model from a NaveGo imuN_params.txt (static bias known, ±10 % residual)
+    #[arg(long)]
+    pub navego_params: Option<PathBuf>,
+    /// initial state lat_deg,lon_deg,h_m,v_n,v_e,v_d,roll_deg,pitch_deg,yaw_deg at the IMU record's start
+    #[arg(long, allow_hyphen_values = true)]
+    pub init: Option<String>,
+    /// initial attitude roll,pitch,yaw [deg]; position and velocity from the first fix
+    #[arg(long, allow_hyphen_values = true)]
+    pub attitude_deg: Option<String>,
+    /// σ of --attitude-deg roll,pitch,yaw [deg] (default 1,1,2)
+    #[arg(long)]
+    pub attitude_sigma_deg: Option<String>,
+    /// at rest for the first S seconds: coarse alignment, position from the first fix
+    #[arg(long)]
+    pub static_s: Option<f64>,
+    /// GNSS antenna lever arm from the IMU, body FRD x,y,z [m]
+    #[arg(long, allow_hyphen_values = true)]
+    pub lever_arm_m: Option<String>,
+    /// reference trajectory to compare with (sdins truth.csv, PSINS avp, NaveGo ref.csv)
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
+    /// run the Rauch–Tung–Striebel smoother after the forward filter (smoothed.csv)
+    #[arg(long)]
+    pub smooth: bool,
+    /// scenario: in-motion alignment from an unknown heading (start at the first fix at
+    /// ≥ 5 m/s, heading from the GNSS track)
+    #[arg(long)]
+    pub in_motion: bool,
     /// output folder (default ./sdins-out/fuse-<scenario>)
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -53,6 +101,40 @@ pub struct Args {
     pub json: bool,
 }
 
+const ERR_HEADER: &str = "t_s,err_n_m,err_e_m,err_d_m,sigma_n_m,sigma_e_m,sigma_d_m,err_vn_mps,err_ve_mps,err_vd_mps,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,err_att_n_rad,err_att_e_rad,err_att_d_rad,sigma_att_n_rad,sigma_att_e_rad,sigma_att_d_rad";
+
+/// One row of nav.csv / smoothed.csv: errors against the truth with σ.
+fn epoch_row(e: &sdins_sim::fuse::FuseEpoch) -> String {
+    let mut line = format!("{}", e.t_s);
+    for (i0, vals) in [
+        (I_POS, e.nav.pos_err_ned_m),
+        (I_VEL, e.nav.vel_err_ned_mps),
+        (I_ATT, e.nav.att_err_rad),
+    ] {
+        for v in vals {
+            line.push_str(&format!(",{v:e}"));
+        }
+        for i in 0..3 {
+            line.push_str(&format!(",{:e}", e.sigma(i0 + i)));
+        }
+    }
+    line
+}
+
+fn err_row(e: &sdins_sim::fuse::FuseEpoch) -> ErrRow {
+    let mut v = [0.0; 9];
+    let mut sg = [0.0; 9];
+    for i in 0..3 {
+        v[i] = e.nav.pos_err_ned_m[i];
+        v[3 + i] = e.nav.vel_err_ned_mps[i];
+        v[6 + i] = e.nav.att_err_rad[i].to_degrees();
+        sg[i] = e.sigma(I_POS + i);
+        sg[3 + i] = e.sigma(I_VEL + i);
+        sg[6 + i] = e.sigma(I_ATT + i).to_degrees();
+    }
+    (e.t_s, v, sg)
+}
+
 fn check_sigma(name: &str, v: Option<f64>) -> Result<(), CliError> {
     match v {
         Some(x) if !(x.is_finite() && x > 0.0) => Err(CliError::bad(format!(
@@ -64,7 +146,28 @@ fn check_sigma(name: &str, v: Option<f64>) -> Result<(), CliError> {
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let scn = Scenario::load(&args.scenario)?;
+    if let Some(imu) = args.imu.clone() {
+        return super::fuse_files::run(args, imu);
+    }
+    let Some(name) = args.scenario.as_deref() else {
+        return Err(CliError::bad("give a scenario, or --imu FILE --gnss FILE"));
+    };
+    for (flag, given) in [
+        ("--grade", args.grade.is_some()),
+        ("--navego-params", args.navego_params.is_some()),
+        ("--init", args.init.is_some()),
+        ("--attitude-deg", args.attitude_deg.is_some()),
+        ("--static-s", args.static_s.is_some()),
+        ("--truth", args.truth.is_some()),
+        ("--lever-arm-m", args.lever_arm_m.is_some()),
+    ] {
+        if given {
+            return Err(CliError::bad(format!(
+                "{flag} applies to recorded data (--imu/--gnss); a scenario sets it in its [imu]/[gnss] tables"
+            )));
+        }
+    }
+    let scn = Scenario::load(name)?;
     let samples = args.samples.unwrap_or(scn.nav.samples);
     if !(1..=4).contains(&samples) {
         return Err(CliError::bad(format!(
@@ -89,6 +192,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         gate_chi2: if args.no_gate { None } else { Some(CHI2_999) },
         zupt: args.zupt_sigma_mps.map(|s| (s, 1e-3)),
         nhc_sigma_mps: args.nhc_sigma_mps,
+        smooth: args.smooth,
+        in_motion: args.in_motion.then(sdins_sim::fuse::InMotionInit::default),
         ..FuseOptions::default()
     };
     let out = args
@@ -98,11 +203,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
     crate::output::claim(&out)?;
     let mut nav = AtomicFile::create(&out.join("nav.csv"))?;
     let mut inn = AtomicFile::create(&out.join("innovations.csv"))?;
+    let mut smo = if args.smooth {
+        Some(AtomicFile::create(&out.join("smoothed.csv"))?)
+    } else {
+        None
+    };
     let io = |name: &str, e: std::io::Error| CliError::Io {
         path: out.join(name),
         source: e,
     };
-    writeln!(nav.writer(), "t_s,err_n_m,err_e_m,err_d_m,sigma_n_m,sigma_e_m,sigma_d_m,err_vn_mps,err_ve_mps,err_vd_mps,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,err_att_n_rad,err_att_e_rad,err_att_d_rad,sigma_att_n_rad,sigma_att_e_rad,sigma_att_d_rad").map_err(|e| io("nav.csv", e))?;
+    if let Some(f) = smo.as_mut() {
+        writeln!(f.writer(), "{ERR_HEADER}").map_err(|e| io("smoothed.csv", e))?;
+    }
+    writeln!(nav.writer(), "{ERR_HEADER}").map_err(|e| io("nav.csv", e))?;
     writeln!(
         inn.writer(),
         "t_s,kind,dof,nis,accepted,forced,nu_1,nu_2,nu_3,nu_4,nu_5,nu_6"
@@ -112,26 +225,37 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut sq = [0.0_f64; 9];
     let mut n_ep = 0.0_f64;
     let cancel = CancelToken::new();
+    let mut fwd_rows = Thin::<ErrRow>::new();
+    let mut smo_rows = Thin::<ErrRow>::new();
+    let mut gnss_rows: Vec<(f64, f64, usize, bool)> = Vec::new();
     let res = fuse_scenario(&scn, &gnss, &opts, args.run, &cancel, |ev| {
+        match ev {
+            FuseEvent::Epoch(e) => fwd_rows.push(err_row(e)),
+            FuseEvent::Smoothed(e) => smo_rows.push(err_row(e)),
+            FuseEvent::Update(u) if u.kind == MeasKind::Gnss => {
+                gnss_rows.push((u.t_s, u.nis, u.dof, u.accepted))
+            }
+            _ => {}
+        }
         let r = match ev {
             FuseEvent::Epoch(e) => {
-                let mut line = format!("{}", e.t_s);
+                let line = epoch_row(e);
                 for (i0, vals) in [
                     (I_POS, e.nav.pos_err_ned_m),
                     (I_VEL, e.nav.vel_err_ned_mps),
                     (I_ATT, e.nav.att_err_rad),
                 ] {
-                    for v in vals {
-                        line.push_str(&format!(",{v:e}"));
-                    }
                     for i in 0..3 {
-                        line.push_str(&format!(",{:e}", e.sigma(i0 + i)));
                         sq[i0 + i] += vals[i] * vals[i];
                     }
                 }
                 n_ep += 1.0;
                 writeln!(nav.writer(), "{line}")
             }
+            FuseEvent::Smoothed(e) => match smo.as_mut() {
+                Some(f) => writeln!(f.writer(), "{}", epoch_row(e)),
+                None => Ok(()),
+            },
             FuseEvent::Update(u) => {
                 let kind = match u.kind {
                     MeasKind::Gnss => "gnss",
@@ -148,6 +272,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 }
                 writeln!(inn.writer(), "{line}")
             }
+            _ => Ok(()),
         };
         if let Err(e) = r {
             werr.get_or_insert(e);
@@ -163,7 +288,44 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     nav.commit()?;
     inn.commit()?;
+    if let Some(f) = smo {
+        f.commit()?;
+    }
     let rms: Vec<f64> = sq.iter().map(|x| (x / n_ep.max(1.0)).sqrt()).collect();
+    let rms_of = |rows: &Thin<ErrRow>| {
+        let n = rows.pts.len().max(1) as f64;
+        let mut v = [0.0; 9];
+        for (i, x) in v.iter_mut().enumerate() {
+            *x = (rows.pts.iter().map(|p| p.1[i] * p.1[i]).sum::<f64>() / n).sqrt();
+        }
+        v
+    };
+    let mut rmse = vec![("forward".to_string(), {
+        let mut v = [0.0; 9];
+        for (i, x) in v.iter_mut().enumerate() {
+            *x = if i < 6 { rms[i] } else { rms[i].to_degrees() };
+        }
+        v
+    })];
+    if args.smooth {
+        rmse.push(("smoothed (plotted epochs)".to_string(), rms_of(&smo_rows)));
+    }
+    super::fuse_report::write(
+        &out,
+        &FuseReportData {
+            title: format!("sdins fuse: {}", scn.name),
+            intro: format!(
+                "Scenario {} run {}: {} GNSS fixes ({} rejected), algorithm {} N = {samples}, covariance at {} Hz; errors against the exact truth.",
+                scn.name, args.run, s.fixes, s.rejected, args.algo, args.cov_rate_hz
+            ),
+            att_names: ["ε_N", "ε_E", "ε_D"],
+            forward: &fwd_rows,
+            smoothed: args.smooth.then_some(&smo_rows),
+            gnss: &gnss_rows,
+            fix_interval_s: 1.0 / gnss.rate_hz,
+            rmse,
+        },
+    )?;
     let v3 = |v: &sdins_core::math::Vec3| [v.x, v.y, v.z];
     let summary = serde_json::json!({
         "scenario": scn.name,

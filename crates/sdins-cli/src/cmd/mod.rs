@@ -6,6 +6,8 @@ pub mod allan;
 pub mod demo;
 pub mod errors;
 pub mod fuse;
+pub mod fuse_files;
+pub mod fuse_report;
 pub mod merge;
 pub mod montecarlo;
 pub mod nav;

@@ -216,15 +216,38 @@ impl core::fmt::Display for FilterError {
 
 impl core::error::Error for FilterError {}
 
-/// One covariance epoch, for a smoother: `P(k|k−1) = Φ P(k−1|k−1) Φᵀ + Q`.
+/// One covariance epoch k, what a Rauch–Tung–Striebel smoother needs (see
+/// [`super::rts`]): `P(k|k−1) = Φ P(k−1|k−1) Φᵀ + Q`, the covariance after the epoch's
+/// measurements `P(k|k)`, and the sum of the closed-loop corrections `δx̂` applied at the
+/// epoch (the error of the state *before* the corrections is the error after them plus
+/// `dx`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CovEpoch {
     /// time \[s\]
     pub t_s: f64,
-    /// transition used from the previous epoch
+    /// transition Φ(k, k−1) used from the previous epoch
     pub phi: StateMat,
-    /// predicted covariance
+    /// predicted covariance P(k|k−1)
     pub p_pred: StateMat,
+    /// covariance after the epoch's measurements P(k|k) (filled by [`Ekf::take_epoch`])
+    pub p_post: StateMat,
+    /// sum of the corrections applied at the epoch (filled by [`Ekf::take_epoch`])
+    pub dx: StateVec,
+}
+
+/// A navigation state corrected by an error estimate `x` (estimate − truth, the states of
+/// [`super::error_model`]): `L −= δL`, `λ −= δλ`, `h −= δh`, `v −= δv`,
+/// `Ĉ ← exp(−[ε×]) Ĉ` (Groves §14.1.1). The filter's closed-loop correction and the
+/// smoother's re-applied corrections both use it.
+pub fn correct_nav_state(state: &NavState, x: &StateVec) -> NavState {
+    let mut s = *state;
+    s.lat_rad -= x[I_POS];
+    s.lon_rad = wrap_pi(s.lon_rad - x[I_POS + 1]);
+    s.h_m -= x[I_POS + 2];
+    s.v_n_mps -= x.fixed_rows::<3>(I_VEL).into_owned();
+    let eps: Vec3 = x.fixed_rows::<3>(I_ATT).into_owned();
+    s.c_b_n = Quat::from_rotvec(&(-eps)).to_dcm() * s.c_b_n;
+    s
 }
 
 /// The filter.
@@ -244,6 +267,8 @@ pub struct Ekf<M: Mechanization> {
     /// compensated rate of the last update \[rad/s\]
     omega_ib_b: Vec3,
     last_epoch: Option<CovEpoch>,
+    /// corrections applied since the last covariance epoch
+    dx_acc: StateVec,
     consecutive_rejections: u32,
     rejected_total: u64,
 }
@@ -278,6 +303,7 @@ impl<M: Mechanization> Ekf<M> {
             updates_acc: 0,
             omega_ib_b: Vec3::zeros(),
             last_epoch: None,
+            dx_acc: StateVec::zeros(),
             consecutive_rejections: 0,
             rejected_total: 0,
         }
@@ -303,9 +329,28 @@ impl<M: Mechanization> Ekf<M> {
     pub fn config(&self) -> &EkfConfig {
         &self.cfg
     }
-    /// Take the covariance epoch recorded since the last call (for a smoother).
+    /// Take the covariance epoch recorded since the last call (for a smoother), with the
+    /// current covariance as `P(k|k)` and the corrections applied since the epoch began.
+    /// Call it after each navigation update and its measurements: an epoch not taken
+    /// before the next covariance propagation is replaced.
     pub fn take_epoch(&mut self) -> Option<CovEpoch> {
-        self.last_epoch.take()
+        self.last_epoch.take().map(|mut e| {
+            e.p_post = self.p;
+            e.dx = self.dx_acc;
+            e
+        })
+    }
+
+    /// The initial epoch (time of the initial state, `Φ = I`, `P(0|−1) = P(0|0) = P0`,
+    /// no correction): the first record of a smoother log.
+    pub fn initial_epoch(&self) -> CovEpoch {
+        CovEpoch {
+            t_s: self.cur.t_s,
+            phi: StateMat::identity(),
+            p_pred: self.p,
+            p_post: self.p,
+            dx: StateVec::zeros(),
+        }
     }
     /// The mechanization.
     pub fn mechanization(&self) -> &M {
@@ -399,7 +444,10 @@ impl<M: Mechanization> Ekf<M> {
             t_s: s.t_s,
             phi,
             p_pred: self.p,
+            p_post: self.p,
+            dx: StateVec::zeros(),
         });
+        self.dx_acc = StateVec::zeros();
         Ok(())
     }
 
@@ -634,13 +682,8 @@ impl<M: Mechanization> Ekf<M> {
 
     /// Closed-loop correction of the navigation state and biases with the error estimate.
     fn apply_correction(&mut self, x: &StateVec) {
-        let mut s = self.cur;
-        s.lat_rad -= x[I_POS];
-        s.lon_rad = wrap_pi(s.lon_rad - x[I_POS + 1]);
-        s.h_m -= x[I_POS + 2];
-        s.v_n_mps -= x.fixed_rows::<3>(I_VEL).into_owned();
-        let eps: Vec3 = x.fixed_rows::<3>(I_ATT).into_owned();
-        s.c_b_n = Quat::from_rotvec(&(-eps)).to_dcm() * s.c_b_n;
+        self.dx_acc += x;
+        let s = correct_nav_state(&self.cur, x);
         self.b_a += x.fixed_rows::<3>(I_BA).into_owned();
         self.b_g += x.fixed_rows::<3>(I_BG).into_owned();
         // the interpolation base moves with the state

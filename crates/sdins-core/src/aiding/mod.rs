@@ -3,3 +3,4 @@
 
 pub mod ekf;
 pub mod error_model;
+pub mod rts;

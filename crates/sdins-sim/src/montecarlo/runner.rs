@@ -67,6 +67,11 @@ pub fn run_one(
 
 /// The job identity and the per-run scenario (seed replaced).
 pub fn job(scn: &Scenario, opts: &McOptions) -> Result<(McJob, Scenario), McError> {
+    if scn.mounting.imu.is_some() {
+        return Err(McError::Config(
+            "the scenario's [mounting] places the IMU away from the vehicle reference point; the Monte Carlo compares with the truth at the reference point and does not model the lever arm: remove imu_lever_arm_m / imu_mount_deg (sdins truth and run support them)".into(),
+        ));
+    }
     if opts.runs == 0 || opts.runs > MAX_RUNS {
         return Err(McError::Config(format!(
             "runs = {}: expected 1 … {MAX_RUNS}",

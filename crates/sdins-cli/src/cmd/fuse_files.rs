@@ -1,0 +1,445 @@
+//! `sdins fuse --imu FILE --gnss FILE`: the filter (and smoother) on recorded data. The
+//! work is `sdins_sim::fuse_files::fuse_files`; this parses, writes the CSVs, the report
+//! and prints.
+
+use super::fuse::Args;
+use super::fuse_report::{ErrRow, FuseReportData, Thin};
+use crate::error::CliError;
+use crate::output::AtomicFile;
+use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
+use sdins_core::nav::AlgorithmSpec;
+use sdins_sim::fuse::{FuseError, InitSigma};
+use sdins_sim::fuse_files::{fuse_files, FilesError, FilesInput, InitSource, SensorModelSource};
+use sdins_sim::fuse_records::{RecordEvent, RecordOptions, RecordPoint, COMPARISON_AXES};
+use sdins_sim::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
+use sdins_sim::imu_file::ImuFormat;
+use std::io::Write;
+use std::path::PathBuf;
+
+fn triple(name: &str, s: &str) -> Result<[f64; 3], CliError> {
+    let v: Vec<&str> = s.split(',').map(str::trim).collect();
+    if v.len() != 3 {
+        return Err(CliError::bad(format!(
+            "{name}: expected three comma-separated numbers, got `{s}`"
+        )));
+    }
+    let mut out = [0.0; 3];
+    for (o, t) in out.iter_mut().zip(&v) {
+        *o = t
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| CliError::bad(format!("{name}: `{t}` is not a finite number")))?;
+    }
+    Ok(out)
+}
+
+fn point_row(p: &RecordPoint) -> String {
+    let s = &p.state;
+    let e = s.euler();
+    let mut line = format!(
+        "{},{:.12},{:.12},{:.4},{:.5},{:.5},{:.5},{:.6},{:.6},{:.6}",
+        p.t_s,
+        s.lat_rad.to_degrees(),
+        s.lon_rad.to_degrees(),
+        s.h_m,
+        s.v_n_mps.x,
+        s.v_n_mps.y,
+        s.v_n_mps.z,
+        e.roll_rad.to_degrees(),
+        e.pitch_rad.to_degrees(),
+        e.yaw_rad.to_degrees()
+    );
+    for v in &p.sigma_nav[0..6] {
+        line.push_str(&format!(",{v:.4e}"));
+    }
+    for v in &p.sigma_euler_rad {
+        line.push_str(&format!(",{:.4e}", v.to_degrees()));
+    }
+    line
+}
+
+fn err_row(p: &RecordPoint, e: &[f64; 9]) -> ErrRow {
+    let d = f64::to_degrees;
+    (
+        p.t_s,
+        [
+            e[6],
+            e[7],
+            e[8],
+            e[3],
+            e[4],
+            e[5],
+            d(e[0]),
+            d(e[1]),
+            d(e[2]),
+        ],
+        [
+            p.sigma_nav[0],
+            p.sigma_nav[1],
+            p.sigma_nav[2],
+            p.sigma_nav[3],
+            p.sigma_nav[4],
+            p.sigma_nav[5],
+            d(p.sigma_euler_rad[0]),
+            d(p.sigma_euler_rad[1]),
+            d(p.sigma_euler_rad[2]),
+        ],
+    )
+}
+
+const NAV_HEADER: &str = "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg,sigma_n_m,sigma_e_m,sigma_d_m,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg";
+
+/// Run `sdins fuse` on files.
+pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
+    let gnss = args
+        .gnss
+        .clone()
+        .ok_or_else(|| CliError::bad("--imu needs --gnss FILE"))?;
+    if args.in_motion {
+        return Err(CliError::bad(
+            "--in-motion applies to scenarios; on recorded data give --attitude-deg (the heading from the first fixes' track) or --init",
+        ));
+    }
+    let imu_format: ImuFormat = args.imu_format.parse().map_err(CliError::bad)?;
+    let gnss_format: GnssFormat = args.gnss_format.parse().map_err(CliError::bad)?;
+    let samples = args.samples.unwrap_or(2);
+    if !(1..=4).contains(&samples) {
+        return Err(CliError::bad(format!(
+            "--samples: must be 1..4, got {samples}"
+        )));
+    }
+    let algo = AlgorithmSpec::from_name(&args.algo, samples)
+        .ok_or_else(|| CliError::bad(format!("--algo: unknown algorithm `{}`", args.algo)))?;
+    let sensor =
+        match (&args.navego_params, &args.grade) {
+            (Some(_), Some(_)) => {
+                return Err(CliError::bad(
+                    "give either --navego-params or --grade, not both",
+                ))
+            }
+            (Some(p), None) => SensorModelSource::NavegoParams(p.clone()),
+            (None, Some(g)) => SensorModelSource::Model(Box::new(
+                sdins_sim::imu_error::presets::preset(g)
+                    .map_err(|e| CliError::bad(format!("--grade: {e}")))?,
+            )),
+            (None, None) => return Err(CliError::bad(
+                "the filter needs the IMU's error model: give --grade NAME or --navego-params FILE",
+            )),
+        };
+    let deg = |v: [f64; 3]| v.map(f64::to_radians);
+    let init = match (&args.init, &args.attitude_deg, args.static_s) {
+        (Some(s), None, None) => {
+            let st = sdins_sim::initial::parse_initial_state(s)
+                .map_err(|e| CliError::bad(format!("--init: {e}")))?;
+            InitSource::Given(st, InitSigma::default())
+        }
+        (None, Some(a), None) => {
+            let sig = match &args.attitude_sigma_deg {
+                Some(s) => triple("--attitude-sigma-deg", s)?,
+                None => [1.0, 1.0, 2.0],
+            };
+            if sig.iter().any(|x| *x <= 0.0 || *x > 10.0) {
+                return Err(CliError::bad(
+                    "--attitude-sigma-deg: each σ must be in (0, 10] deg (the linearised filter's limit)",
+                ));
+            }
+            InitSource::FirstFix(deg(triple("--attitude-deg", a)?), deg(sig))
+        }
+        (None, None, Some(w)) => {
+            if !(w.is_finite() && w > 0.0 && w <= 3600.0) {
+                return Err(CliError::bad(format!(
+                    "--static-s: must be in (0, 3600] s, got {w}"
+                )));
+            }
+            InitSource::StaticCoarse(w)
+        }
+        (None, None, None) if args.navego_params.is_some() => InitSource::FirstFixNavegoAttitude,
+        (None, None, None) => {
+            return Err(CliError::bad(
+                "the initial state: give --init, --attitude-deg (position and velocity from the first fix) or --static-s (coarse alignment at rest)",
+            ))
+        }
+        _ => {
+            return Err(CliError::bad(
+                "give only one of --init, --attitude-deg, --static-s",
+            ))
+        }
+    };
+    let lever = match &args.lever_arm_m {
+        Some(s) => triple("--lever-arm-m", s)?,
+        None => [0.0; 3],
+    };
+    if !(args.gnss_offset_s.is_finite()) {
+        return Err(CliError::bad("--gnss-offset-s: must be finite"));
+    }
+    let input = FilesInput {
+        imu: (imu.clone(), imu_format),
+        gnss: (gnss.clone(), gnss_format),
+        gnss_options: GnssReadOptions::default(),
+        clock: if args.gnss_offset_s == 0.0 {
+            ImuClock::SameAsGnss
+        } else {
+            ImuClock::Offset {
+                t_imu_minus_t_gnss_s: args.gnss_offset_s,
+            }
+        },
+        sensor,
+        init,
+        truth: args.truth.clone(),
+        check_after_s: 30.0,
+    };
+    let opts = RecordOptions {
+        algo,
+        cov_rate_hz: args.cov_rate_hz,
+        gate_chi2: if args.no_gate { None } else { Some(CHI2_999) },
+        lever_arm_b_m: lever,
+        nhc_sigma_mps: args.nhc_sigma_mps,
+        smooth: args.smooth,
+        ..RecordOptions::default()
+    };
+    let stem = imu
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "imu".into());
+    let stem: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/fuse-{stem}")));
+    let io = |name: &str, e: std::io::Error| CliError::Io {
+        path: out.join(name),
+        source: e,
+    };
+    let mut nav = AtomicFile::create(&out.join("nav.csv"))?;
+    let mut inn = AtomicFile::create(&out.join("innovations.csv"))?;
+    let mut smo = if args.smooth {
+        Some(AtomicFile::create(&out.join("smoothed.csv"))?)
+    } else {
+        None
+    };
+    writeln!(nav.writer(), "{NAV_HEADER}").map_err(|e| io("nav.csv", e))?;
+    if let Some(f) = smo.as_mut() {
+        writeln!(f.writer(), "{NAV_HEADER}").map_err(|e| io("smoothed.csv", e))?;
+    }
+    writeln!(
+        inn.writer(),
+        "t_s,kind,dof,nis,accepted,forced,nu_1,nu_2,nu_3,nu_4,nu_5,nu_6"
+    )
+    .map_err(|e| io("innovations.csv", e))?;
+    let mut werr: Option<(&'static str, std::io::Error)> = None;
+    let mut last_fwd: Option<RecordPoint> = None;
+    let mut t_start = None;
+    let mut fwd_rows = Thin::<ErrRow>::new();
+    let mut smo_rows = Thin::<ErrRow>::new();
+    let mut gnss_rows: Vec<(f64, f64, usize, bool)> = Vec::new();
+    let res = fuse_files(&input, &opts, &crate::progress::token(), |ev, err| {
+        if let Some(e) = err {
+            match ev {
+                RecordEvent::Forward(p) => fwd_rows.push(err_row(p, e)),
+                RecordEvent::Smoothed(p) => smo_rows.push(err_row(p, e)),
+                _ => {}
+            }
+        }
+        let r = match ev {
+            RecordEvent::Forward(p) => {
+                t_start.get_or_insert(p.t_s);
+                last_fwd = Some(*p);
+                writeln!(nav.writer(), "{}", point_row(p)).map_err(|e| ("nav.csv", e))
+            }
+            RecordEvent::Smoothed(p) => match smo.as_mut() {
+                Some(f) => {
+                    writeln!(f.writer(), "{}", point_row(p)).map_err(|e| ("smoothed.csv", e))
+                }
+                None => Ok(()),
+            },
+            RecordEvent::Update(u) => {
+                let kind = match u.kind {
+                    MeasKind::Gnss => "gnss",
+                    MeasKind::Zupt => "zupt",
+                    MeasKind::Nhc => "nhc",
+                    _ => "other",
+                };
+                let mut line = format!(
+                    "{},{kind},{},{:.6},{},{}",
+                    t_start.unwrap_or(0.0) + u.t_s,
+                    u.dof,
+                    u.nis,
+                    u.accepted,
+                    u.forced
+                );
+                for v in u.innovation {
+                    line.push_str(&format!(",{v:e}"));
+                }
+                if u.kind == MeasKind::Gnss {
+                    gnss_rows.push((t_start.unwrap_or(0.0) + u.t_s, u.nis, u.dof, u.accepted));
+                }
+                writeln!(inn.writer(), "{line}").map_err(|e| ("innovations.csv", e))
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = r {
+            werr.get_or_insert(e);
+        }
+    });
+    if let Some((name, e)) = werr {
+        return Err(io(name, e));
+    }
+    let r = match res {
+        Ok(r) => r,
+        Err(FilesError::Fuse(FuseError::Cancelled(_))) => return Err(CliError::Interrupted),
+        Err(e) => return Err(CliError::bad(e.to_string())),
+    };
+    nav.commit()?;
+    inn.commit()?;
+    if let Some(f) = smo {
+        f.commit()?;
+    }
+    let v3 = |v: &sdins_core::math::Vec3| [v.x, v.y, v.z];
+    let cmp = |c: &Option<sdins_sim::fuse_records::TruthComparison>| {
+        c.as_ref().map(|c| {
+            let rmse = c.rmse();
+            let inside = c.inside_3sigma();
+            let mut m = serde_json::Map::new();
+            for (i, name) in COMPARISON_AXES.iter().enumerate() {
+                let v = if i < 3 { rmse[i].to_degrees() } else { rmse[i] };
+                m.insert(
+                    (*name).to_string(),
+                    serde_json::json!({"rmse": v, "inside_3sigma": inside[i]}),
+                );
+            }
+            m.insert("matched_epochs".into(), c.matched().into());
+            serde_json::Value::Object(m)
+        })
+    };
+    let summary = serde_json::json!({
+        "imu": imu.display().to_string(),
+        "imu_format": r.imu_format.name(),
+        "imu_samples": r.imu_samples,
+        "imu_dt_s": r.imu_dt_s,
+        "gnss": gnss.display().to_string(),
+        "gnss_format": r.gnss_format.name(),
+        "fixes_in_span": r.fixes_in_span,
+        "fixes_before_imu": r.fixes_outside.0,
+        "fixes_after_imu": r.fixes_outside.1,
+        "fixes_used": r.summary.fixes_used,
+        "rejected": r.summary.rejected,
+        "algo": args.algo,
+        "samples": samples,
+        "nav_updates": r.summary.nav_updates,
+        "t_start_s": r.summary.t_start_s,
+        "accel_bias_est_mps2": v3(&r.summary.final_bias.0),
+        "gyro_bias_est_rps": v3(&r.summary.final_bias.1),
+        "final": last_fwd.map(|p| serde_json::json!({
+            "t_s": p.t_s, "lat_deg": p.state.lat_rad.to_degrees(), "lon_deg": p.state.lon_rad.to_degrees(), "h_m": p.state.h_m
+        })),
+        "forward_vs_truth": cmp(&r.forward),
+        "smoothed_vs_truth": cmp(&r.smoothed),
+        "units": "rmse: roll/pitch/yaw deg, v m/s, N/E/D m",
+    });
+    let mut fields = toml::Table::new();
+    fields.insert("imu".into(), imu.display().to_string().into());
+    fields.insert("gnss".into(), gnss.display().to_string().into());
+    fields.insert("algo".into(), args.algo.clone().into());
+    fields.insert("samples".into(), (samples as i64).into());
+    fields.insert("cov_rate_hz".into(), args.cov_rate_hz.into());
+    fields.insert("gate".into(), (!args.no_gate).into());
+    fields.insert("smooth".into(), args.smooth.into());
+    let rm = |c: &Option<sdins_sim::fuse_records::TruthComparison>, name: &str| {
+        c.as_ref().map(|c| {
+            let v = c.rmse();
+            (
+                name.to_string(),
+                [
+                    v[6],
+                    v[7],
+                    v[8],
+                    v[3],
+                    v[4],
+                    v[5],
+                    v[0].to_degrees(),
+                    v[1].to_degrees(),
+                    v[2].to_degrees(),
+                ],
+            )
+        })
+    };
+    let rmse: Vec<(String, [f64; 9])> = [rm(&r.forward, "forward"), rm(&r.smoothed, "smoothed")]
+        .into_iter()
+        .flatten()
+        .collect();
+    if !fwd_rows.pts.is_empty() || !gnss_rows.is_empty() {
+        let fix_interval = gnss_rows
+            .windows(2)
+            .map(|w| w[1].0 - w[0].0)
+            .fold(f64::INFINITY, f64::min);
+        super::fuse_report::write(
+            &out,
+            &FuseReportData {
+                title: format!("sdins fuse: {}", imu.display()),
+                intro: format!(
+                    "{} ({} samples at {} Hz) with {} ({} fixes used, {} rejected), algorithm {} N = {samples}, covariance at {} Hz{}.",
+                    imu.display(),
+                    r.imu_samples,
+                    1.0 / r.imu_dt_s,
+                    gnss.display(),
+                    r.summary.fixes_used,
+                    r.summary.rejected,
+                    args.algo,
+                    args.cov_rate_hz,
+                    match &args.truth {
+                        Some(t) => format!("; reference {}", t.display()),
+                        None => "; no reference: the error plots are empty, give --truth".into(),
+                    }
+                ),
+                att_names: ["roll", "pitch", "yaw"],
+                forward: &fwd_rows,
+                smoothed: args.smooth.then_some(&smo_rows),
+                gnss: &gnss_rows,
+                fix_interval_s: if fix_interval.is_finite() { fix_interval } else { 1.0 },
+                rmse,
+            },
+        )?;
+    }
+    crate::report::write_run_toml(&out, fields)?;
+    for w in &r.imu_warnings {
+        eprintln!("warning: {}: {w}", imu.display());
+    }
+    for w in &r.gnss_report.warnings {
+        eprintln!("warning: {}: {w}", gnss.display());
+    }
+    if args.json {
+        println!("{summary:#}");
+    } else {
+        println!(
+            "sdins fuse {} + {}: {} IMU samples ({}), {} fixes used ({} outside the IMU record skipped), {} rejected; wrote {}",
+            imu.display(),
+            gnss.display(),
+            r.imu_samples,
+            r.imu_format.name(),
+            r.summary.fixes_used,
+            r.fixes_outside.0 + r.fixes_outside.1,
+            r.summary.rejected,
+            out.display()
+        );
+        for (name, c) in [("forward", &r.forward), ("smoothed", &r.smoothed)] {
+            if let Some(c) = c {
+                let rm = c.rmse();
+                println!(
+                    "  {name} RMSE vs truth: roll/pitch/yaw {:.4}/{:.4}/{:.4} deg, v N/E/D {:.4}/{:.4}/{:.4} m/s, N/E/D {:.3}/{:.3}/{:.3} m",
+                    rm[0].to_degrees(), rm[1].to_degrees(), rm[2].to_degrees(), rm[3], rm[4], rm[5], rm[6], rm[7], rm[8]
+                );
+            }
+        }
+    }
+    Ok(())
+}
