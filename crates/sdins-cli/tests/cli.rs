@@ -569,7 +569,15 @@ fn signal_stops_cleanly(signal: &str, code: i32) {
         .unwrap();
     // wait until the temporary files exist (the run is under way)
     let start = Instant::now();
-    while std::fs::read_dir(&d).unwrap().count() < 2 && start.elapsed() < Duration::from_secs(20) {
+    // (they are written in the staging folder `.sdins-stage-PID` inside `d`)
+    let staged = |d: &std::path::Path| -> usize {
+        std::fs::read_dir(d)
+            .unwrap()
+            .filter_map(|e| std::fs::read_dir(e.ok()?.path()).ok())
+            .map(|r| r.count())
+            .sum()
+    };
+    while staged(&d) < 2 && start.elapsed() < Duration::from_secs(20) {
         std::thread::sleep(Duration::from_millis(20));
     }
     std::thread::sleep(Duration::from_millis(200));
