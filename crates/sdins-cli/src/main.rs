@@ -9,7 +9,6 @@
 mod cmd;
 #[allow(dead_code)]
 mod error;
-#[allow(dead_code)]
 mod output;
 mod plot;
 mod progress;
@@ -85,6 +84,8 @@ fn main() -> ExitCode {
         Command::Merge(a) => cmd::merge::run(a),
         Command::Fuse(a) => cmd::fuse::run(a),
     };
+    // a run's outputs all or none: swap the staged files in only if the command succeeded
+    let result = output::finish(result);
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -918,6 +918,7 @@ pub fn write_png(
     draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
 ) -> Result<(), CliError> {
     register_font()?;
+    let dest = &crate::output::route(dest)?;
     if let Some(dir) = dest.parent() {
         if !dir.as_os_str().is_empty() {
             std::fs::create_dir_all(dir).map_err(|source| CliError::Io {

@@ -21,6 +21,14 @@ fn tmp(name: &str) -> std::path::PathBuf {
     d
 }
 
+/// An input file next to the output folder `d` (inside it, it would be a file that no
+/// sdins manifest lists, and sdins would refuse the folder).
+fn input(d: &std::path::Path, name: &str) -> std::path::PathBuf {
+    let dir = d.with_extension("in");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
 const GOOD: &str = "[start]\nlat_deg = 37.5\nlon_deg = 127.0\n[imu]\nrate_hz = 100.0\n[[segment]]\ntype = \"static\"\nduration_s = 1.0\n";
 
 #[test]
@@ -94,7 +102,7 @@ fn unknown_algorithm_and_scenario_exit_2() {
 #[test]
 fn truth_writes_both_files_and_run_json_shape() {
     let d = tmp("good");
-    let p = d.join("s.toml");
+    let p = input(&d, "s.toml");
     std::fs::write(&p, GOOD).unwrap();
     let (code, _, err) = sdins(&[
         "truth",
@@ -209,7 +217,7 @@ fn nav_over_a_recorded_file_matches_run() {
     // `sdins truth` then `sdins nav` over its imu.csv with its truth.csv reproduces the
     // errors of `sdins run` on the same scenario (same increments, same algorithm).
     let d = tmp("nav");
-    let p = d.join("s.toml");
+    let p = input(&d, "s.toml");
     std::fs::write(
         &p,
         GOOD.replace(
@@ -430,7 +438,7 @@ fn scenario_ranges_and_names_exit_2() {
 }
 
 fn truth_and_imu(d: &std::path::Path) {
-    let p = d.join("s.toml");
+    let p = input(d, "s.toml");
     std::fs::write(&p, GOOD).unwrap();
     let (code, _, err) = sdins(&[
         "truth",
@@ -561,7 +569,15 @@ fn signal_stops_cleanly(signal: &str, code: i32) {
         .unwrap();
     // wait until the temporary files exist (the run is under way)
     let start = Instant::now();
-    while std::fs::read_dir(&d).unwrap().count() < 2 && start.elapsed() < Duration::from_secs(20) {
+    // (they are written in the staging folder `.sdins-stage-PID` inside `d`)
+    let staged = |d: &std::path::Path| -> usize {
+        std::fs::read_dir(d)
+            .unwrap()
+            .filter_map(|e| std::fs::read_dir(e.ok()?.path()).ok())
+            .map(|r| r.count())
+            .sum()
+    };
+    while staged(&d) < 2 && start.elapsed() < Duration::from_secs(20) {
         std::thread::sleep(Duration::from_millis(20));
     }
     std::thread::sleep(Duration::from_millis(200));
@@ -607,7 +623,7 @@ fn assert_self_contained(html: &str) {
 #[test]
 fn initial_states_from_files_are_validated() {
     let d = tmp("initval");
-    let imu = d.join("bad.imu");
+    let imu = input(&d, "bad.imu");
     let mut text = String::from(
         "% PSINS-format SIMU log file\n0 0 -90.6 0 0 0\n95.0 108.9 380 0 10 9.78\n0.1 0.1 0.1 125 125 125\n",
     );

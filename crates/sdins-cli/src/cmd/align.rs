@@ -264,6 +264,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let phi = res.phi_true;
     let e = res.euler;
     if let Some(dir) = &args.out {
+        crate::output::claim(dir)?;
         write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi))?;
         let mut svgs = None;
         if res.has_history {

@@ -66,6 +66,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.imu.display()
         )));
     }
+    crate::output::claim(&args.out)?;
     let report = analyse(&data.increments, data.dt_s);
     write_string(&args.out.join("allan.csv"), &csv(&report))?;
     let svg = plot_svg(&report)?;
@@ -371,17 +372,18 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let file = dir.join("imu.csv");
         std::fs::write(&file, text).unwrap();
-        run(Args {
+        let out = dir.join("out");
+        crate::output::finish(run(Args {
             imu: file.clone(),
             format: ImuFormat::Auto,
-            out: dir.clone(),
+            out: out.clone(),
             json: true,
-        })
+        }))
         .unwrap();
         for f in ["allan.csv", "allan.svg", "allan.png"] {
-            assert!(std::fs::metadata(dir.join(f)).unwrap().len() > 100, "{f}");
+            assert!(std::fs::metadata(out.join(f)).unwrap().len() > 100, "{f}");
         }
-        let svg = std::fs::read_to_string(dir.join("allan.svg")).unwrap();
+        let svg = std::fs::read_to_string(out.join("allan.svg")).unwrap();
         assert!(
             svg.contains("Allan deviation [°/h]") && svg.contains("gyro_x"),
             "axis label and legend"
@@ -404,12 +406,12 @@ mod tests {
             "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n0.01,1,2\n",
         )
         .unwrap();
-        let e = run(Args {
+        let e = crate::output::finish(run(Args {
             imu: dir.join("bad.csv"),
             format: ImuFormat::Auto,
-            out: dir.clone(),
+            out: out.clone(),
             json: false,
-        })
+        }))
         .unwrap_err();
         assert_eq!(e.exit_code(), 2);
         assert!(e.to_string().contains("bad.csv:2"), "{e}");

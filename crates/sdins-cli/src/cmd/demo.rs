@@ -97,6 +97,7 @@ fn v(xs: &[&str]) -> Vec<String> {
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let out = args.out.unwrap_or_else(|| PathBuf::from("sdins-out/demo"));
+    crate::output::claim(&out)?;
     let mut r = Report::new("sdins demo: the papers' comparisons reproduced against exact truth");
 
     // 1. Song–Lee Table 1

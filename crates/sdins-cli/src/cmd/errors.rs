@@ -88,6 +88,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .out
         .clone()
         .unwrap_or_else(|| std::path::PathBuf::from("sdins-out/errors"));
+    crate::output::claim(&dir)?;
     write_folder(&dir, &args, report, &out.closed, &out.envelope, &out.budget)?;
     eprintln!(
         "wrote {0}/errors.csv, {0}/errors.png, {0}/budget.png, {0}/report.html, {0}/run.toml",
@@ -376,7 +377,7 @@ mod tests {
         let mut a = args();
         a.no_nonlinear = true;
         let dir = a.out.clone().unwrap();
-        run(a).unwrap();
+        crate::output::finish(run(a)).unwrap();
         for f in [
             "errors.csv",
             "errors.png",
@@ -411,20 +412,35 @@ mod tests {
     fn bad_inputs_exit_2() {
         let mut a = args();
         a.hours = -1.0;
-        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         let mut a = args();
         a.lat = 91.0;
-        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         let mut a = args();
         a.gyro_bias_dph = Some(vec![1.0]);
-        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         let mut a = args();
         a.gyro_bias_dph = None;
-        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         let mut a = args();
         a.gyro_bias_dph = None;
         a.grade = Some("nope".into());
-        assert!(matches!(run(a), Err(CliError::BadInput(_))));
+        assert!(matches!(
+            crate::output::finish(run(a)),
+            Err(CliError::BadInput(_))
+        ));
         assert_eq!(CliError::bad("x").exit_code(), 2);
     }
 }

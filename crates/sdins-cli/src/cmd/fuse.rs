@@ -199,7 +199,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/fuse-{}", scn.name)));
+        .unwrap_or_else(|| crate::output::default_dir("fuse-", &scn.name));
+    crate::output::claim(&out)?;
     let mut nav = AtomicFile::create(&out.join("nav.csv"))?;
     let mut inn = AtomicFile::create(&out.join("innovations.csv"))?;
     let mut smo = if args.smooth {

@@ -180,6 +180,7 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("sdins-out/fuse-{stem}")));
+    crate::output::claim(&out)?;
     let io = |name: &str, e: std::io::Error| CliError::Io {
         path: out.join(name),
         source: e,

@@ -73,6 +73,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             eprintln!("sdins: warning: {msg}");
         }
     }
+    crate::output::claim(&args.out)?;
     let stats = merged.statistics();
     write_outputs(&args.out, &merged, &stats)?;
     if args.json {

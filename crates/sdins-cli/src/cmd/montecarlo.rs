@@ -277,12 +277,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
         None => Shard::ALL,
         Some(s) => Shard::parse(s).map_err(|e| CliError::bad(format!("--shard: {e}")))?,
     };
-    let out = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from(match args.shard {
-            None => format!("sdins-out/mc-{}", scn.name),
-            Some(_) => format!("sdins-out/mc-{}-shard{}", scn.name, shard.index),
-        })
+    let out = args.out.clone().unwrap_or_else(|| match args.shard {
+        None => crate::output::default_dir("mc-", &scn.name),
+        Some(_) => crate::output::default_dir("mc-", &format!("{}-shard{}", scn.name, shard.index)),
     });
+    crate::output::check_size(
+        "mc_stats.csv",
+        opts.until_s
+            .map_or(scn.duration_s(), |t| t.min(scn.duration_s()))
+            / opts.every_s
+            + 1.0,
+        400.0,
+        "raise --every-s",
+    )?;
+    crate::output::claim(&out)?;
     let total = shard_runs(&opts, shard);
     let bar = Mutex::new((Progress::new(total, "runs", args.quiet), 0_u64));
     let on_run = || {

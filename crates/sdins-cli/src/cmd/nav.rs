@@ -115,6 +115,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("sdins-out/nav"));
+    crate::output::claim(&out)?;
     let mut nav_file = AtomicFile::create(&out.join(format!("nav_{}.csv", spec.kind.name())))?;
     let io = |source| CliError::Io {
         path: out.clone(),

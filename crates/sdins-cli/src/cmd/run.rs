@@ -214,7 +214,14 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/run-{}", scn.name)));
+        .unwrap_or_else(|| crate::output::default_dir("run-", &scn.name));
+    crate::output::check_size(
+        "each nav_*.csv and err_*.csv",
+        t_end_s / (dt_u * every as f64) + 1.0,
+        250.0,
+        "raise --every-s or lower --until-s",
+    )?;
+    crate::output::claim(&out)?;
     let mut nav_files = Vec::new();
     let mut err_files = Vec::new();
     for a in &algos {

@@ -34,7 +34,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let out = args
         .out
-        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/truth-{}", scn.name)));
+        .unwrap_or_else(|| crate::output::default_dir("truth-", &scn.name));
+    crate::output::claim(&out)?;
     let cfg = TruthConfig {
         earth: scn.nav.earth.model(),
         dt_s: scn.imu.dt_s(),
@@ -51,6 +52,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
         eprintln!("note: imu.csv is sensed at the IMU lever arm and mounting ([mounting]); truth.csv is at the vehicle reference point");
     }
     let total = gen.len_samples();
+    crate::output::check_size(
+        "imu.csv",
+        total as f64,
+        160.0,
+        "shorten the scenario or lower imu.rate_hz",
+    )?;
+    crate::output::check_size(
+        "truth.csv",
+        total as f64 / args.every as f64,
+        280.0,
+        "raise --every",
+    )?;
     let mut truth = AtomicFile::create(&out.join("truth.csv"))?;
     let mut imu = AtomicFile::create(&out.join("imu.csv"))?;
     writeln!(truth.writer(), "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg,q_w,q_x,q_y,q_z")
