@@ -192,3 +192,42 @@ fn fuse_on_recorded_files_and_bad_gnss_files() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--grade"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Output size cap (nothing silent, resource bounds): an IMU file whose rows would give a
+/// nav.csv above the per-file cap is refused before anything is read or written (a sparse
+/// 10 GB file: no disk space used).
+#[test]
+fn fuse_refuses_outputs_above_the_size_cap() {
+    let dir = std::env::temp_dir().join(format!("sdins-fuse-cap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let imu = dir.join("huge.csv");
+    let f = std::fs::File::create(&imu).unwrap();
+    f.set_len(10_000_000_000).unwrap();
+    let g = dir.join("g.csv");
+    std::fs::write(
+        &g,
+        "t_s,lat_deg,lon_deg,h_m,sigma_n_m,sigma_e_m,sigma_d_m\n1,37.5,127,0,1,1,2\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args(["fuse", "--imu"])
+        .arg(&imu)
+        .arg("--gnss")
+        .arg(&g)
+        .args([
+            "--grade",
+            "tactical",
+            "--init",
+            "37.5,127,0,0,0,0,0,0,0",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("cap"), "{err}");
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -200,6 +200,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .out
         .clone()
         .unwrap_or_else(|| crate::output::default_dir("fuse-", &scn.name));
+    crate::output::check_size(
+        "nav.csv (and smoothed.csv)",
+        scn.duration_s() * args.cov_rate_hz + 2.0,
+        250.0,
+        "lower --cov-rate-hz or shorten the scenario",
+    )?;
     crate::output::claim(&out)?;
     let mut nav = AtomicFile::create(&out.join("nav.csv"))?;
     let mut inn = AtomicFile::create(&out.join("innovations.csv"))?;

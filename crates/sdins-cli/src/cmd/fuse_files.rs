@@ -180,6 +180,15 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("sdins-out/fuse-{stem}")));
+    // nav.csv and smoothed.csv get one row per navigation update (the IMU file's size
+    // bounds it; checked before anything is written)
+    let imu_bytes = std::fs::metadata(&imu).map_or(0.0, |m| m.len() as f64);
+    crate::output::check_size(
+        "nav.csv (and smoothed.csv)",
+        imu_bytes / 40.0 / samples as f64 + 1.0,
+        200.0,
+        "split the IMU file or raise --samples",
+    )?;
     crate::output::claim(&out)?;
     let io = |name: &str, e: std::io::Error| CliError::Io {
         path: out.join(name),

@@ -115,6 +115,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("sdins-out/nav"));
+    crate::output::check_size(
+        "nav_*.csv",
+        data.increments.len() as f64 / spec.samples as f64 + 1.0,
+        250.0,
+        "split the IMU file",
+    )?;
     crate::output::claim(&out)?;
     let mut nav_file = AtomicFile::create(&out.join(format!("nav_{}.csv", spec.kind.name())))?;
     let io = |source| CliError::Io {
