@@ -411,7 +411,7 @@ pub fn read_gnss_file(
     format: GnssFormat,
     opts: &GnssReadOptions,
 ) -> Result<GnssData, GnssFileError> {
-    let bytes = std::fs::read(path).map_err(|source| GnssFileError::Io {
+    let bytes = crate::input::read_capped(path).map_err(|source| GnssFileError::Io {
         file: path.to_path_buf(),
         source,
     })?;

@@ -399,7 +399,7 @@ pub enum ImuFileError {
 
 /// Read an IMU file (see the module docs for formats and checks).
 pub fn read_imu_file(path: &Path, format: ImuFormat) -> Result<ImuData, ImuFileError> {
-    let bytes = std::fs::read(path).map_err(|source| ImuFileError::Io {
+    let bytes = crate::input::read_capped(path).map_err(|source| ImuFileError::Io {
         file: path.to_path_buf(),
         source,
     })?;

@@ -59,6 +59,7 @@ pub mod gnss_fix;
 pub mod imu_error;
 pub mod imu_file;
 pub mod initial;
+pub mod input;
 pub mod montecarlo;
 pub mod nav_recorded;
 pub mod navego_params;

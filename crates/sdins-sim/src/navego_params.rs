@@ -201,7 +201,7 @@ pub fn read_navego_gnss_params(path: &Path) -> Result<NavegoGnssParams, ParamsEr
 }
 
 fn read(path: &Path) -> Result<String, ParamsError> {
-    let bytes = std::fs::read(path).map_err(|source| ParamsError::Io {
+    let bytes = crate::input::read_capped(path).map_err(|source| ParamsError::Io {
         file: path.to_path_buf(),
         source,
     })?;

@@ -1095,9 +1095,13 @@ impl Scenario {
     /// Read and validate a scenario file.
     pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read {
+        let bytes = crate::input::read_capped(path).map_err(|e| ScenarioError::Read {
             file: file.clone(),
             reason: e.to_string(),
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| ScenarioError::Read {
+            file: file.clone(),
+            reason: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         })?;
         Scenario::from_toml(&text, &file)
     }

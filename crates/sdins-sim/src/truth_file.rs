@@ -256,7 +256,7 @@ pub fn read_sdins_truth(path: &Path) -> Result<Vec<TruthSample>, TruthFileError>
 }
 
 fn read_text(path: &Path) -> Result<String, TruthFileError> {
-    let bytes = std::fs::read(path).map_err(|source| TruthFileError::Io {
+    let bytes = crate::input::read_capped(path).map_err(|source| TruthFileError::Io {
         file: path.into(),
         source,
     })?;
