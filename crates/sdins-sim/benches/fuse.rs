@@ -30,18 +30,8 @@ fn fuse(c: &mut Criterion) {
     let scn = hour();
     let (imu, fixes) = record_from_scenario(&scn, &GnssConfig::default(), 0).unwrap();
     let model = RecordModel::from_error_model(&scn.imu.model);
-    let state = sdins_sim::truth::TruthGenerator::new(
-        &scn.trajectory,
-        sdins_sim::truth::TruthConfig {
-            earth: scn.nav.earth.model(),
-            dt_s: scn.imu.dt_s(),
-            lat0_rad: scn.start.lat_rad,
-            lon0_rad: scn.start.lon_rad,
-            h0_m: scn.start.h_m,
-            substeps: scn.nav.substeps,
-        },
-    )
-    .initial_state();
+    let state =
+        sdins_sim::truth::TruthGenerator::new(&scn.trajectory, scn.truth_config()).initial_state();
     let init = RecordInit::Given {
         state,
         sigma: InitSigma::default(),

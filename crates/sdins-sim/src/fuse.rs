@@ -28,7 +28,7 @@ use crate::imu_error::{UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ};
 use crate::pipeline::nav_error;
 use crate::scenario::Scenario;
 use crate::smoother::{SmootherError, SmootherLog};
-use crate::truth::{lon_diff, TruthConfig, TruthGenerator, TruthSample};
+use crate::truth::{lon_diff, TruthGenerator, TruthSample};
 use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -283,14 +283,7 @@ pub fn fuse_scenario(
 
 /// The exact truth of a scenario, generated once (for Monte Carlo runs sharing it).
 pub fn scenario_truth(scn: &Scenario) -> Vec<TruthSample> {
-    let cfg = TruthConfig {
-        earth: scn.nav.earth.model(),
-        dt_s: scn.imu.dt_s(),
-        lat0_rad: scn.start.lat_rad,
-        lon0_rad: scn.start.lon_rad,
-        h0_m: scn.start.h_m,
-        substeps: scn.nav.substeps,
-    };
+    let cfg = scn.truth_config();
     TruthGenerator::new(&scn.trajectory, cfg).collect()
 }
 
@@ -359,14 +352,7 @@ pub fn fuse_scenario_with(
         ));
     }
     let cov_updates = (nav_rate / opts.cov_rate_hz).round().max(1.0) as usize;
-    let cfg = TruthConfig {
-        earth,
-        dt_s: dt,
-        lat0_rad: scn.start.lat_rad,
-        lon0_rad: scn.start.lon_rad,
-        h0_m: scn.start.h_m,
-        substeps: scn.nav.substeps,
-    };
+    let cfg = scn.truth_config();
     let generator = TruthGenerator::new(&scn.trajectory, cfg);
     let init_true = generator.initial_state();
     let len_samples = generator.len_samples();

@@ -743,17 +743,10 @@ pub fn record_from_scenario(
     gnss: &crate::gnss::GnssConfig,
     run: u64,
 ) -> Result<(ImuData, Vec<GnssFix>), FuseError> {
-    use crate::truth::{TruthConfig, TruthGenerator, TruthSample};
+    use crate::truth::{TruthGenerator, TruthSample};
     let earth = scn.nav.earth.model();
     let dt = scn.imu.dt_s();
-    let cfg = TruthConfig {
-        earth,
-        dt_s: dt,
-        lat0_rad: scn.start.lat_rad,
-        lon0_rad: scn.start.lon_rad,
-        h0_m: scn.start.h_m,
-        substeps: scn.nav.substeps,
-    };
+    let cfg = scn.truth_config();
     let generator = TruthGenerator::new(&scn.trajectory, cfg);
     let init = generator.initial_state();
     let n = generator.len_samples() as usize;

@@ -514,6 +514,19 @@ fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> ScenarioError {
 }
 
 impl Scenario {
+    /// The exact-truth generator's configuration of this scenario (its earth model, IMU
+    /// interval, start position and truth resolution).
+    pub fn truth_config(&self) -> crate::truth::TruthConfig {
+        crate::truth::TruthConfig {
+            earth: self.nav.earth.model(),
+            dt_s: self.imu.dt_s(),
+            lat0_rad: self.start.lat_rad,
+            lon0_rad: self.start.lon_rad,
+            h0_m: self.start.h_m,
+            substeps: self.nav.substeps,
+        }
+    }
+
     /// Parse and validate scenario text; `file` names it in error messages.
     pub fn from_toml(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
         let doc: FileDoc = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;

@@ -54,18 +54,8 @@ fn one_hour_at_200hz_filter_and_smoother_peak_heap_below_300mb() {
     let input = CURRENT.load(Ordering::Relaxed);
     PEAK.store(input, Ordering::Relaxed);
     let model = RecordModel::from_error_model(&scn.imu.model);
-    let truth0 = sdins_sim::truth::TruthGenerator::new(
-        &scn.trajectory,
-        sdins_sim::truth::TruthConfig {
-            earth: scn.nav.earth.model(),
-            dt_s: scn.imu.dt_s(),
-            lat0_rad: scn.start.lat_rad,
-            lon0_rad: scn.start.lon_rad,
-            h0_m: scn.start.h_m,
-            substeps: scn.nav.substeps,
-        },
-    )
-    .initial_state();
+    let truth0 =
+        sdins_sim::truth::TruthGenerator::new(&scn.trajectory, scn.truth_config()).initial_state();
     let init = RecordInit::Given {
         state: truth0,
         sigma: InitSigma::default(),
