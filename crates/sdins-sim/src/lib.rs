@@ -46,6 +46,7 @@
 pub mod align;
 pub mod align_run;
 pub mod allan;
+pub mod calibration;
 pub mod cancel;
 pub mod envelope;
 pub mod error_analysis;

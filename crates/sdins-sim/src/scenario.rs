@@ -68,8 +68,10 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "angle_of_attack_deg",
             "mounting",
             "gnss",
+            "calibration",
         ],
     ),
+    ("calibration", &["schedule", "dwell_s", "rotation_s"]),
     (
         "mounting",
         &["imu_lever_arm_m", "imu_mount_deg", "gnss_lever_arm_m"],
@@ -119,6 +121,7 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "angle_amp_deg",
             "accel_amp_mps2",
             "phase_deg",
+            "angle_deg",
             "start_s",
             "end_s",
         ],
@@ -167,6 +170,15 @@ struct FileDoc {
     mounting: Option<S<MountingDoc>>,
     // [gnss] section
     gnss: Option<S<crate::gnss::GnssConfig>>,
+    calibration: Option<S<CalibrationDoc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CalibrationDoc {
+    schedule: S<String>,
+    dwell_s: Option<S<f64>>,
+    rotation_s: Option<S<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -248,6 +260,7 @@ struct OverlayDoc {
     angle_amp_deg: Option<S<f64>>,
     accel_amp_mps2: Option<S<f64>>,
     phase_deg: Option<S<f64>>,
+    angle_deg: Option<S<f64>>,
     start_s: Option<S<f64>>,
     end_s: Option<S<f64>>,
 }
@@ -667,6 +680,7 @@ impl Scenario {
                 }
             }
         }
+        let calibration = parse_calibration(&cx, &doc, speed, climb, vehicle, 1.0 / rate_hz)?;
         let mut motions = Vec::new();
         // the [[segment]] of each motion (a coordinated turn is three motions)
         let mut seg_of_motion: Vec<std::ops::Range<usize>> = Vec::new();
@@ -895,12 +909,17 @@ impl Scenario {
             motions.push((motion, (n.round()) * dt));
             seg_of_motion.push(s.span());
         }
+        if let Some(sched) = &calibration {
+            motions.push((Motion::Static, sched.duration_s));
+            seg_of_motion.push(doc.calibration.as_ref().map_or(0..0, |c| c.span()));
+        }
         if motions.is_empty() {
             return Err(ScenarioError::Invalid {
                 file: file.into(),
                 line: 1,
                 key: "segment".into(),
-                message: "a scenario needs at least one [[segment]]".into(),
+                message: "a scenario needs at least one [[segment]] (or a [calibration] table)"
+                    .into(),
             });
         }
         let total: f64 = motions.iter().map(|m| m.1).sum();
@@ -934,6 +953,17 @@ impl Scenario {
                     },
                 }
             };
+            if kind == "rotation" {
+                overlays.push(parse_rotation(&cx, o, total)?);
+                continue;
+            }
+            if let Some(a) = &od.angle_deg {
+                return cx.err(
+                    a.span(),
+                    "overlay.angle_deg",
+                    format!("angle_deg belongs to overlay type `rotation`, not `{kind}`"),
+                );
+            }
             let freq = need_pos(&od.freq_hz, "overlay.freq_hz")?;
             if freq > 0.5 * rate_hz {
                 return cx.err(
@@ -999,7 +1029,7 @@ impl Scenario {
                     }
                 }
                 other => {
-                    return cx.err(od.kind.span(), "overlay.type", format!("unknown overlay type `{other}`: expected coning, sculling, vibration or sway"));
+                    return cx.err(od.kind.span(), "overlay.type", format!("unknown overlay type `{other}`: expected coning, sculling, vibration, sway or rotation"));
                 }
             };
             let start_s = match &od.start_s {
@@ -1029,6 +1059,9 @@ impl Scenario {
             });
         }
 
+        if let Some(sched) = &calibration {
+            overlays.extend(sched.overlays());
+        }
         let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
         let trajectory = match trajectory.with_vehicle(vehicle, nav.earth.model(), lat * D2R, h) {
             Ok(t) => t,
@@ -1142,6 +1175,113 @@ impl Scenario {
     pub fn duration_s(&self) -> f64 {
         self.trajectory.duration_s
     }
+}
+
+/// `[calibration]`: a standard turntable schedule (crate::calibration::schedule) in
+/// place of `[[segment]]` and `[[overlay]]`, at rest (zero speed and climb rate, free
+/// vehicle).
+fn parse_calibration(
+    cx: &Ctx<'_>,
+    doc: &FileDoc,
+    speed: f64,
+    climb: f64,
+    vehicle: Vehicle,
+    dt: f64,
+) -> Result<Option<crate::calibration::Schedule>, ScenarioError> {
+    use crate::calibration::schedule::{
+        Schedule, ScheduleError, Standard, DEFAULT_DWELL_S, DEFAULT_ROTATION_S,
+    };
+    let Some(c) = &doc.calibration else {
+        return Ok(None);
+    };
+    let span = c.span();
+    if let Some(s) = doc.segment.first() {
+        return cx.err(s.span(), "segment", "a [calibration] scenario builds its own static segment and rotations: remove the [[segment]] tables");
+    }
+    if let Some(o) = doc.overlay.first() {
+        return cx.err(o.span(), "overlay", "a [calibration] scenario builds its own rotations: remove the [[overlay]] tables");
+    }
+    if speed != 0.0 || climb != 0.0 || vehicle != Vehicle::Free {
+        return cx.err(span, "calibration", "a calibration schedule is at rest on the table: start.speed_mps and start.climb_rate_mps must be 0 and vehicle left out");
+    }
+    let cd = c.get_ref();
+    let Some(kind) = Standard::from_name(cd.schedule.get_ref()) else {
+        return cx.err(
+            cd.schedule.span(),
+            "calibration.schedule",
+            format!(
+                "unknown schedule `{}`: expected 6-position or 12-position",
+                cd.schedule.get_ref()
+            ),
+        );
+    };
+    let dwell = match &cd.dwell_s {
+        Some(v) => cx.positive(v, "calibration.dwell_s")?,
+        None => DEFAULT_DWELL_S,
+    };
+    let rot = match &cd.rotation_s {
+        Some(v) => cx.positive(v, "calibration.rotation_s")?,
+        None => DEFAULT_ROTATION_S,
+    };
+    if dwell > MAX_SEGMENT_S / 16.0 || rot > MAX_SEGMENT_S / 16.0 {
+        return cx.err(span, "calibration", format!("dwell_s and rotation_s must be at most {:e} s", MAX_SEGMENT_S / 16.0));
+    }
+    match Schedule::standard(kind, dwell, rot, dt) {
+        Ok(s) => Ok(Some(s)),
+        Err(ScheduleError::Duration { key, what }) => {
+            let v = if key == "dwell_s" { &cd.dwell_s } else { &cd.rotation_s };
+            cx.err(
+                v.as_ref().map_or(span, |v| v.span()),
+                &format!("calibration.{key}"),
+                what,
+            )
+        }
+        Err(e) => cx.err(span, "calibration", e.to_string()),
+    }
+}
+
+/// `[[overlay]] type = "rotation"`: `axis`, `angle_deg`, `start_s` and `end_s` required,
+/// no `freq_hz` (the raised-cosine rate follows from the angle and the window).
+fn parse_rotation(cx: &Ctx<'_>, o: &S<OverlayDoc>, total: f64) -> Result<Overlay, ScenarioError> {
+    let od = o.get_ref();
+    for (k, present) in [
+        ("freq_hz", od.freq_hz.is_some()),
+        ("half_angle_deg", od.half_angle_deg.is_some()),
+        ("angle_amp_deg", od.angle_amp_deg.is_some()),
+        ("accel_amp_mps2", od.accel_amp_mps2.is_some()),
+        ("phase_deg", od.phase_deg.is_some()),
+    ] {
+        if present {
+            return cx.err(o.span(), &format!("overlay.{k}"), format!("not a key of overlay type `rotation` (its keys: axis, angle_deg, start_s, end_s)"));
+        }
+    }
+    let axis = match &od.axis {
+        None => return cx.err(o.span(), "overlay.axis", "missing required key for overlay type `rotation`"),
+        Some(a) => match a.get_ref().as_str() {
+            "x" => Axis::X,
+            "y" => Axis::Y,
+            "z" => Axis::Z,
+            other => {
+                return cx.err(a.span(), "overlay.axis", format!("unknown axis `{other}`: expected x, y or z"))
+            }
+        },
+    };
+    let Some(a) = &od.angle_deg else {
+        return cx.err(o.span(), "overlay.angle_deg", "missing required key for overlay type `rotation`");
+    };
+    let angle = cx.range(a, "overlay.angle_deg", -3600.0, 3600.0, "an angle within ±3600 deg")?;
+    if angle == 0.0 {
+        return cx.err(a.span(), "overlay.angle_deg", "a rotation needs a non-zero angle");
+    }
+    let (Some(s0), Some(s1)) = (&od.start_s, &od.end_s) else {
+        return cx.err(o.span(), "overlay.end_s", "overlay type `rotation` needs both start_s and end_s");
+    };
+    let start_s = cx.range(s0, "overlay.start_s", 0.0, total, "a time within the scenario")?;
+    let end_s = cx.range(s1, "overlay.end_s", start_s, total, "a time after start_s within the scenario")?;
+    if end_s <= start_s {
+        return cx.err(s1.span(), "overlay.end_s", "a rotation needs end_s > start_s");
+    }
+    Ok(OverlayKind::rotation(axis, angle * D2R, start_s, end_s))
 }
 
 fn parse_mounting(cx: &Ctx<'_>, m: Option<&S<MountingDoc>>) -> Result<Mounting, ScenarioError> {
@@ -1354,6 +1494,7 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "alignment", summary: "stationary alignment reference: roll/pitch/yaw 2/-3/40 deg at 37.5N (alignment spec §6)", toml: include_str!("../scenarios/alignment.toml") },
     Builtin { name: "moored-ship", summary: "disturbed base: moored ship at 40N, roll/pitch sway ±5 deg, 0.5 m heave, 0.2 m surge, marine grade", toml: include_str!("../scenarios/moored-ship.toml") },
     Builtin { name: "rocking-car", summary: "disturbed base: parked car rocking ±0.8/0.5 deg at 1.373/1.827 Hz with 1 cm heave, aviation grade", toml: include_str!("../scenarios/rocking-car.toml") },
+    Builtin { name: "calibration", summary: "12-position turntable calibration: 300 s dwells, 10 s rotations, tactical grade, 100 Hz (sdins calibrate)", toml: include_str!("../scenarios/calibration.toml") },
 ];
 
 /// Look up a built-in scenario by name.

@@ -185,6 +185,19 @@ pub enum OverlayKind {
         /// phase φ \[rad\]
         phase_rad: f64,
     },
+    /// turntable step: rotation by `angle_rad` about a body axis over the overlay window
+    /// `[start_s, end_s]` (length T) with a raised-cosine rate, `θ(τ) = A·S(x)`,
+    /// `S(x) = x − sin(2πx)/(2π)`, `θ̇ = (A/T)(1 − cos 2πx)`, `x = τ/T` (the profile of
+    /// [`Motion::TurnSmooth`]; θ̇ and θ̈ vanish at both ends): `C_k = R_axis(θ)`, held at
+    /// `R_axis(A)` after the window (docs/theory/calibration.md §1)
+    Rotation {
+        /// axis of the body frame after the earlier overlays
+        axis: Axis,
+        /// rotation angle A \[rad\] (positive: right-handed about the axis)
+        angle_rad: f64,
+        /// `Ω = 2π/T` of the window \[rad/s\] (set by [`OverlayKind::rotation`])
+        omega_rps: f64,
+    },
 }
 
 impl OverlayKind {
@@ -194,8 +207,32 @@ impl OverlayKind {
             OverlayKind::Coning { omega_rps, .. }
             | OverlayKind::Sculling { omega_rps, .. }
             | OverlayKind::Vibration { omega_rps, .. }
-            | OverlayKind::Sway { omega_rps, .. } => omega_rps,
+            | OverlayKind::Sway { omega_rps, .. }
+            | OverlayKind::Rotation { omega_rps, .. } => omega_rps,
         }
+    }
+
+    /// A turntable step of `angle_rad` about `axis` over `[start_s, end_s]`
+    /// ([`OverlayKind::Rotation`], `Ω = 2π/(end_s − start_s)`), as an overlay.
+    pub fn rotation(axis: Axis, angle_rad: f64, start_s: f64, end_s: f64) -> Overlay {
+        Overlay {
+            kind: OverlayKind::Rotation {
+                axis,
+                angle_rad,
+                omega_rps: 2.0 * PI / (end_s - start_s),
+            },
+            start_s,
+            end_s,
+        }
+    }
+}
+
+/// Rotation matrix `R_axis(θ)` from `(sin θ, cos θ)` (body frame after ← before).
+fn axis_rotation(axis: Axis, (sa, ca): (f64, f64)) -> Mat3 {
+    match axis {
+        Axis::X => Mat3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca),
+        Axis::Y => Mat3::new(ca, 0.0, sa, 0.0, 1.0, 0.0, -sa, 0.0, ca),
+        Axis::Z => Mat3::new(ca, -sa, 0.0, sa, ca, 0.0, 0.0, 0.0, 1.0),
     }
 }
 
@@ -542,6 +579,12 @@ impl Trajectory {
             | OverlayKind::Sculling { omega_rps, .. }
             | OverlayKind::Vibration { omega_rps, .. }
             | OverlayKind::Sway { omega_rps, .. } => omega_rps,
+            // the raised-cosine profile, and the rotation it drives (peak rate 2A/T)
+            OverlayKind::Rotation {
+                angle_rad,
+                omega_rps,
+                ..
+            } => omega_rps.max(omega_rps * angle_rad.abs() / PI),
         });
         seg.chain(ov).fold(0.0, f64::max)
     }
@@ -766,17 +809,31 @@ impl Trajectory {
                     let [sp, cp, _, _] = *kc;
                     let (swt, cwt) = sincos(omega_rps);
                     let (s_ph, c_ph) = (swt * cp + cwt * sp, cwt * cp - swt * sp);
-                    let (sa, ca) = (amp_rad * s_ph).sin_cos();
-                    let c = match axis {
-                        Axis::X => Mat3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca),
-                        Axis::Y => Mat3::new(ca, 0.0, sa, 0.0, 1.0, 0.0, -sa, 0.0, ca),
-                        Axis::Z => Mat3::new(ca, -sa, 0.0, sa, ca, 0.0, 0.0, 0.0, 1.0),
-                    };
+                    let c = axis_rotation(axis, (amp_rad * s_ph).sin_cos());
                     let mut w = Vec3::zeros();
                     if active {
                         w[axis.index()] = amp_rad * omega_rps * c_ph;
                     }
                     (c, w)
+                }
+                OverlayKind::Rotation {
+                    axis,
+                    angle_rad,
+                    omega_rps,
+                } => {
+                    let mut w = Vec3::zeros();
+                    let theta = if active {
+                        // sin/cos(2πx) = sin/cos(Ωτ); x = τ/T with T = 2π/Ω
+                        let (s2, c2) = sincos(omega_rps);
+                        let x = (tau_base + tau_off) * omega_rps / (2.0 * PI);
+                        w[axis.index()] = angle_rad * omega_rps / (2.0 * PI) * (1.0 - c2);
+                        angle_rad * (x - s2 / (2.0 * PI))
+                    } else if t_sel < ov.start_s {
+                        0.0
+                    } else {
+                        angle_rad
+                    };
+                    (axis_rotation(axis, theta.sin_cos()), w)
                 }
             };
             // compose: C_c ← C_c C_k, ω_c ← C_kᵀ ω_c + ω_k (the first directly: the
