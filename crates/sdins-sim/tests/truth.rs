@@ -394,6 +394,16 @@ fn gauss_matches_rk4_reference_turn_90dps() {
 }
 
 #[test]
+fn gauss_matches_rk4_reference_calibration_rotations() {
+    // The 12-position schedule: the first rotation (z +180° in 300…310 s) with the dwells
+    // around it, and a later one (y +90° in 1230…1240 s) after three composed rotations.
+    let (dth, dv, dpos) = gauss_vs_rk4("calibration", &[(299.0, 12.0), (1229.0, 12.0)]);
+    assert!(dth <= 2e-17, "{dth:e}");
+    assert!(dv <= 2e-16, "{dv:e}");
+    assert!(dpos <= 1e-9, "{dpos:e}");
+}
+
+#[test]
 #[ignore = "release: whole dq-paper and turn-90dps with the RK4 reference (~4 s)"]
 fn gauss_matches_rk4_reference_whole_runs() {
     for name in ["dq-paper", "turn-90dps"] {
