@@ -48,6 +48,8 @@ enum Command {
     Errors(cmd::errors::Args),
     /// Initial alignment: coarse 1-/2-step, Kalman fine, multi-heading; observability.
     Align(cmd::align::Args),
+    /// Turntable calibration: bias, scale factor and misalignment least squares with 1σ.
+    Calibrate(cmd::calibrate::Args),
     /// Monte Carlo: N seeded runs with the scenario's IMU errors, per-epoch statistics.
     Montecarlo(cmd::montecarlo::Args),
     /// INS/GNSS Kalman filter on a scenario: errors with ±3σ, innovations, bias estimates.
@@ -80,6 +82,7 @@ fn main() -> ExitCode {
         Command::Allan(a) => cmd::allan::run(a),
         Command::Errors(a) => cmd::errors::run(a),
         Command::Align(a) => cmd::align::run(a),
+        Command::Calibrate(a) => cmd::calibrate::run(a),
         Command::Montecarlo(a) => cmd::montecarlo::run(a),
         Command::Merge(a) => cmd::merge::run(a),
         Command::Fuse(a) => cmd::fuse::run(a),

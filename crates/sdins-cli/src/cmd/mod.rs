@@ -3,6 +3,7 @@
 pub mod align;
 pub mod align_plot;
 pub mod allan;
+pub mod calibrate;
 pub mod demo;
 pub mod errors;
 pub mod fuse;

@@ -5,6 +5,7 @@
 pub mod estimate;
 pub mod run;
 pub mod schedule;
+pub mod table;
 
 pub use estimate::{EstimateError, TriadAccumulator, TriadEstimate};
 pub use run::{

@@ -1,0 +1,381 @@
+//! `sdins calibrate`: simulated turntable calibration of a scenario's IMU
+//! (docs/theory/calibration.md): the least-squares estimate of the 24 bias, scale-factor
+//! and misalignment parameters with 1σ, against the truth, and (with `--runs N`) the Monte
+//! Carlo consistency (mean NEES and its χ² band) and the largest errors per group.
+//!
+//! Outputs in `--out` (if given): `calibration.csv` (one row per parameter; with
+//! `--runs`, the first run), `calibration_runs.csv` (per run: NEES and max errors),
+//! `calibration.json` (the same as `--json`), `report.html` and `run.toml`.
+
+use crate::error::CliError;
+use crate::output::write_string;
+use sdins_sim::calibration::run::{
+    calibrate_scenario, group_errors, monte_carlo, CalibrationError, CalibrationRun, GroupMax,
+    MonteCarloSummary,
+};
+use sdins_sim::calibration::table::{rows, ParamRow};
+use sdins_sim::calibration::DrawSpec;
+use sdins_sim::imu_error::{DPH, UG};
+use sdins_sim::scenario::Scenario;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Arguments of `sdins calibrate`.
+#[derive(clap::Args, Debug)]
+#[command(after_help = "Examples:\n  sdins calibrate calibration\n  \
+    sdins calibrate calibration --runs 100 --out cal-mc\n  \
+    sdins calibrate my-table.toml --no-draw --json")]
+pub struct Args {
+    /// scenario (built-in name or file), normally with a [calibration] schedule
+    pub scenario: String,
+    /// error-model run index of a single run
+    #[arg(long, default_value_t = 0)]
+    pub run: u64,
+    /// number of Monte Carlo runs (indices 0..N; 1 = the single run --run)
+    #[arg(long, default_value_t = 1)]
+    pub runs: usize,
+    /// drawn scale-factor magnitudes LO,HI [ppm] (random sign, every axis, every run)
+    #[arg(long, default_value = "100,1000", allow_hyphen_values = true)]
+    pub draw_scale_ppm: String,
+    /// drawn misalignment magnitudes LO,HI [mrad] (random sign, every off-diagonal entry)
+    #[arg(long, default_value = "0.1,1", allow_hyphen_values = true)]
+    pub draw_misalignment_mrad: String,
+    /// keep the scenario's own scale factors and misalignments ([imu.errors]) instead of
+    /// drawing them
+    #[arg(long)]
+    pub no_draw: bool,
+    /// output folder
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// print a JSON summary on stdout
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Largest accepted `--runs`.
+const MAX_RUNS: usize = 100_000;
+
+fn pair(option: &str, s: &str) -> Result<(f64, f64), CliError> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let bad = || {
+        CliError::bad(format!(
+            "--{option}: `{s}` must be two finite numbers LO,HI with 0 ≤ LO ≤ HI"
+        ))
+    };
+    let [a, b] = parts.as_slice() else {
+        return Err(bad());
+    };
+    let (lo, hi): (f64, f64) = (a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?);
+    if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo <= hi) {
+        return Err(bad());
+    }
+    Ok((lo, hi))
+}
+
+impl Args {
+    /// The draw of these options (`None` with `--no-draw`), validated.
+    fn draw(&self) -> Result<Option<DrawSpec>, CliError> {
+        let scale = pair("draw-scale-ppm", &self.draw_scale_ppm)?;
+        let mis = pair("draw-misalignment-mrad", &self.draw_misalignment_mrad)?;
+        if scale.1 > 1e5 {
+            return Err(CliError::bad(format!(
+                "--draw-scale-ppm: {} ppm is beyond the small-error model (at most 1e5 ppm)",
+                scale.1
+            )));
+        }
+        if mis.1 > 100.0 {
+            return Err(CliError::bad(format!(
+                "--draw-misalignment-mrad: {} mrad is beyond the small-angle model (at most 100 mrad)",
+                mis.1
+            )));
+        }
+        Ok((!self.no_draw).then_some(DrawSpec {
+            scale_ppm: scale,
+            misalignment_mrad: mis,
+        }))
+    }
+}
+
+fn cal_error(e: CalibrationError) -> CliError {
+    match e {
+        CalibrationError::Cancelled(_) => CliError::Interrupted,
+        other => CliError::BadInput(other.to_string()),
+    }
+}
+
+fn params_csv(rows: &[ParamRow]) -> String {
+    let mut s = String::from("parameter,unit,estimate,sigma,truth,error,normalised_error\n");
+    for r in rows {
+        let t = r.truth.map_or(String::new(), |t| format!("{t:.9e}"));
+        let e = r
+            .truth
+            .map_or(String::new(), |t| format!("{:.9e}", r.estimate - t));
+        let n = r
+            .normalised_error()
+            .map_or(String::new(), |x| format!("{x:.4}"));
+        let _ = writeln!(
+            s,
+            "{},{},{:.9e},{:.9e},{t},{e},{n}",
+            r.name, r.unit, r.estimate, r.sigma
+        );
+    }
+    s
+}
+
+fn group_json(g: &GroupMax, bias_unit: &str) -> serde_json::Value {
+    serde_json::json!({
+        format!("bias_{bias_unit}"): g.bias,
+        "scale_ppm": g.scale_ppm,
+        "misalignment_mrad": g.misalignment_mrad,
+    })
+}
+
+fn summary_json(
+    scn: &Scenario,
+    first: &CalibrationRun,
+    mc: Option<&MonteCarloSummary>,
+) -> serde_json::Value {
+    let params: Vec<serde_json::Value> = rows(first)
+        .iter()
+        .map(|r| {
+            serde_json::json!({
+                "name": r.name, "unit": r.unit, "estimate": r.estimate,
+                "sigma": r.sigma, "truth": r.truth,
+            })
+        })
+        .collect();
+    let mut v = serde_json::json!({
+        "scenario": scn.name,
+        "samples": first.gyro.samples,
+        "dt_s": scn.imu.dt_s(),
+        "run": first.run,
+        "nees": first.nees,
+        "nees_dof": sdins_sim::calibration::N_PARAMS,
+        "unmodelled_terms": first.unmodelled,
+        "parameters": params,
+    });
+    if let Some(m) = mc {
+        v["monte_carlo"] = serde_json::json!({
+            "runs": m.runs,
+            "mean_nees": m.mean_nees,
+            "nees_band_95": [m.nees_band.0, m.nees_band.1],
+            "gyro_max_abs_error": group_json(&m.gyro_max, "dph"),
+            "accel_max_abs_error": group_json(&m.accel_max, "ug"),
+        });
+    }
+    v
+}
+
+fn param_table(rows: &[ParamRow]) -> Vec<Vec<String>> {
+    rows.iter()
+        .map(|r| {
+            let prec = if r.unit == "mrad" || r.unit == "deg/h" { 5 } else { 2 };
+            vec![
+                r.name.clone(),
+                r.unit.to_string(),
+                format!("{:.prec$}", r.estimate),
+                format!("{:.prec$}", r.sigma),
+                r.truth.map_or(String::new(), |t| format!("{t:.prec$}")),
+                r.normalised_error()
+                    .map_or(String::new(), |x| format!("{x:+.2}")),
+            ]
+        })
+        .collect()
+}
+
+fn mc_rows(m: &MonteCarloSummary) -> Vec<Vec<String>> {
+    vec![
+        vec![
+            "gyro".into(),
+            format!("{:.5} °/h", m.gyro_max.bias),
+            format!("{:.3}", m.gyro_max.scale_ppm),
+            format!("{:.5}", m.gyro_max.misalignment_mrad),
+        ],
+        vec![
+            "accelerometer".into(),
+            format!("{:.3} μg", m.accel_max.bias),
+            format!("{:.3}", m.accel_max.scale_ppm),
+            format!("{:.5}", m.accel_max.misalignment_mrad),
+        ],
+    ]
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    if args.runs == 0 || args.runs > MAX_RUNS {
+        return Err(CliError::bad(format!(
+            "--runs: {} must be in 1..={MAX_RUNS}",
+            args.runs
+        )));
+    }
+    let draw = args.draw()?;
+    let scn = Scenario::load(&args.scenario)?;
+    let token = crate::progress::token();
+    let (first, all, mc) = if args.runs == 1 {
+        let r = calibrate_scenario(&scn, draw.as_ref(), args.run, &token).map_err(cal_error)?;
+        (r, Vec::new(), None)
+    } else {
+        let (all, s) = monte_carlo(&scn, draw.as_ref(), args.runs, &token).map_err(cal_error)?;
+        let first = all[0].clone();
+        (first, all, Some(s))
+    };
+    if !first.unmodelled.is_empty() {
+        eprintln!(
+            "warning: the IMU model has terms the estimator does not model ({}): its 1σ is optimistic",
+            first.unmodelled.join(", ")
+        );
+    }
+    let table = rows(&first);
+    let json = summary_json(&scn, &first, mc.as_ref());
+    if let Some(dir) = &args.out {
+        crate::output::claim(dir)?;
+        write_string(&dir.join("calibration.csv"), &params_csv(&table))?;
+        if !all.is_empty() {
+            let mut s = String::from(
+                "run,nees,gyro_bias_dph,gyro_scale_ppm,gyro_misalignment_mrad,accel_bias_ug,accel_scale_ppm,accel_misalignment_mrad\n",
+            );
+            for r in &all {
+                let g = group_errors(&r.gyro, &r.gyro_truth, DPH);
+                let a = group_errors(&r.accel, &r.accel_truth, UG);
+                let _ = writeln!(
+                    s,
+                    "{},{:.6},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}",
+                    r.run,
+                    r.nees,
+                    g.bias,
+                    g.scale_ppm,
+                    g.misalignment_mrad,
+                    a.bias,
+                    a.scale_ppm,
+                    a.misalignment_mrad
+                );
+            }
+            write_string(&dir.join("calibration_runs.csv"), &s)?;
+        }
+        write_string(
+            &dir.join("calibration.json"),
+            &serde_json::to_string_pretty(&json).map_err(|e| CliError::Other(e.to_string()))?,
+        )?;
+        write_report(dir, &args, &scn, &first, &table, mc.as_ref())?;
+        let mut t = toml::Table::new();
+        t.insert("scenario_name".into(), scn.name.clone().into());
+        t.insert(
+            "scenario".into(),
+            crate::report::scenario_text(&args.scenario).into(),
+        );
+        t.insert("seed".into(), scn.imu.seed.to_string().into());
+        t.insert("run".into(), args.run.to_string().into());
+        t.insert("runs".into(), args.runs.to_string().into());
+        t.insert("draw".into(), (!args.no_draw).into());
+        t.insert("draw_scale_ppm".into(), args.draw_scale_ppm.clone().into());
+        t.insert(
+            "draw_misalignment_mrad".into(),
+            args.draw_misalignment_mrad.clone().into(),
+        );
+        crate::report::write_run_toml(dir, t)?;
+    }
+    if args.json {
+        println!("{json}");
+        return Ok(());
+    }
+    println!(
+        "{}: {} samples at {} Hz ({:.0} s); run {}: NEES {:.2} (χ²(24): mean 24, 95 % below 36.4)",
+        scn.name,
+        first.gyro.samples,
+        scn.imu.rate_hz,
+        scn.duration_s(),
+        first.run,
+        first.nees
+    );
+    println!(
+        "{:<8} {:>6} {:>14} {:>12} {:>14} {:>8}",
+        "param", "unit", "estimate", "1σ", "truth", "err/σ"
+    );
+    for r in param_table(&table) {
+        println!(
+            "{:<8} {:>6} {:>14} {:>12} {:>14} {:>8}",
+            r[0], r[1], r[2], r[3], r[4], r[5]
+        );
+    }
+    if let Some(m) = &mc {
+        println!(
+            "Monte Carlo, {} runs: mean NEES {:.2} (95 % band of χ²(24·{0})/{0}: [{:.2}, {:.2}])",
+            m.runs, m.mean_nees, m.nees_band.0, m.nees_band.1
+        );
+        println!("max |error| over runs and axes: bias, scale [ppm], misalignment [mrad]");
+        for r in mc_rows(m) {
+            println!("  {:<14} {:>14} {:>10} {:>10}", r[0], r[1], r[2], r[3]);
+        }
+    }
+    if let Some(d) = &args.out {
+        println!(
+            "wrote {0}/calibration.csv, {0}/calibration.json, {0}/report.html, {0}/run.toml{1}",
+            d.display(),
+            if all.is_empty() {
+                String::new()
+            } else {
+                format!(", {}/calibration_runs.csv", d.display())
+            }
+        );
+    }
+    Ok(())
+}
+
+fn write_report(
+    dir: &std::path::Path,
+    args: &Args,
+    scn: &Scenario,
+    first: &CalibrationRun,
+    table: &[ParamRow],
+    mc: Option<&MonteCarloSummary>,
+) -> Result<(), CliError> {
+    let mut r = crate::report::Report::new(&format!("sdins calibrate: {}", scn.name));
+    r.para(&format!(
+        "Scenario {}: {} samples at {} Hz ({:.0} s). Model f̃ = b + (I + K) f + n per sample \
+         (docs/theory/calibration.md): K has the scale-factor errors on its diagonal and the \
+         misalignments (output axis i per true axis j, full 3×3, body = table frame) off it. \
+         Scale factors and misalignments {}; biases from the scenario's grade. \
+         Least squares over every sample with the covariance of the white-noise densities.",
+        scn.name,
+        first.gyro.samples,
+        scn.imu.rate_hz,
+        scn.duration_s(),
+        if args.no_draw {
+            "as in the scenario".to_string()
+        } else {
+            format!(
+                "drawn per run: {} ppm, {} mrad, random signs",
+                args.draw_scale_ppm, args.draw_misalignment_mrad
+            )
+        }
+    ));
+    r.heading(&format!(
+        "Run {}: estimate against truth (NEES {:.2}, χ²(24))",
+        first.run, first.nees
+    ));
+    r.table(
+        &["parameter", "unit", "estimate", "1σ", "truth", "(est − truth)/σ"],
+        &param_table(table),
+    );
+    if let Some(m) = mc {
+        r.heading(&format!("Monte Carlo: {} runs", m.runs));
+        r.para(&format!(
+            "Mean NEES of the 24-vector {:.2}; two-sided 95 % band of χ²(24·{n})/{n}: [{:.2}, {:.2}].",
+            m.mean_nees,
+            m.nees_band.0,
+            m.nees_band.1,
+            n = m.runs
+        ));
+        r.table(
+            &["sensor", "max |bias error|", "max |scale error| [ppm]", "max |misalignment error| [mrad]"],
+            &mc_rows(m),
+        );
+    }
+    if !first.unmodelled.is_empty() {
+        r.para(&format!(
+            "Warning: the IMU model has terms the estimator does not model ({}): the 1σ is optimistic.",
+            first.unmodelled.join(", ")
+        ));
+    }
+    r.write(&dir.join("report.html"))
+}
