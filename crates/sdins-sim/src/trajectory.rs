@@ -972,6 +972,39 @@ mod tests {
     }
 
     #[test]
+    fn rotation_overlays_rate_and_end_attitude() {
+        // two composed turntable steps: ω_nb^b agrees with the attitude's finite
+        // difference (O(h²|C⃛|) ≈ 1e-9 with h = 1e-4) inside the windows, the rotation is at
+        // rest before and after, and each step ends at R_axis(A) (to sin/cos rounding)
+        let tr = Trajectory::new(
+            0.0,
+            0.0,
+            Euler::new(0.0, 0.0, 0.0),
+            &[(Motion::Static, 30.0)],
+            vec![
+                OverlayKind::rotation(Axis::X, PI, 2.0, 8.0),
+                OverlayKind::rotation(Axis::Z, -0.5 * PI, 10.0, 14.0),
+            ],
+        );
+        for &t in &[3.1, 5.0, 7.9, 11.3, 13.2] {
+            let k = tr.kinematics(t, t);
+            let h = 1e-4;
+            let cdot = (tr.kinematics(t + h, t).c_b_n - tr.kinematics(t - h, t).c_b_n) / (2.0 * h);
+            let w = sdins_core::math::vee_antisym(&(k.c_b_n.transpose() * cdot));
+            assert!((w - k.omega_nb_b_rps).norm() < 1e-7, "t={t}");
+        }
+        for &t in &[1.0, 9.0, 20.0] {
+            assert_eq!(tr.kinematics(t, t).omega_nb_b_rps, Vec3::zeros(), "t={t}");
+        }
+        let want = Mat3::new(0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0);
+        let got = tr.kinematics(20.0, 20.0).c_b_n;
+        assert!((got - want).abs().max() < 4.0 * f64::EPSILON, "{got}");
+        // peak rate 2A/T of the first step at mid-window
+        let k = tr.kinematics(5.0, 5.0);
+        assert!((k.omega_nb_b_rps.x - 2.0 * PI / 6.0).abs() < 1e-15);
+    }
+
+    #[test]
     fn segments_are_continuous() {
         let tr = rich();
         for seg in tr.segments().iter().skip(1) {

@@ -23,7 +23,7 @@ use std::path::PathBuf;
 /// Arguments of `sdins calibrate`.
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:\n  sdins calibrate calibration\n  \
-    sdins calibrate calibration --runs 100 --out cal-mc\n  \
+    sdins calibrate calibration --runs 20 --out cal-mc\n  \
     sdins calibrate my-table.toml --no-draw --json")]
 pub struct Args {
     /// scenario (built-in name or file), normally with a [calibration] schedule
