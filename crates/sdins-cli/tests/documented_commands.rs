@@ -73,6 +73,10 @@ const RULES: &[Rule] = &[
         Before("test -f my.toml || sdins scenarios mach1-east > my.toml"),
     ),
     rule(
+        "my-cal.toml",
+        Before("test -f my-cal.toml || sdins scenarios calibration > my-cal.toml"),
+    ),
+    rule(
         "--imu imu.csv",
         Before("test -f imu.csv || sdins truth turn-90dps --out . --quiet"),
     ),

@@ -24,7 +24,7 @@ use std::path::PathBuf;
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:\n  sdins calibrate calibration\n  \
     sdins calibrate calibration --runs 20 --out cal-mc\n  \
-    sdins calibrate my-table.toml --no-draw --json")]
+    sdins scenarios calibration > my-cal.toml\n  sdins calibrate my-cal.toml --no-draw --json")]
 pub struct Args {
     /// scenario (built-in name or file), normally with a [calibration] schedule
     pub scenario: String,
