@@ -52,7 +52,12 @@ fn calibrate_json_files_and_monte_carlo() {
             / p["sigma"].as_f64().unwrap();
         assert!(z.abs() < 5.0, "{p}");
     }
-    for f in ["calibration.csv", "calibration.json", "report.html", "run.toml"] {
+    for f in [
+        "calibration.csv",
+        "calibration.json",
+        "report.html",
+        "run.toml",
+    ] {
         assert!(out.join(f).exists(), "{f}");
     }
     let csv = std::fs::read_to_string(out.join("calibration.csv")).unwrap();
@@ -60,9 +65,19 @@ fn calibrate_json_files_and_monte_carlo() {
     assert!(csv.starts_with("parameter,unit,estimate,sigma,truth"));
     // Monte Carlo: text summary and per-run file
     let out2 = d.join("mc");
-    let (code, stdout, err) = sdins(&["calibrate", &scn, "--runs", "4", "--out", out2.to_str().unwrap()]);
+    let (code, stdout, err) = sdins(&[
+        "calibrate",
+        &scn,
+        "--runs",
+        "4",
+        "--out",
+        out2.to_str().unwrap(),
+    ]);
     assert_eq!(code, 0, "{err}");
-    assert!(stdout.contains("Monte Carlo, 4 runs: mean NEES"), "{stdout}");
+    assert!(
+        stdout.contains("Monte Carlo, 4 runs: mean NEES"),
+        "{stdout}"
+    );
     let runs = std::fs::read_to_string(out2.join("calibration_runs.csv")).unwrap();
     assert_eq!(runs.lines().count(), 5);
     let _ = std::fs::remove_dir_all(&d);
@@ -76,9 +91,18 @@ fn calibrate_bad_options_exit_2_naming_the_option() {
         (vec!["--runs", "0"], "--runs"),
         (vec!["--draw-scale-ppm", "100"], "--draw-scale-ppm"),
         (vec!["--draw-scale-ppm", "500,100"], "--draw-scale-ppm"),
-        (vec!["--draw-misalignment-mrad", "0.1,nan"], "--draw-misalignment-mrad"),
-        (vec!["--draw-misalignment-mrad", "-1,1"], "--draw-misalignment-mrad"),
-        (vec!["--draw-misalignment-mrad", "1,1000"], "--draw-misalignment-mrad"),
+        (
+            vec!["--draw-misalignment-mrad", "0.1,nan"],
+            "--draw-misalignment-mrad",
+        ),
+        (
+            vec!["--draw-misalignment-mrad", "-1,1"],
+            "--draw-misalignment-mrad",
+        ),
+        (
+            vec!["--draw-misalignment-mrad", "1,1000"],
+            "--draw-misalignment-mrad",
+        ),
     ] {
         let mut a = vec!["calibrate", scn.as_str()];
         a.extend(args.iter().copied());

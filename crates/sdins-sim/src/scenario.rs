@@ -1199,7 +1199,11 @@ fn parse_calibration(
         return cx.err(s.span(), "segment", "a [calibration] scenario builds its own static segment and rotations: remove the [[segment]] tables");
     }
     if let Some(o) = doc.overlay.first() {
-        return cx.err(o.span(), "overlay", "a [calibration] scenario builds its own rotations: remove the [[overlay]] tables");
+        return cx.err(
+            o.span(),
+            "overlay",
+            "a [calibration] scenario builds its own rotations: remove the [[overlay]] tables",
+        );
     }
     if speed != 0.0 || climb != 0.0 || vehicle != Vehicle::Free {
         return cx.err(span, "calibration", "a calibration schedule is at rest on the table: start.speed_mps and start.climb_rate_mps must be 0 and vehicle left out");
@@ -1224,12 +1228,23 @@ fn parse_calibration(
         None => DEFAULT_ROTATION_S,
     };
     if dwell > MAX_SEGMENT_S / 16.0 || rot > MAX_SEGMENT_S / 16.0 {
-        return cx.err(span, "calibration", format!("dwell_s and rotation_s must be at most {:e} s", MAX_SEGMENT_S / 16.0));
+        return cx.err(
+            span,
+            "calibration",
+            format!(
+                "dwell_s and rotation_s must be at most {:e} s",
+                MAX_SEGMENT_S / 16.0
+            ),
+        );
     }
     match Schedule::standard(kind, dwell, rot, dt) {
         Ok(s) => Ok(Some(s)),
         Err(ScheduleError::Duration { key, what }) => {
-            let v = if key == "dwell_s" { &cd.dwell_s } else { &cd.rotation_s };
+            let v = if key == "dwell_s" {
+                &cd.dwell_s
+            } else {
+                &cd.rotation_s
+            };
             cx.err(
                 v.as_ref().map_or(span, |v| v.span()),
                 &format!("calibration.{key}"),
@@ -1252,34 +1267,82 @@ fn parse_rotation(cx: &Ctx<'_>, o: &S<OverlayDoc>, total: f64) -> Result<Overlay
         ("phase_deg", od.phase_deg.is_some()),
     ] {
         if present {
-            return cx.err(o.span(), &format!("overlay.{k}"), format!("not a key of overlay type `rotation` (its keys: axis, angle_deg, start_s, end_s)"));
+            return cx.err(
+                o.span(),
+                &format!("overlay.{k}"),
+                "not a key of overlay type `rotation` (its keys: axis, angle_deg, start_s, end_s)",
+            );
         }
     }
     let axis = match &od.axis {
-        None => return cx.err(o.span(), "overlay.axis", "missing required key for overlay type `rotation`"),
+        None => {
+            return cx.err(
+                o.span(),
+                "overlay.axis",
+                "missing required key for overlay type `rotation`",
+            )
+        }
         Some(a) => match a.get_ref().as_str() {
             "x" => Axis::X,
             "y" => Axis::Y,
             "z" => Axis::Z,
             other => {
-                return cx.err(a.span(), "overlay.axis", format!("unknown axis `{other}`: expected x, y or z"))
+                return cx.err(
+                    a.span(),
+                    "overlay.axis",
+                    format!("unknown axis `{other}`: expected x, y or z"),
+                )
             }
         },
     };
     let Some(a) = &od.angle_deg else {
-        return cx.err(o.span(), "overlay.angle_deg", "missing required key for overlay type `rotation`");
+        return cx.err(
+            o.span(),
+            "overlay.angle_deg",
+            "missing required key for overlay type `rotation`",
+        );
     };
-    let angle = cx.range(a, "overlay.angle_deg", -3600.0, 3600.0, "an angle within ±3600 deg")?;
+    let angle = cx.range(
+        a,
+        "overlay.angle_deg",
+        -3600.0,
+        3600.0,
+        "an angle within ±3600 deg",
+    )?;
     if angle == 0.0 {
-        return cx.err(a.span(), "overlay.angle_deg", "a rotation needs a non-zero angle");
+        return cx.err(
+            a.span(),
+            "overlay.angle_deg",
+            "a rotation needs a non-zero angle",
+        );
     }
     let (Some(s0), Some(s1)) = (&od.start_s, &od.end_s) else {
-        return cx.err(o.span(), "overlay.end_s", "overlay type `rotation` needs both start_s and end_s");
+        return cx.err(
+            o.span(),
+            "overlay.end_s",
+            "overlay type `rotation` needs both start_s and end_s",
+        );
     };
-    let start_s = cx.range(s0, "overlay.start_s", 0.0, total, "a time within the scenario")?;
-    let end_s = cx.range(s1, "overlay.end_s", start_s, total, "a time after start_s within the scenario")?;
+    let start_s = cx.range(
+        s0,
+        "overlay.start_s",
+        0.0,
+        total,
+        "a time within the scenario",
+    )?;
+    let end_s = cx.range(
+        s1,
+        "overlay.end_s",
+        start_s,
+        total,
+        "a time after start_s within the scenario",
+    )?;
     if end_s <= start_s {
-        return cx.err(s1.span(), "overlay.end_s", "a rotation needs end_s > start_s");
+        return cx.err(
+            s1.span(),
+            "overlay.end_s",
+            "a rotation needs end_s > start_s",
+        );
     }
     Ok(OverlayKind::rotation(axis, angle * D2R, start_s, end_s))
 }

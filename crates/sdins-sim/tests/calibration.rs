@@ -125,14 +125,9 @@ fn noise_free_recovery_is_exact() {
         exact.iter().map(|x| st.apply(x, dt)).collect()
     };
     let unit = sdins_core::math::Vec3::repeat(dt.sqrt());
-    let (g1, a1) = sdins_sim::calibration::run::estimate(
-        &exact,
-        &meas,
-        dt,
-        (Some(unit), Some(unit)),
-        &cancel,
-    )
-    .unwrap();
+    let (g1, a1) =
+        sdins_sim::calibration::run::estimate(&exact, &meas, dt, (Some(unit), Some(unit)), &cancel)
+            .unwrap();
     assert_eq!(g1.k, r.gyro.k);
     assert_eq!(a1.bias, r.accel.bias);
     let eps = f64::EPSILON;
@@ -192,7 +187,12 @@ fn one_noisy_run_and_determinism() {
     .unwrap();
     assert_eq!(runs[2], one);
     for r in &runs {
-        assert!(r.nees.is_finite() && r.nees < 51.18, "run {}: {}", r.run, r.nees);
+        assert!(
+            r.nees.is_finite() && r.nees < 51.18,
+            "run {}: {}",
+            r.run,
+            r.nees
+        );
         assert!(r.unmodelled.is_empty());
     }
     assert_eq!(summary.runs, 3);

@@ -169,7 +169,11 @@ fn summary_json(
 fn param_table(rows: &[ParamRow]) -> Vec<Vec<String>> {
     rows.iter()
         .map(|r| {
-            let prec = if r.unit == "mrad" || r.unit == "deg/h" { 5 } else { 2 };
+            let prec = if r.unit == "mrad" || r.unit == "deg/h" {
+                5
+            } else {
+                2
+            };
             vec![
                 r.name.clone(),
                 r.unit.to_string(),
@@ -354,7 +358,14 @@ fn write_report(
         first.run, first.nees
     ));
     r.table(
-        &["parameter", "unit", "estimate", "1σ", "truth", "(est − truth)/σ"],
+        &[
+            "parameter",
+            "unit",
+            "estimate",
+            "1σ",
+            "truth",
+            "(est − truth)/σ",
+        ],
         &param_table(table),
     );
     if let Some(m) = mc {
@@ -367,7 +378,12 @@ fn write_report(
             n = m.runs
         ));
         r.table(
-            &["sensor", "max |bias error|", "max |scale error| [ppm]", "max |misalignment error| [mrad]"],
+            &[
+                "sensor",
+                "max |bias error|",
+                "max |scale error| [ppm]",
+                "max |misalignment error| [mrad]",
+            ],
             &mc_rows(m),
         );
     }

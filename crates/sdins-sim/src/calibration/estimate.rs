@@ -143,7 +143,11 @@ impl TriadAccumulator {
         };
         let inv_scaled = ch.inverse();
         // reciprocal condition guard: a rank-deficient schedule leaves a pivot at rounding level
-        let diag_min = ch.l().diagonal().iter().fold(f64::INFINITY, |m, x| m.min(*x));
+        let diag_min = ch
+            .l()
+            .diagonal()
+            .iter()
+            .fold(f64::INFINITY, |m, x| m.min(*x));
         if diag_min < 1e-7 {
             return Err(EstimateError::Unobservable {
                 sensor,
@@ -191,7 +195,6 @@ impl TriadEstimate {
                     self.k[(i, 2)] - k[(i, 2)],
                 );
                 self.cov_rows[i]
-                    .clone()
                     .cholesky()
                     .map_or(f64::INFINITY, |c| e.dot(&c.solve(&e)))
             })

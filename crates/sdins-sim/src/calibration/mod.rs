@@ -9,7 +9,7 @@ pub mod table;
 
 pub use estimate::{EstimateError, TriadAccumulator, TriadEstimate};
 pub use run::{
-    calibrate_scenario, monte_carlo, CalibrationError, CalibrationRun, DrawSpec,
-    MonteCarloSummary, N_PARAMS,
+    calibrate_scenario, monte_carlo, CalibrationError, CalibrationRun, DrawSpec, MonteCarloSummary,
+    N_PARAMS,
 };
 pub use schedule::{Schedule, ScheduleError, Standard, Step};

@@ -150,7 +150,10 @@ pub fn unmodelled_terms(m: &ImuErrorModel) -> Vec<&'static str> {
     let mut out = Vec::new();
     for (name, v) in [
         ("gyro_bias_gm_dph", &m.gyro_bias_gm_dph[..]),
-        ("gyro_bias_instability_dph", &m.gyro_bias_instability_dph[..]),
+        (
+            "gyro_bias_instability_dph",
+            &m.gyro_bias_instability_dph[..],
+        ),
         ("gyro_rrw_dphpsh", &m.gyro_rrw_dphpsh[..]),
         ("gyro_scale_asym_ppm", &m.gyro_scale_asym_ppm[..]),
         (
@@ -159,7 +162,10 @@ pub fn unmodelled_terms(m: &ImuErrorModel) -> Vec<&'static str> {
         ),
         ("gyro_quantum_arcsec", &m.gyro_quantum_arcsec[..]),
         ("accel_bias_gm_ug", &m.accel_bias_gm_ug[..]),
-        ("accel_bias_instability_ug", &m.accel_bias_instability_ug[..]),
+        (
+            "accel_bias_instability_ug",
+            &m.accel_bias_instability_ug[..],
+        ),
         ("accel_rrw_ugpsh", &m.accel_rrw_ugpsh[..]),
         ("accel_scale_asym_ppm", &m.accel_scale_asym_ppm[..]),
         ("accel_quantum_mps", &m.accel_quantum_mps[..]),
@@ -190,10 +196,7 @@ pub fn noise_densities(m: &ImuErrorModel) -> (Vec3, Vec3) {
 
 /// The exact increments of a scenario's whole trajectory (polls `cancel` every 2048
 /// samples).
-pub fn truth_increments(
-    scn: &Scenario,
-    cancel: &CancelToken,
-) -> Result<Vec<Increment>, Cancelled> {
+pub fn truth_increments(scn: &Scenario, cancel: &CancelToken) -> Result<Vec<Increment>, Cancelled> {
     let gen = TruthGenerator::new(&scn.trajectory, scn.truth_config());
     let mut out = Vec::with_capacity(gen.len_samples() as usize);
     for (k, s) in gen.enumerate() {
@@ -280,8 +283,8 @@ pub fn run_on_truth(
         bias: ba,
         k: k_of(&model.accel_scale_ppm, &model.accel_misalignment_mrad),
     };
-    let nees = gyro.nees(&gyro_truth.bias, &gyro_truth.k)
-        + accel.nees(&accel_truth.bias, &accel_truth.k);
+    let nees =
+        gyro.nees(&gyro_truth.bias, &gyro_truth.k) + accel.nees(&accel_truth.bias, &accel_truth.k);
     Ok(CalibrationRun {
         run,
         gyro,
@@ -424,6 +427,9 @@ mod tests {
         // χ²(2400)/100, two-sided 95 % (z = 1.96): the issue's [22.7, 25.4]; the normal
         // approximation 24 ± 1.96·√(2·2400)/100 = [22.64, 25.36] differs by the skew
         let (lo, hi) = chi2_mean_band(2400.0, 100.0, 1.96);
-        assert!((lo - 22.7).abs() < 0.05 && (hi - 25.4).abs() < 0.05, "{lo} {hi}");
+        assert!(
+            (lo - 22.7).abs() < 0.05 && (hi - 25.4).abs() < 0.05,
+            "{lo} {hi}"
+        );
     }
 }

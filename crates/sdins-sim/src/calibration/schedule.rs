@@ -97,7 +97,9 @@ pub enum ScheduleError {
         what: String,
     },
     /// A step's angle is not finite or not a non-zero multiple of 90°.
-    #[error("step {index}: angle {angle_deg} deg must be a non-zero multiple of 90 deg within ±720 deg")]
+    #[error(
+        "step {index}: angle {angle_deg} deg must be a non-zero multiple of 90 deg within ±720 deg"
+    )]
     Angle {
         /// 1-based step index
         index: usize,
