@@ -321,6 +321,7 @@ def fuse(
     until_s: Optional[float] = None,
     smooth: Optional[bool] = None,
     in_motion: Optional[bool] = None,
+    scale_factors_ppm: Optional[Tuple[float, float]] = None,
 ) -> FuseResult:
     """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``); the scenario's
     ``[gnss]`` table sets the receiver.
@@ -332,12 +333,17 @@ def fuse(
     ``nhc_sigma_mps`` None (off), ``until_s`` None (whole scenario), ``smooth`` False
     (True: the Rauch–Tung–Striebel smoother; ``result.smoothed`` then holds the smoothed
     epochs with the same fields as the forward ones), ``in_motion`` False (True: in-motion
-    alignment from an unknown heading, started at the first fix at ≥ 5 m/s).
+    alignment from an unknown heading, started at the first fix at ≥ 5 m/s),
+    ``scale_factors_ppm`` None (15 states; ``(accel_ppm, gyro_ppm)``: the 21-state filter
+    that also estimates the accelerometer and gyro scale factors with that prior σ per
+    axis; the result then has ``scale_factor_error`` / ``scale_factor_sigma`` (n × 6,
+    dimensionless, accel x y z then gyro x y z) and the ``accel_scale_est`` /
+    ``accel_scale_true`` / ``gyro_scale_est`` / ``gyro_scale_true`` summaries).
     """
     return FuseResult(
         _sdins.fuse(
             _scenario(scenario), algo, samples, run, cov_rate_hz, gate, exact_start,
-            zupt_sigma_mps, nhc_sigma_mps, until_s, smooth, in_motion,
+            zupt_sigma_mps, nhc_sigma_mps, until_s, smooth, in_motion, scale_factors_ppm,
         )
     )
 

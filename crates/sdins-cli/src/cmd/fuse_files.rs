@@ -96,6 +96,11 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         .gnss
         .clone()
         .ok_or_else(|| CliError::bad("--imu needs --gnss FILE"))?;
+    if args.scale_factors_ppm.is_some() {
+        return Err(CliError::bad(
+            "--scale-factors-ppm applies to scenarios; recorded data uses the 15-state filter",
+        ));
+    }
     if args.in_motion {
         return Err(CliError::bad(
             "--in-motion applies to scenarios; on recorded data give --attitude-deg (the heading from the first fixes' track) or --init",
