@@ -368,6 +368,7 @@ def fuse_files(
     gate: Optional[bool] = None,
     nhc_sigma_mps: Optional[float] = None,
     gnss_offset_s: Optional[float] = None,
+    scale_factors_ppm: Optional[Tuple[float, float]] = None,
 ) -> Dict[str, Any]:
     """INS/GNSS filter (and smoother) on recorded files (``sdins fuse --imu --gnss``).
 
@@ -381,7 +382,10 @@ def fuse_files(
     with per navigation update ``t_s`` (IMU clock) [s], ``lat_rad``, ``lon_rad``, ``h_m``,
     ``v_ned_mps`` (n, 3), ``euler_rad`` (n, 3: roll, pitch, yaw), ``sigma_nav`` (n, 9:
     N, E, D [m], v N, E, D [m/s], ε N, E, D [rad]), ``sigma_euler_rad`` (n, 3), ``bias``
-    (n, 6: accelerometer [m/s²], gyro [rad/s]); ``innovations`` (t_s, nis, dof,
+    (n, 6: accelerometer [m/s²], gyro [rad/s]), ``scale_factor`` and
+    ``sigma_scale_factor`` (n, 6: accelerometer then gyro, dimensionless; zero unless
+    ``scale_factors_ppm = (accel_ppm, gyro_ppm)`` selects the 21-state filter with that
+    prior σ); ``innovations`` (t_s, nis, dof,
     accepted); ``fixes_used``, ``rejected``, ``fixes_outside`` (before, after),
     ``imu_samples``; with ``truth``: ``forward_rmse`` / ``smoothed_rmse`` (roll, pitch,
     yaw [rad], v N, E, D [m/s], N, E, D [m]) and their ``*_inside_3sigma`` fractions.
@@ -393,4 +397,5 @@ def fuse_files(
         static_s,
         None if lever_arm_m is None else [float(x) for x in lever_arm_m],
         truth, smooth, algo, samples, cov_rate_hz, gate, nhc_sigma_mps, gnss_offset_s,
+        scale_factors_ppm,
     )

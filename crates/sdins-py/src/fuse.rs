@@ -216,6 +216,8 @@ struct Track {
     sigma_nav: Vec<f64>,
     sigma_euler: Vec<f64>,
     bias: Vec<f64>,
+    scale: Vec<f64>,
+    sigma_scale: Vec<f64>,
 }
 
 impl Track {
@@ -232,6 +234,9 @@ impl Track {
         self.sigma_euler.extend(p.sigma_euler_rad);
         let (ba, bg) = p.bias;
         self.bias.extend([ba.x, ba.y, ba.z, bg.x, bg.y, bg.z]);
+        let (sa, sg) = p.scale;
+        self.scale.extend([sa.x, sa.y, sa.z, sg.x, sg.y, sg.z]);
+        self.sigma_scale.extend(p.sigma_scale);
     }
     fn dict<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
@@ -244,6 +249,8 @@ impl Track {
         d.set_item("sigma_nav", matrix(py, self.sigma_nav, 9)?)?;
         d.set_item("sigma_euler_rad", matrix(py, self.sigma_euler, 3)?)?;
         d.set_item("bias", matrix(py, self.bias, 6)?)?;
+        d.set_item("scale_factor", matrix(py, self.scale, 6)?)?;
+        d.set_item("sigma_scale_factor", matrix(py, self.sigma_scale, 6)?)?;
         Ok(d)
     }
 }
@@ -254,7 +261,7 @@ impl Track {
 #[pyo3(signature = (imu, gnss, imu_format=None, gnss_format=None, grade=None,
     navego_params=None, init=None, attitude_deg=None, attitude_sigma_deg=None, static_s=None,
     lever_arm_m=None, truth=None, smooth=None, algo=None, samples=None, cov_rate_hz=None,
-    gate=None, nhc_sigma_mps=None, gnss_offset_s=None))]
+    gate=None, nhc_sigma_mps=None, gnss_offset_s=None, scale_factors_ppm=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse_files<'py>(
     py: Python<'py>,
@@ -277,6 +284,7 @@ pub fn fuse_files<'py>(
     gate: Option<bool>,
     nhc_sigma_mps: Option<f64>,
     gnss_offset_s: Option<f64>,
+    scale_factors_ppm: Option<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use sdins_sim::fuse_files::{FilesError, FilesInput, InitSource, SensorModelSource};
     use sdins_sim::fuse_records::{RecordEvent, RecordOptions};
@@ -337,6 +345,10 @@ pub fn fuse_files<'py>(
         lever_arm_b_m: lever_arm_m.unwrap_or(d.lever_arm_b_m),
         nhc_sigma_mps,
         smooth: smooth.unwrap_or(d.smooth),
+        scale_factors: scale_factors_ppm.map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior {
+            accel_ppm: [a; 3],
+            gyro_ppm: [g; 3],
+        }),
         ..d
     };
     #[derive(Default)]

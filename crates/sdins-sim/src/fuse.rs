@@ -111,6 +111,24 @@ pub struct ScaleFactorPrior {
     pub gyro_ppm: [f64; 3],
 }
 
+impl ScaleFactorPrior {
+    /// Every σ finite and in \[0, 100 000\] ppm.
+    pub fn validate(&self) -> Result<(), FuseError> {
+        if self
+            .accel_ppm
+            .iter()
+            .chain(self.gyro_ppm.iter())
+            .any(|x| !x.is_finite() || *x < 0.0 || *x > 1e5)
+        {
+            return Err(FuseError::Option(
+                "scale_factors",
+                "prior σ must be finite and in [0, 100000] ppm".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// In-motion alignment for a ground vehicle from an unknown heading: the filter starts at
 /// the first GNSS fix whose horizontal speed is at least `min_speed_mps`. Heading from the
 /// GNSS track, `ψ = atan2(v_E, v_N)` (the velocity of a car points along its body x axis
@@ -370,17 +388,7 @@ fn fuse_impl<const N: usize>(
 ) -> Result<FuseSummary, FuseError> {
     let sf_prior = opts.scale_factors.filter(|_| N > N_STATES);
     if let Some(sp) = &sf_prior {
-        if sp
-            .accel_ppm
-            .iter()
-            .chain(sp.gyro_ppm.iter())
-            .any(|x| !x.is_finite() || *x < 0.0 || *x > 1e5)
-        {
-            return Err(FuseError::Option(
-                "scale_factors",
-                "prior σ must be finite and in [0, 100000] ppm".into(),
-            ));
-        }
+        sp.validate()?;
     }
     if scn.mounting.imu.is_some() {
         return Err(FuseError::Option(

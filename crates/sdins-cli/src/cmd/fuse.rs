@@ -69,8 +69,8 @@ pub struct Args {
     /// ≥ 5 m/s, heading from the GNSS track)
     #[arg(long)]
     pub in_motion: bool,
-    /// scenario: also estimate accelerometer and gyro scale factors (21 states) with prior
-    /// σ ACCEL_PPM,GYRO_PPM per axis
+    /// also estimate accelerometer and gyro scale factors (21 states) with prior σ
+    /// ACCEL_PPM,GYRO_PPM per axis
     #[arg(long)]
     pub scale_factors_ppm: Option<String>,
     /// output folder (default ./sdins-out/fuse-<scenario>)
@@ -140,16 +140,18 @@ fn err_row(e: &sdins_sim::fuse::FuseEpoch) -> ErrRow {
 }
 
 /// `--scale-factors-ppm ACCEL,GYRO`: prior σ of the scale-factor states, in (0, 1e5] ppm.
-fn scale_factor_prior(s: &str) -> Result<sdins_sim::fuse::ScaleFactorPrior, CliError> {
+pub(crate) fn scale_factor_prior(s: &str) -> Result<sdins_sim::fuse::ScaleFactorPrior, CliError> {
     let v: Vec<&str> = s.split(',').map(str::trim).collect();
     let parsed: Vec<f64> = v.iter().filter_map(|t| t.parse::<f64>().ok()).collect();
-    match parsed[..] {
-        [a, g] if v.len() == 2 && [a, g].iter().all(|x| x.is_finite() && *x > 0.0 && *x <= 1e5) => {
-            Ok(sdins_sim::fuse::ScaleFactorPrior {
-                accel_ppm: [a; 3],
-                gyro_ppm: [g; 3],
-            })
-        }
+    let prior = match parsed[..] {
+        [a, g] if v.len() == 2 && a > 0.0 && g > 0.0 => Some(sdins_sim::fuse::ScaleFactorPrior {
+            accel_ppm: [a; 3],
+            gyro_ppm: [g; 3],
+        }),
+        _ => None,
+    };
+    match prior {
+        Some(p) if p.validate().is_ok() => Ok(p),
         _ => Err(CliError::bad(format!(
             "--scale-factors-ppm: expected ACCEL_PPM,GYRO_PPM, two numbers in (0, 100000], got `{s}`"
         ))),

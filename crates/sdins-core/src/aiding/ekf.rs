@@ -23,7 +23,7 @@
 //!   random constant (optionally plus a random walk of density K, `q = K²`); in the
 //!   21-state filter the scale-factor columns `∂δv̇/∂δs_a = C_b^n diag(f^b)` and
 //!   `∂ε̇/∂δs_g = C_b^n diag(ω_ib^b)` are the interval means `Σ Ĉ diag(Δv)/τ` and
-//!   `Σ Ĉ diag(Δθ)/τ` (Groves 2nd ed. (14.63) with the scale-factor terms of §14.2.6);
+//!   `Σ Ĉ diag(Δθ)/τ` (Groves 2nd ed. §14.2, the "additional IMU error states");
 //! * `Φ = I + Fτ + (Fτ)²/2 + (Fτ)³/6` (Groves (3.34) truncated, §14.2.3);
 //! * `Q = ½(Φ Q_c Φᵀ + Q_c) τ` (trapezoidal rule), `Q_c = G diag(ARW², VRW², q_b) Gᵀ`, the
 //!   white noises entering through `C_b^n` (Groves §14.2.2);

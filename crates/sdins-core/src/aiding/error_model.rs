@@ -14,7 +14,7 @@
 //! | 18, 19, 20 | gyro scale-factor error `s − ŝ` (21-state filter only), body | 1 |
 //!
 //! The scale-factor states enter as `δf^b = diag(f^b) δs_a`, `δω^b = diag(ω_ib^b) δs_g`
-//! (Groves 2nd ed. §14.2.6: the accelerometer and gyro error states of the
+//! (Groves 2nd ed. §14.2, "additional IMU error states": the accelerometer and gyro error states of the
 //! "scale-factor" model; the sensor model is `f̃ = (1 + s) f + b` per axis, compensated
 //! as `f̂ = (f̃ − b̂)/(1 + ŝ)`, so that `f̂ − f ≈ diag(f)(s − ŝ) + (b − b̂)`).
 //!
