@@ -133,3 +133,67 @@ fn calibrate_bad_options_exit_2_naming_the_option() {
     assert!(err.contains("not observable"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn calibrate_recorded_file_against_the_schedule() {
+    // The exact increments of the schedule written by `sdins truth` (noise-free, printed
+    // with round-trip precision): every estimate is zero to far below its 1σ (the
+    // tactical grade's), and a truncated record is refused.
+    let d = tmp("rec");
+    let scn = small_scenario(&d);
+    let tdir = d.join("truth");
+    let (code, _, err) = sdins(&["truth", &scn, "--out", tdir.to_str().unwrap(), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let imu = tdir.join("imu.csv");
+    let (code, stdout, err) = sdins(&[
+        "calibrate",
+        &scn,
+        "--imu",
+        imu.to_str().unwrap(),
+        "--format",
+        "sdins",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert!(v["nees"].is_null());
+    let params = v["parameters"].as_array().unwrap();
+    assert_eq!(params.len(), 24);
+    for p in params {
+        let (e, s) = (
+            p["estimate"].as_f64().unwrap(),
+            p["sigma"].as_f64().unwrap(),
+        );
+        assert!(p["truth"].is_null());
+        assert!(e.abs() < 1e-3 * s, "{p}");
+    }
+    // drop the last sample: located refusal
+    let text = std::fs::read_to_string(&imu).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines.pop();
+    let short = d.join("short.csv");
+    std::fs::write(&short, lines.join("\n") + "\n").unwrap();
+    let (code, _, err) = sdins(&[
+        "calibrate",
+        &scn,
+        "--imu",
+        short.to_str().unwrap(),
+        "--format",
+        "sdins",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("does not fit the schedule"), "{err}");
+    let (code, _, err) = sdins(&[
+        "calibrate",
+        &scn,
+        "--imu",
+        imu.to_str().unwrap(),
+        "--format",
+        "sdins",
+        "--runs",
+        "3",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--runs"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -77,6 +77,10 @@ const RULES: &[Rule] = &[
         Before("test -f my-cal.toml || sdins scenarios calibration > my-cal.toml"),
     ),
     rule(
+        "--imu cal-imu/imu.csv",
+        Before("test -f cal-imu/imu.csv || sdins truth calibration --out cal-imu --every 100 --quiet"),
+    ),
+    rule(
         "--imu imu.csv",
         Before("test -f imu.csv || sdins truth turn-90dps --out . --quiet"),
     ),

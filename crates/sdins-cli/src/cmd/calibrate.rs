@@ -3,19 +3,24 @@
 //! and misalignment parameters with 1σ, against the truth, and (with `--runs N`) the Monte
 //! Carlo consistency (mean NEES and its χ² band) and the largest errors per group.
 //!
+//! With `--imu FILE` the scenario gives only the schedule (site, start attitude, rotations,
+//! sample rate) and the file the measured increments: the estimate with 1σ, no truth.
+//!
 //! Outputs in `--out` (if given): `calibration.csv` (one row per parameter; with
 //! `--runs`, the first run), `calibration_runs.csv` (per run: NEES and max errors),
 //! `calibration.json` (the same as `--json`), `report.html` and `run.toml`.
 
 use crate::error::CliError;
 use crate::output::write_string;
+use sdins_sim::calibration::run::calibrate_recorded;
 use sdins_sim::calibration::run::{
     calibrate_scenario, group_errors, monte_carlo, CalibrationError, CalibrationRun, GroupMax,
     MonteCarloSummary,
 };
-use sdins_sim::calibration::table::{rows, ParamRow};
+use sdins_sim::calibration::table::{rows, triad_rows, ParamRow};
 use sdins_sim::calibration::DrawSpec;
 use sdins_sim::imu_error::{DPH, UG};
+use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use sdins_sim::scenario::Scenario;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -24,10 +29,19 @@ use std::path::PathBuf;
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:\n  sdins calibrate calibration\n  \
     sdins calibrate calibration --runs 20 --out cal-mc\n  \
-    sdins scenarios calibration > my-cal.toml\n  sdins calibrate my-cal.toml --no-draw --json")]
+    sdins scenarios calibration > my-cal.toml\n  sdins calibrate my-cal.toml --no-draw --json\n  \
+    sdins truth calibration --out cal-imu --every 100 --quiet\n  \
+    sdins calibrate calibration --imu cal-imu/imu.csv --format sdins")]
 pub struct Args {
     /// scenario (built-in name or file), normally with a [calibration] schedule
     pub scenario: String,
+    /// recorded IMU file of the schedule (sdins CSV, PSINS .imu, KF-GINS text, ...): one
+    /// sample per truth sample of the scenario, at its rate
+    #[arg(long)]
+    pub imu: Option<PathBuf>,
+    /// IMU file format: auto, sdins, psins, psins-csv, kfgins, navego
+    #[arg(long, default_value = "auto", value_parser = parse_format)]
+    pub format: ImuFormat,
     /// error-model run index of a single run
     #[arg(long, default_value_t = 0)]
     pub run: u64,
@@ -50,6 +64,17 @@ pub struct Args {
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
+}
+
+fn parse_format(s: &str) -> Result<ImuFormat, String> {
+    s.parse()
+}
+
+fn file_error(e: ImuFileError) -> CliError {
+    match e {
+        ImuFileError::Io { file, source } => CliError::Io { path: file, source },
+        other => CliError::BadInput(other.to_string()),
+    }
 }
 
 /// Largest accepted `--runs`.
@@ -130,12 +155,18 @@ fn group_json(g: &GroupMax, bias_unit: &str) -> serde_json::Value {
     })
 }
 
-fn summary_json(
-    scn: &Scenario,
-    first: &CalibrationRun,
-    mc: Option<&MonteCarloSummary>,
-) -> serde_json::Value {
-    let params: Vec<serde_json::Value> = rows(first)
+/// What one invocation estimated: the parameter rows and, for simulations, the run.
+struct Outcome<'a> {
+    rows: Vec<ParamRow>,
+    samples: u64,
+    first: Option<&'a CalibrationRun>,
+    mc: Option<&'a MonteCarloSummary>,
+    all: &'a [CalibrationRun],
+}
+
+fn summary_json(scn: &Scenario, o: &Outcome<'_>) -> serde_json::Value {
+    let params: Vec<serde_json::Value> = o
+        .rows
         .iter()
         .map(|r| {
             serde_json::json!({
@@ -146,15 +177,15 @@ fn summary_json(
         .collect();
     let mut v = serde_json::json!({
         "scenario": scn.name,
-        "samples": first.gyro.samples,
+        "samples": o.samples,
         "dt_s": scn.imu.dt_s(),
-        "run": first.run,
-        "nees": first.nees,
+        "run": o.first.map(|f| f.run),
+        "nees": o.first.map(|f| f.nees),
         "nees_dof": sdins_sim::calibration::N_PARAMS,
-        "unmodelled_terms": first.unmodelled,
+        "unmodelled_terms": o.first.map_or(Vec::new(), |f| f.unmodelled.clone()),
         "parameters": params,
     });
-    if let Some(m) = mc {
+    if let Some(m) = o.mc {
         v["monte_carlo"] = serde_json::json!({
             "runs": m.runs,
             "mean_nees": m.mean_nees,
@@ -215,6 +246,42 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let draw = args.draw()?;
     let scn = Scenario::load(&args.scenario)?;
     let token = crate::progress::token();
+    if let Some(path) = &args.imu {
+        if args.runs != 1 {
+            return Err(CliError::bad(
+                "--runs: a recorded IMU file is one calibration (Monte Carlo needs a simulated IMU)",
+            ));
+        }
+        let data = read_imu_file(path, args.format).map_err(file_error)?;
+        for w in &data.warnings {
+            eprintln!("warning: {w}");
+        }
+        let (g, a) =
+            calibrate_recorded(&scn, &data.increments, data.dt_s, &token).map_err(cal_error)?;
+        let mut rows = triad_rows(&g, None, 'g', (DPH, "deg/h"));
+        rows.extend(triad_rows(&a, None, 'a', (UG, "ug")));
+        let o = Outcome {
+            rows,
+            samples: g.samples,
+            first: None,
+            mc: None,
+            all: &[],
+        };
+        let resid = |v: sdins_core::math::Vec3, unit: f64| {
+            format!("{:.4}, {:.4}, {:.4}", v.x / unit, v.y / unit, v.z / unit)
+        };
+        let note = format!(
+            "residual noise densities: gyro {} °/√h, accelerometer {} μg/√Hz (the 1σ uses {})",
+            resid(g.density_residual, sdins_sim::imu_error::DPSH),
+            resid(a.density_residual, sdins_sim::imu_error::UG_PER_SQRT_HZ),
+            if g.density == g.density_residual {
+                "these"
+            } else {
+                "the scenario's grade"
+            }
+        );
+        return finish(&args, &scn, &o, &format!("{}: {}", path.display(), note));
+    }
     let (first, all, mc) = if args.runs == 1 {
         let r = calibrate_scenario(&scn, draw.as_ref(), args.run, &token).map_err(cal_error)?;
         (r, Vec::new(), None)
@@ -229,16 +296,31 @@ pub fn run(args: Args) -> Result<(), CliError> {
             first.unmodelled.join(", ")
         );
     }
-    let table = rows(&first);
-    let json = summary_json(&scn, &first, mc.as_ref());
+    let o = Outcome {
+        rows: rows(&first),
+        samples: first.gyro.samples,
+        first: Some(&first),
+        mc: mc.as_ref(),
+        all: &all,
+    };
+    let note = format!(
+        "run {}: NEES {:.2} (χ²(24): mean 24, 95 % below 36.4)",
+        first.run, first.nees
+    );
+    finish(&args, &scn, &o, &note)
+}
+
+/// Write the outputs and print the table.
+fn finish(args: &Args, scn: &Scenario, o: &Outcome<'_>, note: &str) -> Result<(), CliError> {
+    let json = summary_json(scn, o);
     if let Some(dir) = &args.out {
         crate::output::claim(dir)?;
-        write_string(&dir.join("calibration.csv"), &params_csv(&table))?;
-        if !all.is_empty() {
+        write_string(&dir.join("calibration.csv"), &params_csv(&o.rows))?;
+        if !o.all.is_empty() {
             let mut s = String::from(
                 "run,nees,gyro_bias_dph,gyro_scale_ppm,gyro_misalignment_mrad,accel_bias_ug,accel_scale_ppm,accel_misalignment_mrad\n",
             );
-            for r in &all {
+            for r in o.all {
                 let g = group_errors(&r.gyro, &r.gyro_truth, DPH);
                 let a = group_errors(&r.accel, &r.accel_truth, UG);
                 let _ = writeln!(
@@ -260,7 +342,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             &dir.join("calibration.json"),
             &serde_json::to_string_pretty(&json).map_err(|e| CliError::Other(e.to_string()))?,
         )?;
-        write_report(dir, &args, &scn, &first, &table, mc.as_ref())?;
+        write_report(dir, args, scn, o, note)?;
         let mut t = toml::Table::new();
         t.insert("scenario_name".into(), scn.name.clone().into());
         t.insert(
@@ -268,14 +350,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
             crate::report::scenario_text(&args.scenario).into(),
         );
         t.insert("seed".into(), scn.imu.seed.to_string().into());
-        t.insert("run".into(), args.run.to_string().into());
-        t.insert("runs".into(), args.runs.to_string().into());
-        t.insert("draw".into(), (!args.no_draw).into());
-        t.insert("draw_scale_ppm".into(), args.draw_scale_ppm.clone().into());
-        t.insert(
-            "draw_misalignment_mrad".into(),
-            args.draw_misalignment_mrad.clone().into(),
-        );
+        if let Some(p) = &args.imu {
+            let abs = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
+            t.insert("imu_file".into(), abs.display().to_string().into());
+            t.insert("imu_format".into(), args.format.name().into());
+        } else {
+            t.insert("run".into(), args.run.to_string().into());
+            t.insert("runs".into(), args.runs.to_string().into());
+            t.insert("draw".into(), (!args.no_draw).into());
+            t.insert("draw_scale_ppm".into(), args.draw_scale_ppm.clone().into());
+            t.insert(
+                "draw_misalignment_mrad".into(),
+                args.draw_misalignment_mrad.clone().into(),
+            );
+        }
         crate::report::write_run_toml(dir, t)?;
     }
     if args.json {
@@ -283,25 +371,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
         return Ok(());
     }
     println!(
-        "{}: {} samples at {} Hz ({:.0} s); run {}: NEES {:.2} (χ²(24): mean 24, 95 % below 36.4)",
+        "{}: {} samples at {} Hz ({:.0} s); {note}",
         scn.name,
-        first.gyro.samples,
+        o.samples,
         scn.imu.rate_hz,
         scn.duration_s(),
-        first.run,
-        first.nees
     );
     println!(
         "{:<8} {:>6} {:>14} {:>12} {:>14} {:>8}",
         "param", "unit", "estimate", "1σ", "truth", "err/σ"
     );
-    for r in param_table(&table) {
+    for r in param_table(&o.rows) {
         println!(
             "{:<8} {:>6} {:>14} {:>12} {:>14} {:>8}",
             r[0], r[1], r[2], r[3], r[4], r[5]
         );
     }
-    if let Some(m) = &mc {
+    if let Some(m) = o.mc {
         println!(
             "Monte Carlo, {} runs: mean NEES {:.2} (95 % band of χ²(24·{0})/{0}: [{:.2}, {:.2}])",
             m.runs, m.mean_nees, m.nees_band.0, m.nees_band.1
@@ -315,7 +401,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         println!(
             "wrote {0}/calibration.csv, {0}/calibration.json, {0}/report.html, {0}/run.toml{1}",
             d.display(),
-            if all.is_empty() {
+            if o.all.is_empty() {
                 String::new()
             } else {
                 format!(", {}/calibration_runs.csv", d.display())
@@ -329,34 +415,30 @@ fn write_report(
     dir: &std::path::Path,
     args: &Args,
     scn: &Scenario,
-    first: &CalibrationRun,
-    table: &[ParamRow],
-    mc: Option<&MonteCarloSummary>,
+    o: &Outcome<'_>,
+    note: &str,
 ) -> Result<(), CliError> {
     let mut r = crate::report::Report::new(&format!("sdins calibrate: {}", scn.name));
+    let source = match &args.imu {
+        Some(p) => format!("recorded IMU file {} on the schedule of the scenario", p.display()),
+        None if args.no_draw => "simulated; scale factors and misalignments as in the scenario".to_string(),
+        None => format!(
+            "simulated; scale factors and misalignments drawn per run: {} ppm, {} mrad, random signs",
+            args.draw_scale_ppm, args.draw_misalignment_mrad
+        ),
+    };
     r.para(&format!(
-        "Scenario {}: {} samples at {} Hz ({:.0} s). Model f̃ = b + (I + K) f + n per sample \
-         (docs/theory/calibration.md): K has the scale-factor errors on its diagonal and the \
-         misalignments (output axis i per true axis j, full 3×3, body = table frame) off it. \
-         Scale factors and misalignments {}; biases from the scenario's grade. \
+        "Scenario {}: {} samples at {} Hz ({:.0} s), {source}. Model f̃ = b + (I + K) f + n per \
+         sample (docs/theory/calibration.md): K has the scale-factor errors on its diagonal and \
+         the misalignments (output axis i per true axis j, full 3×3, body = table frame) off it. \
          Least squares over every sample with the covariance of the white-noise densities.",
         scn.name,
-        first.gyro.samples,
+        o.samples,
         scn.imu.rate_hz,
         scn.duration_s(),
-        if args.no_draw {
-            "as in the scenario".to_string()
-        } else {
-            format!(
-                "drawn per run: {} ppm, {} mrad, random signs",
-                args.draw_scale_ppm, args.draw_misalignment_mrad
-            )
-        }
     ));
-    r.heading(&format!(
-        "Run {}: estimate against truth (NEES {:.2}, χ²(24))",
-        first.run, first.nees
-    ));
+    r.heading("Estimate");
+    r.para(note);
     r.table(
         &[
             "parameter",
@@ -366,9 +448,9 @@ fn write_report(
             "truth",
             "(est − truth)/σ",
         ],
-        &param_table(table),
+        &param_table(&o.rows),
     );
-    if let Some(m) = mc {
+    if let Some(m) = o.mc {
         r.heading(&format!("Monte Carlo: {} runs", m.runs));
         r.para(&format!(
             "Mean NEES of the 24-vector {:.2}; two-sided 95 % band of χ²(24·{n})/{n}: [{:.2}, {:.2}].",
@@ -387,10 +469,10 @@ fn write_report(
             &mc_rows(m),
         );
     }
-    if !first.unmodelled.is_empty() {
+    if let Some(f) = o.first.filter(|f| !f.unmodelled.is_empty()) {
         r.para(&format!(
             "Warning: the IMU model has terms the estimator does not model ({}): the 1σ is optimistic.",
-            first.unmodelled.join(", ")
+            f.unmodelled.join(", ")
         ));
     }
     r.write(&dir.join("report.html"))

@@ -110,6 +110,9 @@ pub enum CalibrationError {
     /// `runs` is zero.
     #[error("runs must be at least 1")]
     NoRuns,
+    /// A recorded IMU file does not fit the schedule.
+    #[error("the IMU record does not fit the schedule: {0}")]
+    Mismatch(String),
     /// Stopped through the cancel token.
     #[error(transparent)]
     Cancelled(#[from] Cancelled),
@@ -311,6 +314,44 @@ pub fn calibrate_scenario(
         draw,
         scn.imu.seed,
         run,
+        cancel,
+    )
+}
+
+/// Calibrate a recorded IMU stream against the exact truth of a schedule scenario (its
+/// site, start attitude and rotations): `measured` must have the scenario's sample period
+/// (to 1e-6 relative) and one sample per truth sample, starting with the first dwell. The
+/// covariance uses the scenario's white-noise densities where its model has them (a
+/// `grade` or `[imu.errors]`), else the residual estimate.
+pub fn calibrate_recorded(
+    scn: &Scenario,
+    measured: &[Increment],
+    dt_s: f64,
+    cancel: &CancelToken,
+) -> Result<(TriadEstimate, TriadEstimate), CalibrationError> {
+    let want_dt = scn.imu.dt_s();
+    if !(dt_s.is_finite() && (dt_s - want_dt).abs() <= 1e-6 * want_dt) {
+        return Err(CalibrationError::Mismatch(format!(
+            "sample period {dt_s} s, the schedule's is {want_dt} s (imu.rate_hz = {})",
+            scn.imu.rate_hz
+        )));
+    }
+    let exact = truth_increments(scn, cancel)?;
+    if measured.len() != exact.len() {
+        return Err(CalibrationError::Mismatch(format!(
+            "{} samples, the schedule has {} ({} s at {} Hz)",
+            measured.len(),
+            exact.len(),
+            scn.duration_s(),
+            scn.imu.rate_hz
+        )));
+    }
+    let (dg, da) = noise_densities(&scn.imu.model);
+    estimate(
+        &exact,
+        measured,
+        want_dt,
+        (densities_or_none(dg), densities_or_none(da)),
         cancel,
     )
 }
