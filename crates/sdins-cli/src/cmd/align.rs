@@ -194,15 +194,37 @@ fn load(args: &Args) -> Result<AlignInput, CliError> {
     }
 }
 
-/// The per-update history as `align_history.csv` text and plot rows.
-fn history(res: &AlignOutcome) -> (String, Vec<HistRow>) {
-    let mut hist = String::from(
-        "t_s,roll_deg,pitch_deg,yaw_deg,sig_phi_n_urad,sig_phi_e_urad,sig_phi_d_urad,\
-         ba_x_ug,ba_y_ug,ba_z_ug,sig_ba_x_ug,sig_ba_y_ug,sig_ba_z_ug,\
-         bg_x_dph,bg_y_dph,bg_z_dph,sig_bg_x_dph,sig_bg_y_dph,sig_bg_z_dph,\
-         phi_n_urad,phi_e_urad,phi_d_urad\n",
-    );
+/// Header of `align_history.csv`.
+const HISTORY_HEADER: [&str; 22] = [
+    "t_s",
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "sig_phi_n_urad",
+    "sig_phi_e_urad",
+    "sig_phi_d_urad",
+    "ba_x_ug",
+    "ba_y_ug",
+    "ba_z_ug",
+    "sig_ba_x_ug",
+    "sig_ba_y_ug",
+    "sig_ba_z_ug",
+    "bg_x_dph",
+    "bg_y_dph",
+    "bg_z_dph",
+    "sig_bg_x_dph",
+    "sig_bg_y_dph",
+    "sig_bg_z_dph",
+    "phi_n_urad",
+    "phi_e_urad",
+    "phi_d_urad",
+];
+
+/// The per-update history as `align_history.csv` text and plot rows (the true attitude
+/// error φ only when the truth is known: empty cells otherwise).
+fn history(res: &AlignOutcome) -> Result<(String, Vec<HistRow>), CliError> {
     let mut rows = Vec::with_capacity(res.history.len());
+    let mut records = Vec::with_capacity(res.history.len());
     for h in &res.history {
         let e = h.euler;
         let sa = h.attitude_sigma / 1e-6;
@@ -211,21 +233,17 @@ fn history(res: &AlignOutcome) -> (String, Vec<HistRow>) {
         let bg = h.gyro_bias_b / DPH;
         let sbg = h.gyro_bias_sigma_b / DPH;
         let phi = h.phi_true.map(|p| p / 1e-6);
-        let _ = write!(
-            hist,
-            "{:.3},{:.9},{:.9},{:.9},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
-            h.t_s,
-            e.roll_rad.to_degrees(),
-            e.pitch_rad.to_degrees(),
-            e.yaw_rad.to_degrees(),
-            sa.x, sa.y, sa.z, ba.x, ba.y, ba.z, sba.x, sba.y, sba.z, bg.x, bg.y, bg.z, sbg.x, sbg.y, sbg.z
-        );
-        match phi {
-            Some(p) => {
-                let _ = writeln!(hist, ",{:.4},{:.4},{:.4}", p.x, p.y, p.z);
-            }
-            None => hist.push_str(",,,\n"),
+        let mut rec: Vec<Option<f64>> = vec![
+            Some(h.t_s),
+            Some(e.roll_rad.to_degrees()),
+            Some(e.pitch_rad.to_degrees()),
+            Some(e.yaw_rad.to_degrees()),
+        ];
+        for v in [sa, ba, sba, bg, sbg] {
+            rec.extend(v.iter().map(|x| Some(*x)));
         }
+        rec.extend((0..3).map(|i| phi.map(|p| p[i])));
+        records.push(rec);
         let a = |v: Vec3| [v.x, v.y, v.z];
         rows.push(HistRow {
             t_s: h.t_s,
@@ -237,7 +255,7 @@ fn history(res: &AlignOutcome) -> (String, Vec<HistRow>) {
             sig_bg_dph: a(sbg),
         });
     }
-    (hist, rows)
+    Ok((crate::csv_out::table(&HISTORY_HEADER, records)?, rows))
 }
 
 /// Run the command.
@@ -258,14 +276,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let (Some(sz), false) = (res.sigma_z_used_mps, args.json) {
         println!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
     }
-    let (hist, rows) = history(&res);
+    let (hist, rows) = history(&res)?;
     let dt = inp.dt_s;
     let t_end = res.samples as f64 * dt;
     let phi = res.phi_true;
     let e = res.euler;
     if let Some(dir) = &args.out {
         crate::output::claim(dir)?;
-        write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi))?;
+        write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi)?)?;
         let mut svgs = None;
         if res.has_history {
             write_string(&dir.join("align_history.csv"), &hist)?;
@@ -499,78 +517,74 @@ fn write_align_toml(
     crate::report::write_run_toml(dir, t)
 }
 
-fn v3(v: &Vec3, unit: f64) -> String {
-    format!("[{}, {}, {}]", v.x / unit, v.y / unit, v.z / unit)
+fn v3(v: &Vec3, unit: f64) -> serde_json::Value {
+    serde_json::json!([v.x / unit, v.y / unit, v.z / unit])
 }
 
 fn result_json(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>, tb: Option<(Vec3, Vec3)>) -> String {
-    let mut s = format!(
-        "{{\"method\": \"{}\", \"roll_deg\": {}, \"pitch_deg\": {}, \"yaw_deg\": {}",
-        r.method,
-        e.roll_rad.to_degrees(),
-        e.pitch_rad.to_degrees(),
-        e.yaw_rad.to_degrees()
-    );
+    let mut m = serde_json::Map::new();
+    m.insert("method".into(), r.method.to_string().into());
+    m.insert("roll_deg".into(), e.roll_rad.to_degrees().into());
+    m.insert("pitch_deg".into(), e.pitch_rad.to_degrees().into());
+    m.insert("yaw_deg".into(), e.yaw_rad.to_degrees().into());
     if let Some((b, sd)) = r.accel_bias {
-        let _ = write!(
-            s,
-            ", \"accel_bias_ug\": {}, \"accel_bias_sigma_ug\": {}",
-            v3(&b, UG),
-            v3(&sd, UG)
-        );
+        m.insert("accel_bias_ug".into(), v3(&b, UG));
+        m.insert("accel_bias_sigma_ug".into(), v3(&sd, UG));
     }
     if let Some((b, sd)) = r.gyro_bias {
-        let _ = write!(
-            s,
-            ", \"gyro_bias_dph\": {}, \"gyro_bias_sigma_dph\": {}",
-            v3(&b, DPH),
-            v3(&sd, DPH)
-        );
+        m.insert("gyro_bias_dph".into(), v3(&b, DPH));
+        m.insert("gyro_bias_sigma_dph".into(), v3(&sd, DPH));
     }
     if let Some(a) = r.attitude_sigma {
-        let _ = write!(s, ", \"attitude_sigma_urad\": {}", v3(&a, 1e-6));
+        m.insert("attitude_sigma_urad".into(), v3(&a, 1e-6));
     }
     if let Some(p) = phi {
-        let _ = write!(s, ", \"phi_urad\": {}", v3(&p, 1e-6));
+        m.insert("phi_urad".into(), v3(&p, 1e-6));
     }
     if let Some((ba, bg)) = tb {
-        let _ = write!(
-            s,
-            ", \"true_accel_bias_ug\": {}, \"true_gyro_bias_dph\": {}",
-            v3(&ba, UG),
-            v3(&bg, DPH)
-        );
+        m.insert("true_accel_bias_ug".into(), v3(&ba, UG));
+        m.insert("true_gyro_bias_dph".into(), v3(&bg, DPH));
     }
-    s.push('}');
-    s
+    serde_json::Value::Object(m).to_string()
 }
 
-fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> String {
-    let mut s = String::from(
-        "method,roll_deg,pitch_deg,yaw_deg,ba_x_ug,ba_y_ug,ba_z_ug,sig_ba_x_ug,sig_ba_y_ug,sig_ba_z_ug,\
-         bg_x_dph,bg_y_dph,bg_z_dph,sig_bg_x_dph,sig_bg_y_dph,sig_bg_z_dph,phi_n_urad,phi_e_urad,phi_d_urad\n",
-    );
-    let _ = write!(
-        s,
-        "{},{:.9},{:.9},{:.9}",
-        r.method,
-        e.roll_rad.to_degrees(),
-        e.pitch_rad.to_degrees(),
-        e.yaw_rad.to_degrees()
-    );
-    let mut cells = |v: Option<Vec3>, unit: f64| match v {
-        Some(v) => {
-            let _ = write!(s, ",{},{},{}", v.x / unit, v.y / unit, v.z / unit);
-        }
-        None => s.push_str(",,,"),
-    };
-    cells(r.accel_bias.map(|b| b.0), UG);
-    cells(r.accel_bias.map(|b| b.1), UG);
-    cells(r.gyro_bias.map(|b| b.0), DPH);
-    cells(r.gyro_bias.map(|b| b.1), DPH);
-    cells(phi, 1e-6);
-    s.push('\n');
-    s
+fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> Result<String, CliError> {
+    const HEADER: [&str; 19] = [
+        "method",
+        "roll_deg",
+        "pitch_deg",
+        "yaw_deg",
+        "ba_x_ug",
+        "ba_y_ug",
+        "ba_z_ug",
+        "sig_ba_x_ug",
+        "sig_ba_y_ug",
+        "sig_ba_z_ug",
+        "bg_x_dph",
+        "bg_y_dph",
+        "bg_z_dph",
+        "sig_bg_x_dph",
+        "sig_bg_y_dph",
+        "sig_bg_z_dph",
+        "phi_n_urad",
+        "phi_e_urad",
+        "phi_d_urad",
+    ];
+    let mut cells: Vec<Option<f64>> = vec![
+        Some(e.roll_rad.to_degrees()),
+        Some(e.pitch_rad.to_degrees()),
+        Some(e.yaw_rad.to_degrees()),
+    ];
+    for (v, unit) in [
+        (r.accel_bias.map(|b| b.0), UG),
+        (r.accel_bias.map(|b| b.1), UG),
+        (r.gyro_bias.map(|b| b.0), DPH),
+        (r.gyro_bias.map(|b| b.1), DPH),
+        (phi, 1e-6),
+    ] {
+        cells.extend((0..3).map(|i| v.map(|v| v[i] / unit)));
+    }
+    crate::csv_out::table(&HEADER, [(r.method.to_string(), cells)])
 }
 
 /// The observability rank tables of spec §2.4 (single heading, NED bias states; pseudo
