@@ -1,5 +1,5 @@
 //! Coning (attitude) and sculling (velocity) compensation over N sensor samples
-//! (mechanization.md §3.1–§3.2 and §4.1–§4.2).
+//! (docs/theory/coning-sculling.md §"Coning and sculling"; docs/theory/coning-sculling.md §"Coefficient sets").
 //!
 //! For a coefficient set `k_ij` the rotation vector over the update interval is
 //! `Δφ = Σ Δθ_j + Σ_{i<j} k_ij Δθ_i × Δθ_j` (§3.1), and by the Ignagni duality the
@@ -9,7 +9,7 @@
 use crate::math::Vec3;
 
 /// One sensor sample: body-frame integrals of the raw gyro and accelerometer outputs
-/// over the sample interval (mechanization.md §1.3).
+/// over the sample interval (docs/conventions.md §"IMU increments").
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Increment {
     /// Δθ = ∫ ω_ib^b dt \[rad\]
@@ -28,7 +28,7 @@ impl Increment {
     }
 }
 
-/// Coning/sculling coefficient set (mechanization.md §3.2 table).
+/// Coning/sculling coefficient set (docs/theory/coning-sculling.md §"Coefficient sets" table).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum ConingSet {

@@ -1,5 +1,5 @@
 //! Exact truth: trajectory state and IMU increments per sensor sample
-//! (mechanization.md §7.0).
+//! (docs/theory/mechanizations.md §"Truth generation").
 //!
 //! * Constant-state cases (static, or cruise along a parallel): closed form
 //!   `Δθ = C_n^b (ω_ie + ω_en) δt`, `Δv = C_n^b ((2ω_ie + ω_en) × v − g) δt`,
@@ -134,7 +134,7 @@ pub enum TruthScheme {
     Gauss,
     /// Classical RK4 on `[L − L0, l − l0, h, ∫ω_ib^b, ∫f^b]` with `substeps` steps per
     /// sample, the integrals reset at every sample boundary and the analytic branch
-    /// selected by the substep midpoint (spec §7.0). The independent reference.
+    /// selected by the substep midpoint (docs/theory/mechanizations.md §"Truth generation"). The independent reference.
     Rk4,
 }
 
@@ -882,7 +882,7 @@ impl Iterator for TruthGenerator<'_> {
     }
 }
 
-/// RK4 substeps per sample for a trajectory: at least 16 (spec §7.0), and enough that
+/// RK4 substeps per sample for a trajectory: at least 16 (docs/theory/mechanizations.md §"Truth generation"), and enough that
 /// the fastest periodic motion advances at most 2e-3 rad per substep. RK4 on a pure
 /// quadrature is Simpson's rule, whose error per sample is δt·h⁴·|ω⁗|/2880; for 1 Hz,
 /// 0.5° coning at 100 Hz this is 4.5e-17 rad with 16 substeps and 2.8e-18 rad with 32.

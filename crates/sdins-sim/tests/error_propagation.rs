@@ -1,5 +1,5 @@
 //! Error propagation against nonlinear simulation: spec
-//! `alignment_and_errors.md` §6 T9 (24 h free-running INS vs the §4.3 closed form), the
+//! docs/validation.md §"error propagation" T9 (24 h free-running INS vs the §4.3 closed form), the
 //! linear model vs the nonlinear error over 1800 s, and the covariance propagation vs
 //! Monte Carlo σ.
 //!
@@ -28,7 +28,7 @@ struct T9Case {
     gyro_dph: [f64; 3],
     accel_ug: [f64; 3],
     phi0: [f64; 3],
-    /// (channel, hour, spec INS value \[m\]) — spec §6 T9 table, INS column
+    /// (channel, hour, spec INS value \[m\]) — docs/validation.md §"error propagation" T9 table, INS column
     spec_points: &'static [(usize, f64, f64)],
 }
 
@@ -98,7 +98,7 @@ fn t9_cases() -> Vec<T9Case> {
     ]
 }
 
-/// Spec §6 T9: 24 h nonlinear free-inertial INS (vertical held, L = 37.5°, body = NED,
+/// docs/validation.md §"error propagation" T9: 24 h nonlinear free-inertial INS (vertical held, L = 37.5°, body = NED,
 /// spherical earth R0 = 6371 km, g = 9.79949) vs the §4.3 closed form:
 /// max |INS − closed| ≤ 1 % of the peak + 50 m, per horizontal channel, over 0–24 h; and
 /// the INS values at the spec's table epochs within the same tolerance.

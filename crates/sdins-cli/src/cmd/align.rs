@@ -35,25 +35,25 @@ use std::path::PathBuf;
 /// Alignment method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
-    /// 1-step analytic (TRIAD-type), polar-orthonormalised (spec §1.1)
+    /// 1-step analytic (TRIAD-type), polar-orthonormalised (docs/theory/alignment.md §"Coarse alignment")
     Coarse1,
-    /// 2-step: levelling + gyrocompassing (spec §1.2)
+    /// 2-step: levelling + gyrocompassing (docs/theory/alignment.md §"Coarse alignment")
     Coarse2,
     /// inertial-frame coarse alignment, robust to sway, rocking, heave and surge
     /// (docs/alignment_i0.md); the attitude at the end of the window
     I0,
-    /// 12-state zero-velocity Kalman fine alignment (spec §2)
+    /// 12-state zero-velocity Kalman fine alignment (docs/theory/alignment.md §"Fine alignment")
     Fine,
-    /// multi-heading: one filter with body-frame bias states across rotations (spec §3.2)
+    /// multi-heading: one filter with body-frame bias states across rotations (docs/theory/alignment.md §"Multi-heading alignment")
     Multiheading,
 }
 
 /// Multi-heading algorithm.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Alg {
-    /// Algorithm A (spec §3.2), recommended
+    /// Algorithm A (docs/theory/alignment.md §"Multi-heading alignment"), recommended
     A,
-    /// Algorithm B (spec §3.3, pseudo-error least squares; scenarios only: needs the
+    /// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment", pseudo-error least squares; scenarios only: needs the
     /// static phases)
     B,
 }
@@ -125,7 +125,7 @@ pub struct Args {
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
-    /// print the observability rank tables (spec §2.4, §3.1) and exit
+    /// print the observability rank tables (docs/theory/alignment.md §"Observability at one heading") and exit
     #[arg(long)]
     pub observability: bool,
 }
@@ -573,7 +573,7 @@ fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> String {
     s
 }
 
-/// The observability rank tables of spec §2.4 (single heading, NED bias states; pseudo
+/// The observability rank tables of docs/theory/alignment.md §"Observability at one heading" (single heading, NED bias states; pseudo
 /// 9-state model) and §3.1 (stripped observability matrix, body-frame bias states,
 /// attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
 pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
@@ -643,7 +643,7 @@ pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     }
     let _ = writeln!(
         s,
-        "\nUnobservable directions, 1 heading (spec §2.4): n1 = φ_N + (−tan L) φ_D + (−g) δa_E; \
+        "\nUnobservable directions, 1 heading (docs/theory/alignment.md §"Observability at one heading"): n1 = φ_N + (−tan L) φ_D + (−g) δa_E; \
          n2 = φ_D + (−Ω cos L) ε_E; n3 = φ_E + g δa_N + Ω sin L ε_N + Ω cos L ε_D"
     );
     Ok(s)

@@ -338,7 +338,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &align_rows,
     );
 
-    // 5. Schuler share (spec §4.4)
+    // 5. Schuler share (docs/theory/error-analysis.md §"The Schuler share")
     println!(
         "\n== 5. Schuler share of the position error by sensor grade ([P2] Table 1, docs/theory/error-analysis.md) =="
     );

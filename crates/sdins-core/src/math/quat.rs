@@ -1,4 +1,4 @@
-//! Hamilton, scalar-first quaternion (mechanization.md §1.2).
+//! Hamilton, scalar-first quaternion (docs/conventions.md §"Quaternions").
 
 use super::{Mat3, Vec3};
 

@@ -1,5 +1,5 @@
 //! Dual quaternions `q̂ = r + ε d` (ε² = 0) and the screw exponential
-//! (mechanization.md §6.1; S2 eqs (1)–(5), (13) corrected).
+//! (docs/theory/mechanizations.md §"Dual quaternion"; S2 eqs (1)–(5), (13) corrected).
 
 use crate::math::{Quat, Vec3};
 

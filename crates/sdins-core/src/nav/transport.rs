@@ -1,5 +1,5 @@
 //! The transport matrix `T(L, l, t) = C_{n0ⁱ}^{n(t)} = C_e^n(L, l + Ω_e t) C_e^n(L0, l0)ᵀ`
-//! (mechanization.md §5.1, S1 eq. (32), corrected).
+//! (docs/theory/mechanizations.md §"Attitude by DCM separation", S1 eq. (32), corrected).
 
 use crate::math::Mat3;
 

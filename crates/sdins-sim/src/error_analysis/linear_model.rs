@@ -7,7 +7,7 @@
 //! |---|---|---|
 //! | 0, 1, 2 | δL, δλ, δh (curvilinear position error, h up) | rad, rad, m |
 //! | 3, 4, 5 | δv^n (N, E, D) | m/s |
-//! | 6, 7, 8 | φ (N, E, D), **convention G**: `Ĉ_b^n = (I + [φ×]) C_b^n` (spec §0.2) | rad |
+//! | 6, 7, 8 | φ (N, E, D), **convention G**: `Ĉ_b^n = (I + [φ×]) C_b^n` (docs/conventions.md §"Errors") | rad |
 //! | 9, 10, 11 | accelerometer bias b_a, body frame (measured − true) | m/s² |
 //! | 12, 13, 14 | gyro bias b_g, body frame | rad/s |
 //!
@@ -193,7 +193,7 @@ impl TrajectorySample {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum VerticalChannel {
     /// δh and δv_D held at zero (their F rows, Q and initial values are zeroed), as in the
-    /// spec §4.3 / §6 T9 reference runs. Default.
+    /// docs/theory/error-analysis.md §"Full stationary closed form"; docs/validation.md §"error propagation" T9 reference runs. Default.
     #[default]
     Held,
     /// Free inertial vertical channel (unstable, `δḧ = (2g/r_eS) δh`).
@@ -609,7 +609,7 @@ mod tests {
             }
             println!("{:18} peak {:8.0} m  |lin-closed| unity {:6.1} m  k {:6.1} m  tol {:6.1} m  hdg {:.4} mrad", c.name, peak, worst[0], worst[1], tol, worst_hdg * 1e3);
             assert!(worst[0] <= tol, "{}: {} > {}", c.name, worst[0], tol);
-            // spec §4.3: heading prediction within 0.013 mrad
+            // docs/theory/error-analysis.md §"Full stationary closed form": heading prediction within 0.013 mrad
             assert!(worst_hdg <= 0.013e-3, "{}: heading {}", c.name, worst_hdg);
         }
     }

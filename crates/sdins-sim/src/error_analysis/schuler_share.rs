@@ -1,4 +1,4 @@
-//! "Schuler share" of the position error — the reconstruction of \[P2\] Table 1 (spec §4.4).
+//! "Schuler share" of the position error — the reconstruction of \[P2\] Table 1 (docs/theory/error-analysis.md §"The Schuler share").
 //!
 //! \[P2\] does not define its ratio; the spec's best reconstruction (rms 0.40 percentage
 //! points over the paper's six numbers, one fitted parameter t*) is, with
@@ -12,7 +12,7 @@
 //! evaluated at `t* = 6573 s` (≈ 1.30 T_s), L = 37.5°, R0 = 6371 km, g = 9.80665,
 //! v_E = 0. The numerator is the sum of the magnitudes of the Schuler-oscillatory parts
 //! of (1), (2), (3) (all of (3) counts as Schuler); the denominator the sum of the
-//! magnitudes of (1), (2), (3) (spec §4.2, [`super::short_term`]). The share is 0 at every
+//! magnitudes of (1), (2), (3) (docs/theory/error-analysis.md §"Single-channel formulas", [`super::short_term`]). The share is 0 at every
 //! multiple of T_s. This is a *plausible* reconstruction, not a proven one.
 //!
 //! [`schuler_share_full`] is the spec's requested variant on the full model of §4.3.
@@ -25,12 +25,12 @@ use super::{DEG_PER_HOUR, MICRO_G};
 use sdins_core::Vec3;
 use serde::Serialize;
 
-/// The fitted evaluation time of the reconstruction, t* = 6573 s (spec §4.4).
+/// The fitted evaluation time of the reconstruction, t* = 6573 s (docs/theory/error-analysis.md §"The Schuler share").
 pub const T_STAR_S: f64 = 6573.0;
 /// Latitude of the reconstruction, 37.5° \[rad\].
 pub const SHARE_LAT_RAD: f64 = 37.5 * core::f64::consts::PI / 180.0;
 
-/// Schuler share \[%\] of the spec §4.4 reconstruction for accelerometer bias `da`
+/// Schuler share \[%\] of the docs/theory/error-analysis.md §"The Schuler share" reconstruction for accelerometer bias `da`
 /// \[m/s²\] and gyro bias `dw` \[rad/s\] at time `t` \[s\]. Uses the single-channel formulas
 /// beyond their 2 h validity on purpose (that is the definition). Returns 0 where the
 /// denominator vanishes (t = 0 or zero biases).
@@ -51,7 +51,7 @@ pub fn schuler_share(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerParams) 
     }
 }
 
-/// Variant on the full stationary model (spec §4.3), defined here as
+/// Variant on the full stationary model (docs/theory/error-analysis.md §"Full stationary closed form"), defined here as
 /// `Σ_i ‖o_i'(t)‖ / Σ_i ‖δp_i(t)‖` over the three sources i = east gyro δω, down gyro δω,
 /// north accelerometer δa, each run alone through [`StationaryClosedForm`]; `o_i'` is the
 /// Foucault-rotated Schuler oscillation, norms are horizontal. \[%\]
@@ -98,7 +98,7 @@ pub struct ShareRow {
     pub share_pct: f64,
 }
 
-/// The reconstruction of \[P2\] Table 1: every grade with a \[P2\] bias box (spec §4.5) ×
+/// The reconstruction of \[P2\] Table 1: every grade with a \[P2\] bias box (docs/imu-errors.md §"Grades") ×
 /// the four corners of its box, evaluated with [`schuler_share`] at `t` (use
 /// [`T_STAR_S`]), latitude `lat_rad` (use [`SHARE_LAT_RAD`]) and `p` (use
 /// [`SchulerParams::P2`]).
@@ -127,7 +127,7 @@ pub fn schuler_share_table(t: f64, lat_rad: f64, p: &SchulerParams) -> Vec<Share
     rows
 }
 
-/// [`schuler_share_table`] with the spec §4.4 settings (t*, 37.5°, P2 constants).
+/// [`schuler_share_table`] with the docs/theory/error-analysis.md §"The Schuler share" settings (t*, 37.5°, P2 constants).
 pub fn schuler_share_table_p2() -> Vec<ShareRow> {
     schuler_share_table(T_STAR_S, SHARE_LAT_RAD, &SchulerParams::P2)
 }
@@ -146,7 +146,7 @@ mod tests {
         )
     }
 
-    /// spec §6 T10: the 12 corner values of §4.4 at t* to ±0.05 percentage points.
+    /// docs/validation.md §"error propagation" T10: the 12 corner values of §4.4 at t* to ±0.05 percentage points.
     #[test]
     fn t10_values_at_t_star() {
         let want = [
@@ -175,7 +175,7 @@ mod tests {
             {
                 assert!((r.share_pct - v).abs() <= 0.05, "{r:?}");
             } else {
-                panic!("corner not in spec §4.4: {r:?}");
+                panic!("corner not in docs/theory/error-analysis.md §"The Schuler share": {r:?}");
             }
         }
     }
@@ -217,7 +217,7 @@ mod tests {
     /// oscillatory part left is the east gyro's `R0 δω/ω_s sin ω_s t` (the others ∝ cos ω_s t;
     /// Foucault rotation keeps norms), so the numerator is `R0 δω/ω_s`; at 21 min the full
     /// model's magnitudes equal |(1)|, |(2)|, |(3)| to < 1 % (Earth-loop terms
-    /// O(Ωt) ≈ 0.1 rad enter at second order, spec §4.2 table: 1 % at 1 h), hence 2 %.
+    /// O(Ωt) ≈ 0.1 rad enter at second order, docs/theory/error-analysis.md §"Single-channel formulas" table: 1 % at 1 h), hence 2 %.
     /// Note the variant does not reproduce Table 1: the reconstruction counts all of (3)
     /// as Schuler, the full model only its oscillation `−δa/ω_s² cos ω_s t`.
     #[test]

@@ -1,10 +1,10 @@
 //! Full stationary closed form of the free-inertial error (Schuler + 24 h + Foucault),
-//! spec §4.3 — the normative reference model.
+//! docs/theory/error-analysis.md §"Full stationary closed form" — the normative reference model.
 //!
 //! Model: stationary vehicle at latitude L, spherical Earth (R0), constant g, Earth rate
 //! Ω, vertical channel held, NED, convention G, errors = estimate − truth.
 //!
-//! Steps (spec §4.3, numbering kept):
+//! Steps (docs/theory/error-analysis.md §"Full stationary closed form", numbering kept):
 //! 1. `u = [cos L, 0, −sin L]`, `ε∥ = (ε·u)u`, `ε⊥ = ε − ε∥`, `φ0⊥ = φ0 − (φ0·u)u`.
 //! 2. Psi-angle solution of `ψ̇ = −ω_ie^n × ψ + ε`, `ψ(0) = ψ0`:
 //!    `ψ(t) = c0 + c1 t + cs sin Ωt + ck (1 − cos Ωt)`, with `c0 = ψ0`, `c1 = ε∥`,
@@ -26,7 +26,7 @@
 //!   computed navigation frame), and the Schuler loop gets the homogeneous term
 //!   `δp0 cos ω_s t` (oscillatory);
 //! * initial horizontal velocity error δv0: homogeneous term `δv0 sin(ω_s t)/ω_s`
-//!   (oscillatory; spec §4.2 companion term);
+//!   (oscillatory; docs/theory/error-analysis.md §"Single-channel formulas" companion term);
 //! * full attitude error: `φ = ψ − δθ(t)`, i.e. `φ_N = ψ_N − δp_E/R0`,
 //!   `φ_E = ψ_E + δp_N/R0`, `φ_D = ψ_D + tan L δp_E/R0` (step 6 is the third component);
 //! * velocity error = time derivative of the position error (analytic). Because step 5
@@ -49,7 +49,7 @@
 //! is the spec text taken literally.
 //!
 //! Body-frame biases are accepted through [`StationaryErrors::from_body`] (`δa = C_b^n b_a`,
-//! `ε = C_b^n b_g`, spec §0.3).
+//! `ε = C_b^n b_g`, docs/theory/imu-errors.md §"IMU error model").
 
 use super::periods::SchulerParams;
 use sdins_core::{Mat3, Vec3};
@@ -62,7 +62,7 @@ pub enum SlowGain {
     /// `k = 1`: reproduces the spec's §6 T9 closed-form values (default).
     #[default]
     Unity,
-    /// `k = ω_s²/(ω_s² − Ω²)`: spec §4.3 step 4 as printed.
+    /// `k = ω_s²/(ω_s² − Ω²)`: docs/theory/error-analysis.md §"Full stationary closed form" step 4 as printed.
     SchulerK,
 }
 
@@ -323,7 +323,7 @@ mod tests {
         }
     }
 
-    /// spec §6 T9, closed-form column (metres, printed to 1 m), asserted to ±1.5 m:
+    /// docs/validation.md §"error propagation" T9, closed-form column (metres, printed to 1 m), asserted to ±1.5 m:
     /// 0.5 m printing + ≤ 0.9 m = (k − 1)·R0 ε/ω_s, the Schuler-amplitude effect of the
     /// prototype's (undocumented) gain on the oscillatory term (see [`SlowGain`]).
     #[test]
@@ -438,13 +438,13 @@ mod tests {
 
     #[test]
     fn heading_and_drift_rates() {
-        // East gyro: heading error at 12 h, closed form −1.676 mrad (spec §6 T9).
+        // East gyro: heading error at 12 h, closed form −1.676 mrad (docs/validation.md §"error propagation" T9).
         let east = cf(gyro(0.0, 1.0, 0.0));
         let h12 = east.eval(12.0 * H).phi[2];
-        // spec §4.3: heading prediction within 0.013 mrad of the INS (−1.680) in all cases
+        // docs/theory/error-analysis.md §"Full stationary closed form": heading prediction within 0.013 mrad of the INS (−1.680) in all cases
         assert!((h12 * 1e3 + 1.676).abs() < 0.013, "{h12}");
         assert!((h12 * 1e3 + 1.680).abs() < 0.013, "{h12}");
-        // North gyro: linear longitude drift R0 cos²L ε_N = 700 m/h (spec §4.3)
+        // North gyro: linear longitude drift R0 cos²L ε_N = 700 m/h (docs/theory/error-analysis.md §"Full stationary closed form")
         let north = cf(gyro(1.0, 0.0, 0.0));
         let p = SchulerParams::T9;
         let drift = p.r0_m * L.cos().powi(2) * 0.01 * DEG_PER_HOUR * H;
@@ -455,7 +455,7 @@ mod tests {
 
     #[test]
     fn accel_bias_with_foucault_special_case() {
-        // spec §4.3: δp_N = (δa_N/ω_s²)(1 − cos ω_F t cos ω_s t),
+        // docs/theory/error-analysis.md §"Full stationary closed form": δp_N = (δa_N/ω_s²)(1 − cos ω_F t cos ω_s t),
         // δp_E = −(δa_N/ω_s²) sin ω_F t cos ω_s t — exact identity of the model.
         let p = SchulerParams::T9;
         let da = 30.0 * MICRO_G;
@@ -574,7 +574,7 @@ mod tests {
         assert!(((s3 - acc.eval(H).dp_n[0]) / s3).abs() < 0.01);
     }
 
-    /// spec §6 REF: body biases b_a = \[50, −80, 30\] μg, b_g = \[0.01, −0.02, 0.015\] °/h at
+    /// docs/validation.md §"error propagation" REF: body biases b_a = \[50, −80, 30\] μg, b_g = \[0.01, −0.02, 0.015\] °/h at
     /// roll 2°, pitch −3°, yaw 40° resolve to δa = \[89.2243, −30.8676, 29.7693\] μg and
     /// ε = \[0.020261, −0.009774, 0.014797\] °/h (printed digits).
     #[test]

@@ -1,6 +1,6 @@
-//! Sensor-grade presets (spec `alignment_and_errors.md` §4.5).
+//! Sensor-grade presets (docs/imu-errors.md §"Grades").
 //!
-//! Source of the table: spec §4.5, which quotes \[P2\] (Ko, Lee, Park, Kim & Song,
+//! Source of the table: docs/imu-errors.md §"Grades", which quotes \[P2\] (Ko, Lee, Park, Kim & Song,
 //! "Analysis of SDINS Performance According to Schuler Period Error Effect") for the
 //! bias ranges and Groves, *Principles of GNSS, Inertial, and Multisensor Integrated
 //! Navigation Systems* (2nd ed.), Tables 4.1/4.2, for the typical biases. The noise
@@ -46,7 +46,7 @@ use super::{ImuErrorModel, ImuErrorModelError, DEG, UG};
 use serde::Serialize;
 
 /// \[P2\]'s grade box of one grade: the bias ranges and Schuler-share range the paper
-/// reports (spec §4.4). These are the *paper's* boxes, used only to reproduce its Schuler
+/// reports (docs/theory/error-analysis.md §"The Schuler share"). These are the *paper's* boxes, used only to reproduce its Schuler
 /// share table (`sdins errors --schuler-share`); they are not a second set of sensor values
 /// (a grade's sensor is the row's turn-on biases and noise).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
