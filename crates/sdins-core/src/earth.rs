@@ -424,7 +424,7 @@ mod tests {
     fn ecef_round_trip_all_heights() {
         // ECEF → geodetic → ECEF. The f64 floor is the quantisation of the latitude itself
         // (one ulp of a latitude near 1 rad is 2.2e-16 rad = 1.4e-9 m on the ground) plus the
-        // rounding of r (ulp of 6.4e6 m = 9.3e-10 m): the spec's 1e-9 m holds only where the
+        // rounding of r (ulp of 6.4e6 m = 9.3e-10 m): a flat 1e-9 m bound holds only where the
         // latitude ulp is small, so the bound is that floor, evaluated per point.
         let e = EarthModel::WGS84;
         for &lat in &[-89.9, -60.0, -1.0, 0.0, 37.5, 80.0, 89.99] {

@@ -15,7 +15,7 @@ fn q_cone(alpha: f64, omega: f64, t: f64) -> Quat {
     Quat::new(c, s * (omega * t).cos(), s * (omega * t).sin(), 0.0)
 }
 
-/// Δθ over \[t1, t2\] in the cancellation-free product form of the spec's closed form.
+/// Δθ over \[t1, t2\] in the cancellation-free product form of the classical coning closed form.
 fn dtheta(alpha: f64, omega: f64, t1: f64, h: f64) -> Vec3 {
     let (m, d) = (omega * (t1 + 0.5 * h), 0.5 * omega * h);
     Vec3::new(
@@ -93,7 +93,7 @@ fn drift_matches_spec_table_and_prediction() {
         let d08 = drift_z(set, 0.8, ALPHA);
         let rel08 = (d08 - m08).abs() / m08.abs();
         eprintln!(
-            "{:>10}: λ=0.8 {d08:+.4e} (spec {m08:+.4e}, {:+.2}%)",
+            "{:>10}: λ=0.8 {d08:+.4e} (ref {m08:+.4e}, {:+.2}%)",
             set.name(),
             100.0 * (d08 / m08 - 1.0)
         );
@@ -103,7 +103,7 @@ fn drift_matches_spec_table_and_prediction() {
         }
         let d04 = drift_z(set, 0.4, ALPHA);
         eprintln!(
-            "{:>10}: λ=0.4 {d04:+.4e} (spec {m04:+.4e}, {:+.2}%)",
+            "{:>10}: λ=0.4 {d04:+.4e} (ref {m04:+.4e}, {:+.2}%)",
             set.name(),
             100.0 * (d04 / m04 - 1.0)
         );

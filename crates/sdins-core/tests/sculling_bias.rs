@@ -4,7 +4,7 @@
 //!
 //! The true velocity change over each update is the integral of (C_b^r f^b), evaluated
 //! here by composite 8-point Gauss–Legendre quadrature (an independent oracle to the
-//! spec's Bessel series; its error is below 1e-20 m/s per update at these frequencies).
+//! Bessel series of docs/theory/coning-sculling.md; its error is below 1e-20 m/s per update at these frequencies).
 #![allow(clippy::unwrap_used)]
 use sdins_core::coning::{compensate, ConingSet, Increment};
 use sdins_core::math::{Mat3, Vec3};
@@ -88,7 +88,7 @@ const MEAS: [(ConingSet, f64, f64, i32); 4] = [
 fn sculling_bias_matches_spec_table() {
     for (set, m04, m08, _) in MEAS {
         let b08 = bias_z(set, 0.8);
-        eprintln!("{:>10}: λ=0.8 {b08:+.4e} (spec {m08:+.4e})", set.name());
+        eprintln!("{:>10}: λ=0.8 {b08:+.4e} (ref {m08:+.4e})", set.name());
         assert!(
             (b08 - m08).abs() <= 0.05 * m08.abs(),
             "{} λ=0.8: {b08:e} vs {m08:e}",
@@ -98,7 +98,7 @@ fn sculling_bias_matches_spec_table() {
             continue;
         }
         let b04 = bias_z(set, 0.4);
-        eprintln!("{:>10}: λ=0.4 {b04:+.4e} (spec {m04:+.4e})", set.name());
+        eprintln!("{:>10}: λ=0.4 {b04:+.4e} (ref {m04:+.4e})", set.name());
         assert!(
             (b04 - m04).abs() <= 0.05 * m04.abs(),
             "{} λ=0.4: {b04:e} vs {m04:e}",

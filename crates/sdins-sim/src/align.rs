@@ -1,10 +1,10 @@
 //! Alignment experiments: exact static / turntable truth, sensor corruption,
 //! and runners for coarse, fine, multi-heading (Algorithms A and B) alignment on top of
-//! [`sdins_core::align`]. See docs/theory/alignment.md §"Coarse alignment"; docs/theory/alignment.md §"Multi-heading alignment"; docs/validation.md.
+//! [`sdins_core::align`]. See docs/theory/alignment.md and docs/validation.md.
 //!
 //! Multi-heading sequences are built from the existing segment types: a stationary
 //! vehicle is turned on the spot with a `turn` segment at zero speed (a rotation about
-//! the local vertical; `profile = "constant"` gives the spec's constant 10 °/s, and
+//! the local vertical; `profile = "constant"` gives a constant 10 °/s, and
 //! `profile = "smooth"` also works at zero speed), see [`multiheading_trajectory`]; no
 //! new segment type is needed.
 

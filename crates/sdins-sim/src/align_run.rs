@@ -47,7 +47,7 @@ pub enum AlignMethod {
     I0,
     /// 12-state zero-velocity Kalman fine alignment (docs/theory/alignment.md §"Fine alignment")
     Fine,
-    /// multi-heading (docs/theory/alignment.md §"Multi-heading alignment" Algorithm A, §3.3 Algorithm B)
+    /// multi-heading (docs/theory/alignment.md §"Multi-heading alignment": Algorithm A or B)
     Multiheading,
 }
 

@@ -13,7 +13,7 @@
 //!   `[L, l, h, ∫ω_ib^b, ∫f^b]` with Gauss–Legendre collocation: one 3-node panel per
 //!   sample up to 16 substeps, else 4-node panels, `⌈substeps/32⌉` per sample (split
 //!   further at segment and overlay boundaries inside a sample, so that no panel straddles
-//!   a kink); see [`TruthScheme::Gauss`] for the error bound. The classical RK4 of the spec, with `substeps` steps per sample and
+//!   a kink); see [`TruthScheme::Gauss`] for the error bound. The classical RK4 (docs/theory/mechanizations.md §"Truth generation"), with `substeps` steps per sample and
 //!   the analytic branch selected by the substep midpoint, is kept as the independent
 //!   reference ([`TruthGenerator::reference_rk4`], [`TruthScheme::Rk4`]).
 
@@ -82,8 +82,8 @@ pub struct TruthConfig {
     pub lon0_rad: f64,
     /// start height \[m\]
     pub h0_m: f64,
-    /// integration resolution: RK4 substeps per sample for [`TruthScheme::Rk4`] (16 in the
-    /// spec; the refinement test compares with 32); [`TruthScheme::Gauss`] uses one
+    /// integration resolution: RK4 substeps per sample for [`TruthScheme::Rk4`] (at least 16,
+    /// docs/theory/mechanizations.md §"Truth generation"; the refinement test compares with 32); [`TruthScheme::Gauss`] uses one
     /// 3-node panel per sample up to 16, else `⌈substeps/32⌉` 4-node panels
     pub substeps: usize,
 }
@@ -482,7 +482,7 @@ impl<'a> TruthGenerator<'a> {
         self
     }
 
-    /// The classical RK4 of the spec with `substeps` steps per sample instead of the Gauss
+    /// The classical RK4 reference with `substeps` steps per sample instead of the Gauss
     /// scheme, and never the closed form: the independent reference for tests.
     pub fn reference_rk4(mut self) -> Self {
         self.closed = None;

@@ -1,7 +1,7 @@
 //! Alignment acceptance tests, docs/validation.md (T1, T2, T4–T7) and the
 //! real-data check on PSINS `lasergyro.imu`.
 //!
-//! Tolerances come from the spec (theory and its prototype); the Monte Carlo ones are
+//! Tolerances come from the theory (docs/theory/alignment.md) and its reference prototype; the Monte Carlo ones are
 //! `#[ignore]`d (run with `cargo test --release -- --ignored`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -276,7 +276,7 @@ fn t4_fine_noise_free() {
     );
     assert!(max_t <= 10.0 * URAD);
     assert!(max_h <= 20.0 * URAD);
-    // Spec T4 literally: the same noise-free data with Q from aviation noise. The tilt
+    // Reference case T4 literally: the same noise-free data with Q from aviation noise. The tilt
     // still meets 10 μrad; the heading drifts off Π x0 by up to ≈ 60 μrad (ARW in Q makes
     // the filter a fading-memory estimator of the weakly observable ε'_D, and Π x0 is the
     // limit of the exact Bayesian (Q = 0) filter only). That deviation is a quarter of the

@@ -1,6 +1,6 @@
 //! End-to-end acceptance of the mechanizations against the exact truth
-//! (docs/validation.md). Reference values are the spec's signed numbers; tolerances are
-//! the spec's (±5 % / ±10 % / bars). The 90-minute runs are release-mode `#[ignore]` tests.
+//! (docs/validation.md). Reference values are the signed numbers of the papers' cases as reconstructed
+//! there; tolerances ±5 % / ±10 % / bars. The 90-minute runs are release-mode `#[ignore]` tests.
 #![allow(clippy::unwrap_used)]
 mod common;
 use common::*;

@@ -254,7 +254,7 @@ fn mach1_truth_satisfies_navigation_equations() {
     let lon_rate = 340.29 / ((r.r_n_m + c.h0_m) * c.lat0_rad.cos());
     assert!(
         (lon_rate - 6.716597206969401e-5).abs() < 1e-19,
-        "docs/validation.md §"Song–Lee Table 1" dl/dt"
+        "A1 closed-form dl/dt"
     );
     for k in [500, 1000, 1500] {
         // central difference over ±1 s: the truth longitude is an absolute angle near

@@ -1,5 +1,4 @@
-//! `sdins align`: initial alignment of a stationary IMU (spec `alignment_and_errors.md`
-//! §1–§3): coarse 1-step / 2-step, 12-state Kalman fine alignment, multi-heading
+//! `sdins align`: initial alignment of a stationary IMU (docs/theory/alignment.md): coarse 1-step / 2-step, 12-state Kalman fine alignment, multi-heading
 //! (Algorithm A, or B for scenarios), and the observability rank tables.
 //!
 //! Input is an IMU file (`--imu`) or a scenario (built-in name or file; its IMU error
@@ -574,7 +573,7 @@ fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> String {
 }
 
 /// The observability rank tables of docs/theory/alignment.md §"Observability at one heading" (single heading, NED bias states; pseudo
-/// 9-state model) and §3.1 (stripped observability matrix, body-frame bias states,
+/// 9-state model) and of the multi-heading case (stripped observability matrix, body-frame bias states,
 /// attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
 pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     if !(lat_deg.is_finite() && lat_deg.abs() <= 80.0) {
@@ -643,7 +642,7 @@ pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     }
     let _ = writeln!(
         s,
-        "\nUnobservable directions, 1 heading (docs/theory/alignment.md §"Observability at one heading"): n1 = φ_N + (−tan L) φ_D + (−g) δa_E; \
+        "\nUnobservable directions, 1 heading (docs/theory/alignment.md): n1 = φ_N + (−tan L) φ_D + (−g) δa_E; \
          n2 = φ_D + (−Ω cos L) ε_E; n3 = φ_E + g δa_N + Ω sin L ε_N + Ω cos L ε_D"
     );
     Ok(s)

@@ -7,7 +7,7 @@
 //!   truth (IMU files) only the `±3σ` band is drawn.
 //! * `align_bias.svg/.png`: accelerometer (μg) and gyro (°/h) bias estimates in body
 //!   axes, `b̂ ± 3σ` shaded in the same color, and the true bias (scenarios) dashed.
-//!   σ is the body-frame 1σ of the bias state (docs/theory/alignment.md §"Fine alignment" NED states rotated with `Ĉᵀ P Ĉ`, or the body states of §3.2).
+//!   σ is the body-frame 1σ of the bias state (docs/theory/alignment.md §"Fine alignment" NED states rotated with `Ĉᵀ P Ĉ`, or the body-frame states of Algorithm A).
 //!
 //! The y range is fitted to the last 90 % of the record (the first Kalman cycles carry
 //! the P0 bounds of docs/theory/alignment.md §"Fine alignment", up to 30 mrad in heading, which would flatten the

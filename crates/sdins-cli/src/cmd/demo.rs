@@ -1,5 +1,5 @@
 //! `sdins demo`: the papers' headline comparisons on built-in scenarios, with the
-//! papers'/spec's numbers printed beside ours, and one self-contained HTML report.
+//! the papers' reference numbers (docs/validation.md) printed beside ours, and one self-contained HTML report.
 
 use super::run::{
     error_figure, execute_full, print_table, summary_rows, Args as RunArgs, Outcome, SUMMARY_HEADER,
@@ -146,7 +146,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "7.1, 0.5, 5.5",
         ]),
         v(&[
-            "Savage, spec reference",
+            "Savage, paper reference",
             "3.065, −47.58, −566.7",
             "3.476, −52.88, −991.6",
             "7.451, 0.482, −5.718",
@@ -158,19 +158,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "0.1, 0.01, 0.08",
         ]),
         v(&[
-            "Song–Lee, spec reference",
+            "Song–Lee, paper reference",
             "0.0438, −0.681, −8.109",
             "0.0497, −0.757, −14.19",
             "0.107, 0.0069, −0.082",
         ]),
         v(&[
-            "Song–Lee complete, spec bars",
+            "Song–Lee complete, reference bars",
             "≤ 1e−2 (horizontal), ≤ 0.2 (D)",
             "≤ 1e−2, ≤ 0.3 (D)",
             "≤ 2e−3",
         ]),
         v(&[
-            "dual quaternion, spec bars",
+            "dual quaternion, reference bars",
             "≤ 0.5 (horizontal), ≤ 5 (D)",
             "",
             "≤ 0.05",
@@ -245,7 +245,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     println!("attitude error |ε| at the end of the turn (t = 8 s):");
     for row in &att_rows {
         println!(
-            "  {:<42} {:>10}  spec {:>20}  S1 {}",
+            "  {:<42} {:>10}  ref {:>20}  S1 {}",
             row[0], row[1], row[2], row[3]
         );
     }
@@ -253,7 +253,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &mut r,
         "2. 90°/s turn from east to south at Mach 1",
         &a2,
-        &["attitude option", "|ε| at 8 s [μrad] (sdins)", "spec", "S1"],
+        &["attitude option", "|ε| at 8 s [μrad] (sdins)", "reference", "S1"],
         &att_rows,
         "The transport-matrix attitude (S1 eq. 6) keeps the attitude error at the end of the turn near 1e-3 μrad; the (5)-method reproduces S1's 0.3 μrad. Position errors during the turn are the trapezoid rule's transient (ΔT²/12)(a(t) − a(t0)), which vanishes when the turn ends.",
     )?;
@@ -265,7 +265,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut timing = String::new();
     if let (Some(sav), Some(dq)) = (find(&b, "savage"), find(&b, "dualquat")) {
         timing = format!(
-            "Execution time dual quaternion / Savage: {:.2} here (S2: 2.7 in MATLAB; spec prototype 2.2).",
+            "Execution time dual quaternion / Savage: {:.2} here (S2: 2.7 in MATLAB; reference prototype 2.2).",
             dq.wall_s / sav.wall_s.max(1e-12)
         );
         println!("  {timing}");
@@ -309,7 +309,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     println!("height and down-velocity errors at 420 s (S2: DQ better in height and v_D):");
     for row in &b_rows {
         println!(
-            "  {:<26} h {:>11} (spec {:>26})  vD {:>11} (spec {})",
+            "  {:<26} h {:>11} (ref {:>26})  vD {:>11} (ref {})",
             row[0], row[1], row[2], row[3], row[4]
         );
     }
@@ -317,7 +317,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &mut r,
         "3. The dual-quaternion paper's case (accuracy and execution time, its Figures 1–4)",
         &b,
-        &["algorithm", "height error [m] (sdins)", "spec", "v_D error [m/s] (sdins)", "spec"],
+        &["algorithm", "height error [m] (sdins)", "reference", "v_D error [m/s] (sdins)", "reference"],
         &b_rows,
         &format!("S2 found the dual-quaternion algorithm better in north/down velocity and height: reproduced. {timing}"),
     )?;
@@ -332,7 +332,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     }
     r.heading("4. Initial alignment");
-    r.para("Built-in scenario `alignment` (37.5°N, roll/pitch/yaw 2/−3/40°, aviation-grade IMU, run 0): attitude error φ (convention G, NED) of coarse 1-step and 2-step alignment over the first 60 s and of the 12-state fine Kalman alignment after 300 s and 1800 s. Tilt is limited by the accelerometer biases and heading by the east gyro bias, as the spec's error table predicts; `sdins align` gives the biases and the ±3σ plots.");
+    r.para("Built-in scenario `alignment` (37.5°N, roll/pitch/yaw 2/−3/40°, aviation-grade IMU, run 0): attitude error φ (convention G, NED) of coarse 1-step and 2-step alignment over the first 60 s and of the 12-state fine Kalman alignment after 300 s and 1800 s. Tilt is limited by the accelerometer biases and heading by the east gyro bias, as the first-order error table (docs/theory/alignment.md) predicts; `sdins align` gives the biases and the ±3σ plots.");
     r.table(
         &["method", "φ N [μrad]", "φ E [μrad]", "φ D [μrad]", "note"],
         &align_rows,

@@ -12,9 +12,9 @@
 //! * [`kf`]: the generic Kalman filter core (prediction, Joseph-form update).
 //! * [`fine`]: the 12-state zero-velocity Kalman fine alignment with its own stationary
 //!   attitude/velocity propagation, closed-loop reset or feed-forward (docs/theory/alignment.md §"Fine alignment",
-//!   §3.2 Algorithm A with body-frame bias states).
+//!   Algorithm A with body-frame bias states, §"Multi-heading alignment").
 //! * [`observability`]: numerical rank and unobservable directions of piece-wise
-//!   constant `(F_j, H)` (docs/theory/alignment.md §"Observability at one heading" procedure, §3.1 stripped observability matrix).
+//!   constant `(F_j, H)` (docs/theory/alignment.md §"Observability at one heading": rank procedure, stripped observability matrix).
 //! * [`multiheading`]: Algorithm B of docs/theory/alignment.md §"Multi-heading alignment" (pseudo-error least squares) with the
 //!   exact attitude-error transition `Φ_k, Γ_k`.
 //!
@@ -58,7 +58,7 @@ impl core::fmt::Display for AlignError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(match self {
             AlignError::LatitudeTooHigh => {
-                "latitude beyond ±80°: gyrocompassing is ill-conditioned (docs/theory/alignment.md §"Coarse alignment")"
+                "latitude beyond ±80°: gyrocompassing is ill-conditioned (docs/theory/alignment.md)"
             }
             AlignError::Degenerate => {
                 "degenerate input (zero or non-finite specific force or rate, singular matrix)"

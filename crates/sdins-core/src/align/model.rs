@@ -58,7 +58,7 @@ pub fn h_zupt() -> SMatrix<f64, 3, 12> {
     h
 }
 
-/// Horizontal-only measurement `H = [I2 0]` (docs/theory/alignment.md §"Fine alignment", loses rank: §2.4).
+/// Horizontal-only measurement `H = [I2 0]` (docs/theory/alignment.md §"Fine alignment"; it loses rank: §"Observability at one heading").
 pub fn h_horizontal() -> SMatrix<f64, 2, 12> {
     let mut h = SMatrix::<f64, 2, 12>::zeros();
     h[(0, 0)] = 1.0;

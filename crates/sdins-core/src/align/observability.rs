@@ -1,5 +1,5 @@
 //! Numerical observability analysis of piece-wise constant linear systems
-//! (docs/theory/alignment.md §"Observability at one heading" "Numerical rank procedure", §3.1 stripped observability matrix).
+//! (docs/theory/alignment.md §"Observability at one heading": numerical rank, stripped observability matrix).
 //!
 //! For segments `j = 1..J` with system matrices `F_j` and a common `H`, the stripped
 //! observability matrix is `SOM = [O_1; …; O_J]`, `O_j = [H; H F_j; …; H F_j^{N−1}]`

@@ -118,7 +118,7 @@ mod tests {
 
     #[test]
     fn exp_matches_rk4_of_constant_twist() {
-        // §7.4 item 3: twist [0.3, −0.2, 0.5] + ε[1, 2, −0.5] over t = 2 s.
+        // Unit check: twist [0.3, −0.2, 0.5] + ε[1, 2, −0.5] over t = 2 s.
         let w = Vec3::new(0.3, -0.2, 0.5);
         let wd = Vec3::new(1.0, 2.0, -0.5);
         let t = 2.0;

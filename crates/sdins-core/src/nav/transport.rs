@@ -57,7 +57,7 @@ mod tests {
 
     #[test]
     fn derivative_is_minus_omega_in() {
-        // §7.4 item 2: Ṫ Tᵀ = −[(ω_ie + ω_en)×] for a vehicle moving over the ellipsoid.
+        // Unit check: Ṫ Tᵀ = −[(ω_ie + ω_en)×] for a vehicle moving over the ellipsoid.
         let e = EarthModel::WGS84;
         let (l0, lon0, h) = (0.6_f64, 2.0_f64, 0.0);
         let v = Vec3::new(150.0, 300.0, 0.0);

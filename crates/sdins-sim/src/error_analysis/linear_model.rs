@@ -79,7 +79,7 @@ pub enum LinearModelError {
 /// Earth used by the error model.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ModelEarth {
-    /// Spherical Earth of radius R0 with constant g (the Schuler-analysis model of §4.3).
+    /// Spherical Earth of radius R0 with constant g (the Schuler-analysis model of docs/theory/error-analysis.md §"Full stationary closed form").
     Spherical(SchulerParams),
     /// An ellipsoidal earth model of `sdins-core`.
     Ellipsoid(EarthModel),
@@ -555,7 +555,7 @@ mod tests {
         ]
     }
 
-    /// Run the 15-state model for 24 h at Δt = 10 s and compare with the §4.3 closed form.
+    /// Run the 15-state model for 24 h at Δt = 10 s and compare with the stationary closed form.
     /// The closed form neglects (i) the Coriolis coupling of the slow 24 h response
     /// (exact gain `1/(1 − r² ± 2 sin L r²)`, so ≤ (1 + 2 sin L) r² of the slow amplitude
     /// per circular component, two components) and (ii) the Foucault effects on the
@@ -614,7 +614,7 @@ mod tests {
         }
     }
 
-    /// The linear model against the spec's *nonlinear INS* column of §6 T9. Tolerance:
+    /// The linear model against the *nonlinear INS* column of the T9 table (docs/validation.md §"error propagation"). Tolerance:
     /// printing (0.5 m) + discretization (< 0.1 m at Δt = 10 s) + the neglected
     /// second-order terms, whose relative size is ~ the position angle δθ = δp/R0 ≤
     /// peak/R0 (2.7e-3 for the 16.9 km case); 1e-3 · peak is used (observed: ≤ 8.3 m at

@@ -14,7 +14,7 @@
 //! * [`linear_model`]: the 15-state phi-angle error model along any trajectory and the
 //!   covariance propagation `P = ΦPΦᵀ + Q`.
 //! * [`schuler_share`]: the reconstruction of the paper's Table 1 (docs/theory/error-analysis.md §"The Schuler share").
-//! * [`nonlinear`]: stationary nonlinear free-inertial runs with injected biases (§6 T9).
+//! * [`nonlinear`]: stationary nonlinear free-inertial runs with injected biases (docs/validation.md §"error propagation" T9).
 //! * [`reference`](mod@reference): reference trajectories and error statistics for the linear model from
 //!   scenarios and IMU error models.
 //! * [`grades`]: the sensor-grade bias/noise values of docs/imu-errors.md §"Grades" used here.

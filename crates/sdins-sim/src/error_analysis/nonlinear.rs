@@ -5,7 +5,7 @@
 //! [`ImuErrorModel`] with fixed body-frame biases (`gyro_bias_dph`, `accel_bias_ug`,
 //! measured − true, docs/theory/imu-errors.md §"IMU error model") and navigated by one algorithm (default
 //! `songlee-complete`) with the vertical channel **held** to the truth (height and v_D
-//! replaced after every update, as in the closed form of §4.3). An initial attitude
+//! replaced after every update, as in the stationary closed form). An initial attitude
 //! error φ0 (convention G) starts the navigation from `Ĉ_b^n = exp([φ0×]) C_b^n`.
 //!
 //! Earth: by default a **spherical** earth of radius R0 with constant gravity g and

@@ -1,6 +1,6 @@
 //! "Schuler share" of the position error — the reconstruction of \[P2\] Table 1 (docs/theory/error-analysis.md §"The Schuler share").
 //!
-//! \[P2\] does not define its ratio; the spec's best reconstruction (rms 0.40 percentage
+//! \[P2\] does not define its ratio; our best reconstruction (rms 0.40 percentage
 //! points over the paper's six numbers, one fitted parameter t*) is, with
 //! `δB_gE = δB_gD = δω` and `δB_aN = δa`:
 //!
@@ -15,7 +15,7 @@
 //! magnitudes of (1), (2), (3) (docs/theory/error-analysis.md §"Single-channel formulas", [`super::short_term`]). The share is 0 at every
 //! multiple of T_s. This is a *plausible* reconstruction, not a proven one.
 //!
-//! [`schuler_share_full`] is the spec's requested variant on the full model of §4.3.
+//! [`schuler_share_full`] is the variant on the full model (docs/theory/error-analysis.md §"Full stationary closed form").
 
 use super::grades::{P2Box, GRADES};
 use super::periods::SchulerParams;
@@ -146,7 +146,7 @@ mod tests {
         )
     }
 
-    /// docs/validation.md §"error propagation" T10: the 12 corner values of §4.4 at t* to ±0.05 percentage points.
+    /// docs/validation.md §"error propagation" T10: the 12 corner values of the reconstruction at t* to ±0.05 percentage points.
     #[test]
     fn t10_values_at_t_star() {
         let want = [
@@ -175,7 +175,7 @@ mod tests {
             {
                 assert!((r.share_pct - v).abs() <= 0.05, "{r:?}");
             } else {
-                panic!("corner not in docs/theory/error-analysis.md §"The Schuler share": {r:?}");
+                panic!("corner not in the Schuler-share reconstruction table: {r:?}");
             }
         }
     }
@@ -197,7 +197,7 @@ mod tests {
         }
     }
 
-    /// T10 and §4.4: share(30 μg, 0.0035 °/h) = 43.8 / 32.6 / 6.8 / 5.8 / 0.1 % at
+    /// T10 and docs/theory/error-analysis.md §"The Schuler share": share(30 μg, 0.0035 °/h) = 43.8 / 32.6 / 6.8 / 5.8 / 0.1 % at
     /// 1 / 2 / 4 / 8 / 24 h (±0.1, one printed digit).
     #[test]
     fn t10_time_dependence() {
@@ -213,7 +213,7 @@ mod tests {
         }
     }
 
-    /// The full-model variant at t = T_s/4 (sin ω_s t = 1, cos ω_s t = 0): by §4.3 the only
+    /// The full-model variant at t = T_s/4 (sin ω_s t = 1, cos ω_s t = 0): by the full closed form the only
     /// oscillatory part left is the east gyro's `R0 δω/ω_s sin ω_s t` (the others ∝ cos ω_s t;
     /// Foucault rotation keeps norms), so the numerator is `R0 δω/ω_s`; at 21 min the full
     /// model's magnitudes equal |(1)|, |(2)|, |(3)| to < 1 % (Earth-loop terms

@@ -1,13 +1,13 @@
 //! Single-channel (short-term) position-error formulas: the corrected \[P2\] (1)–(3) and
 //! their companion terms (docs/theory/error-analysis.md §"Single-channel formulas").
 //!
-//! The formulas ignore the Earth-rate (24 h) loop and the Foucault rotation; the spec
-//! measures 1 % error at 1 h, 4.7 % at 2 h and 21 % at 4 h against the full model
+//! The formulas ignore the Earth-rate (24 h) loop and the Foucault rotation; against the full
+//! model (docs/theory/error-analysis.md §"Single-channel formulas") they are 1 % error at 1 h, 4.7 % at 2 h and 21 % at 4 h off
 //! (east gyro, 37.5°). **Validity policy (chosen here):** the checked entry point
 //! [`position_error`] returns [`ShortTermError::BeyondValidity`] for `t >`
 //! [`VALIDITY_LIMIT_S`] (2 h), so no caller can silently use them for long times.
 //! The raw formulas (`eq1_*`, `eq2_*`, `eq3_*`, ...) are public *without* the check
-//! because the docs/theory/error-analysis.md §"The Schuler share" Schuler-share reconstruction deliberately evaluates them at
+//! because the Schuler-share reconstruction (docs/theory/error-analysis.md §"The Schuler share") deliberately evaluates them at
 //! any t; their doc comments say so.
 //!
 //! Units: R0 \[m\], t \[s\], ε \[rad/s\], δa \[m/s²\], results in metres. NED, convention G,
@@ -27,7 +27,7 @@ pub enum ShortTermError {
     /// The time is beyond the validity of the single-channel formulas.
     #[error(
         "t = {t_s} s is beyond the {limit_s} s validity of the single-channel formulas \
-         (docs/theory/error-analysis.md §"Single-channel formulas"); use the stationary closed form (§4.3)"
+         (docs/theory/error-analysis.md); use the stationary closed form"
     )]
     BeyondValidity {
         /// requested time \[s\]
