@@ -1,5 +1,5 @@
-//! Earth model (docs/theory/mechanizations.md §"Earth model"): ellipsoid radii, normal gravity, earth rate,
-//! transport rate, geodetic ↔ ECEF and `C_e^n`.
+//! Earth model (docs/theory/mechanizations.md §"Earth model"): ellipsoid radii, normal gravity,
+//! earth rate, transport rate, geodetic ↔ ECEF and `C_e^n`.
 //!
 //! The model is a value ([`EarthModel`]) so that the WGS-84 default, the PSINS constant
 //! set (for PSINS data) and a flat, non-rotating model (for flat-NED fixtures) can be
@@ -179,8 +179,8 @@ impl EarthModel {
         )
     }
 
-    /// WGS-84 (docs/theory/mechanizations.md §"Earth model"): a = 6378137, f = 1/298.257223563,
-    /// Ω = 7.292115e-5 rad/s, Somigliana gravity with the TR8350.2 height series.
+    /// WGS-84 (docs/theory/mechanizations.md §"Earth model"): a = 6378137, f = 1/298.257223563, Ω =
+    /// 7.292115e-5 rad/s, Somigliana gravity with the TR8350.2 height series.
     pub const WGS84: EarthModel = EarthModel {
         a_m: 6_378_137.0,
         f: 1.0 / 298.257_223_563,
@@ -405,7 +405,8 @@ mod tests {
 
     #[test]
     fn wgs84_gravity_published_values() {
-        // TR8350.2: γ_e = 9.7803253359, γ_p = 9.8321849378 m/s²; docs/validation.md §"stationary 90 min" value at 37.5°.
+        // TR8350.2: γ_e = 9.7803253359, γ_p = 9.8321849378 m/s²; docs/validation.md
+        // §"stationary 90 min" value at 37.5°.
         let e = EarthModel::WGS84;
         assert!(rel(e.gravity(0.0, 0.0), 9.780_325_335_9) < 1e-9);
         assert!(rel(e.gravity(90.0 * D2R, 0.0), 9.832_184_937_8) < 1e-9);

@@ -1,9 +1,11 @@
 //! Coning drift of every coefficient set against the closed-form classical coning truth
-//! (docs/theory/coning-sculling.md §"Classical coning and sculling truth"; docs/validation.md §"coning drift of all 7 sets").
+//! (docs/theory/coning-sculling.md §"Classical coning and sculling truth"; docs/validation.md
+//! §"coning drift of all 7 sets").
 //!
-//! Method (docs/validation.md §"coning drift of all 7 sets"): ΔT = 6 ms, α = 0.1°, Ω = λ/ΔT, max(200, ⌈20·2π/λ⌉) updates from
-//! t0 = 0.123456789 s; per update e_b = 2 vec(Δq_true* ⊗ q(Δφ_alg)) (sign-fixed),
-//! ε_k = C(q_true(t_k)) e_b; drift = mean(ε_z)/ΔT. Prediction: −c_N sin²α cosα λ^p/ΔT.
+//! Method (docs/validation.md §"coning drift of all 7 sets"): ΔT = 6 ms, α = 0.1°, Ω = λ/ΔT,
+//! max(200, ⌈20·2π/λ⌉) updates from t0 = 0.123456789 s; per update e_b = 2 vec(Δq_true* ⊗
+//! q(Δφ_alg)) (sign-fixed), ε_k = C(q_true(t_k)) e_b; drift = mean(ε_z)/ΔT. Prediction: −c_N sin²α
+//! cosα λ^p/ΔT.
 #![allow(clippy::unwrap_used)]
 use sdins_core::coning::{compensate, ConingSet, Increment};
 use sdins_core::math::{Quat, Vec3};

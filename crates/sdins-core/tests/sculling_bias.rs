@@ -1,10 +1,12 @@
 //! Sculling bias of the coefficient sets against the classical sculling truth
-//! (docs/theory/coning-sculling.md §"Classical coning and sculling truth"): angular oscillation θ0 sin Ωt about body x in phase with a
-//! specific force A0 sin Ωt along body y, no gravity, non-rotating reference frame.
+//! (docs/theory/coning-sculling.md §"Classical coning and sculling truth"): angular oscillation θ0
+//! sin Ωt about body x in phase with a specific force A0 sin Ωt along body y, no gravity,
+//! non-rotating reference frame.
 //!
 //! The true velocity change over each update is the integral of (C_b^r f^b), evaluated
 //! here by composite 8-point Gauss–Legendre quadrature (an independent oracle to the
-//! Bessel series of docs/theory/coning-sculling.md; its error is below 1e-20 m/s per update at these frequencies).
+//! Bessel series of docs/theory/coning-sculling.md; its error is below 1e-20 m/s per update at
+//! these frequencies).
 #![allow(clippy::unwrap_used)]
 use sdins_core::coning::{compensate, ConingSet, Increment};
 use sdins_core::math::{Mat3, Vec3};
@@ -76,7 +78,8 @@ fn bias_z(set: ConingSet, lambda: f64) -> f64 {
     sum / updates as f64
 }
 
-/// docs/theory/coning-sculling.md §"Classical coning and sculling truth" "meas" columns (λ = 0.4, λ = 0.8) \[m/s²\].
+/// docs/theory/coning-sculling.md §"Classical coning and sculling truth" "meas" columns (λ = 0.4, λ
+/// = 0.8) \[m/s²\].
 const MEAS: [(ConingSet, f64, f64, i32); 4] = [
     (ConingSet::Two, -4.632e-9, -7.306e-8, 4),
     (ConingSet::ThreePoly, 6.820e-10, 1.055e-8, 4),
@@ -109,7 +112,8 @@ fn sculling_bias_matches_spec_table() {
 
 #[test]
 fn sculling_bias_order() {
-    // bias ∝ λ^{p−1}: λ⁴ for two and three_poly, λ⁶ for three_opt (docs/theory/coning-sculling.md §"Classical coning and sculling truth").
+    // bias ∝ λ^{p−1}: λ⁴ for two and three_poly, λ⁶ for three_opt (docs/theory/coning-sculling.md
+    // §"Classical coning and sculling truth").
     for (set, _, _, order) in MEAS.iter().copied().take(3) {
         let b3 = bias_z(set, 0.3).abs();
         let b4 = bias_z(set, 0.4).abs();

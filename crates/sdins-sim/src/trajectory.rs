@@ -1,5 +1,6 @@
 //! Analytic trajectories: piecewise motion segments plus attitude/linear overlays,
-//! evaluated exactly (value and derivative) at any time (docs/theory/mechanizations.md §"Truth generation").
+//! evaluated exactly (value and derivative) at any time (docs/theory/mechanizations.md
+//! §"Truth generation").
 //!
 //! The nominal vehicle moves with horizontal speed `s` along heading `ψ` (= yaw) and
 //! down velocity `v_D`: `v^n = [s cosψ, s sinψ, v_D]`. Roll and pitch stay at their start
@@ -37,7 +38,8 @@ pub enum Motion {
         /// total heading change A \[rad\]
         angle_rad: f64,
     },
-    /// S-turn: `ψ̇ = a sin(2πτ/T)`, `ψ = ψ0 + a(T/2π)(1 − cos(2πτ/T))` (docs/scenarios.md §"profile")
+    /// S-turn: `ψ̇ = a sin(2πτ/T)`, `ψ = ψ0 + a(T/2π)(1 − cos(2πτ/T))` (docs/scenarios.md
+    /// §"profile")
     STurn {
         /// peak yaw rate a \[rad/s\]
         amplitude_rps: f64,
@@ -143,7 +145,8 @@ impl Axis {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum OverlayKind {
     /// classical coning about a body axis, relative form `C_c = C(q_c(0)* ⊗ q_c(τ))`
-    /// (docs/theory/coning-sculling.md §"Classical coning and sculling truth"; docs/scenarios.md §"profile")
+    /// (docs/theory/coning-sculling.md §"Classical coning and sculling truth"; docs/scenarios.md
+    /// §"profile")
     Coning {
         /// cone axis
         axis: Axis,
@@ -153,7 +156,8 @@ pub enum OverlayKind {
         omega_rps: f64,
     },
     /// classical sculling: rotation θ0 sin Ωτ about body x, in phase with a specific-force
-    /// oscillation A0 sin Ωτ along the nominal body y (docs/theory/coning-sculling.md §"Classical coning and sculling truth")
+    /// oscillation A0 sin Ωτ along the nominal body y (docs/theory/coning-sculling.md
+    /// §"Classical coning and sculling truth")
     Sculling {
         /// angular amplitude θ0 \[rad\]
         angle_amp_rad: f64,
@@ -552,7 +556,8 @@ impl Trajectory {
     }
 
     /// Whether the kinematics are constant with v_N = v_D = 0 (no overlays, only static or
-    /// cruise segments): then the truth has the closed form of docs/theory/mechanizations.md §"Truth generation" (A0, A1).
+    /// cruise segments): then the truth has the closed form of docs/theory/mechanizations.md
+    /// §"Truth generation" (A0, A1).
     pub fn is_constant_parallel(&self) -> bool {
         self.track.is_none()
             && self.overlays.is_empty()
@@ -680,7 +685,8 @@ impl Trajectory {
             }
         };
 
-        // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (docs/theory/mechanizations.md §"Truth generation")
+        // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (docs/theory/mechanizations.md
+        // §"Truth generation")
         let mut c_c = Mat3::identity();
         let mut w_c = Vec3::zeros();
         for (j, (ov, kc)) in self.overlays.iter().zip(&self.consts.overlay).enumerate() {

@@ -1,8 +1,8 @@
-//! Alignment acceptance tests, docs/validation.md (T1, T2, T4–T7) and the
-//! real-data check on PSINS `lasergyro.imu`.
+//! Alignment acceptance tests, docs/validation.md (T1, T2, T4–T7) and the real-data check on PSINS
+//! `lasergyro.imu`.
 //!
-//! Tolerances come from the theory (docs/theory/alignment.md) and its reference prototype; the Monte Carlo ones are
-//! `#[ignore]`d (run with `cargo test --release -- --ignored`).
+//! Tolerances come from the theory (docs/theory/alignment.md) and its reference prototype; the
+//! Monte Carlo ones are `#[ignore]`d (run with `cargo test --release -- --ignored`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{SMatrix, SVector};
@@ -172,7 +172,8 @@ fn t1_coarse_randomized_against_table() {
 }
 
 /// T2: coarse-alignment noise, biases 0, T_c = 60 s, 200 runs: sample σ within ±15 % of
-/// docs/theory/alignment.md §"Coarse alignment" (σ_tilt 2.58 μrad, σ_yaw 1.298 mrad, 1-step σ(φ_E) 0.649 mrad).
+/// docs/theory/alignment.md §"Coarse alignment" (σ_tilt 2.58 μrad, σ_yaw 1.298 mrad, 1-step σ(φ_E)
+/// 0.649 mrad).
 #[test]
 fn t2_coarse_noise_sigma() {
     let tr = ref_truth();
@@ -401,11 +402,11 @@ const NEES_TIMES: [u64; 4] = [60, 300, 900, 1800];
 /// `ν ~ N(0, σ_z² I3)` (exactly the R of the filter); otherwise `ṽ = 0` (noise-free).
 ///
 /// Returns, per epoch of [`NEES_TIMES`], the run-mean of
-/// `[NEES of the 9 observable coordinates p = T9 e (docs/theory/alignment.md §"Observability at one heading"), marginal NEES of δv
-/// (3 dof), marginal NEES of the 6 pseudo states φ', ε'_N, ε'_D, δa_D (6 dof)]`, with
-/// `e` = true error − estimate (estimate = 0 after the closed-loop reset; convention G,
-/// `φ = log(Ĉ Cᵀ)`; residual biases resolved with the true C) and the covariance
-/// `T9 P T9ᵀ`.
+/// `[NEES of the 9 observable coordinates p = T9 e (docs/theory/alignment.md
+/// §"Observability at one heading"), marginal NEES of δv (3 dof), marginal NEES of the 6 pseudo
+/// states φ', ε'_N, ε'_D, δa_D (6 dof)]`, with `e` = true error − estimate (estimate = 0 after the
+/// closed-loop reset; convention G, `φ = log(Ĉ Cᵀ)`; residual biases resolved with the true C) and
+/// the covariance `T9 P T9ᵀ`.
 fn nees_monte_carlo(runs: u64, sigma_z: f64, meas_noise: bool) -> Vec<[f64; 3]> {
     let tr = ref_truth();
     let s = ref_site();
@@ -498,8 +499,8 @@ fn nees_monte_carlo(runs: u64, sigma_z: f64, meas_noise: bool) -> Vec<[f64; 3]> 
 
 /// Filter consistency (NEES) with a statistically matched measurement: the simulated
 /// zero-velocity measurement carries exactly the noise the filter assumes,
-/// `ν ~ N(0, σ_z² I3)`, σ_z = 1 mm/s (docs/theory/alignment.md §"Fine alignment"). The mean pseudo-state NEES (9 dof)
-/// over 50 runs lies in its 95 % χ² band at 60, 300, 900 and 1800 s.
+/// `ν ~ N(0, σ_z² I3)`, σ_z = 1 mm/s (docs/theory/alignment.md §"Fine alignment"). The mean
+/// pseudo-state NEES (9 dof) over 50 runs lies in its 95 % χ² band at 60, 300, 900 and 1800 s.
 ///
 /// Why the simulated ν: in the simulation the IMU is exactly at rest, so the plain
 /// zero-velocity update `ṽ = 0` is noise-free, while the filter uses R = (1 mm/s)² — a
@@ -698,8 +699,9 @@ fn t6_multiheading_noise_free_algorithm_a() {
     assert!(phi.z.abs() > 1e-3);
 }
 
-/// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment") on simulated signals, noise-free: same accuracy class as
-/// Algorithm A for 2 and 4 headings; single heading is rank-deficient.
+/// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment") on simulated signals,
+/// noise-free: same accuracy class as Algorithm A for 2 and 4 headings; single heading is
+/// rank-deficient.
 #[test]
 fn algorithm_b_noise_free_signals() {
     for (h, tr, ph) in mh_cases() {

@@ -1,6 +1,6 @@
 //! Error propagation against nonlinear simulation:
-//! docs/validation.md §"error propagation" T9 (24 h free-running INS vs the stationary closed form), the
-//! linear model vs the nonlinear error over 1800 s, and the covariance propagation vs
+//! docs/validation.md §"error propagation" T9 (24 h free-running INS vs the stationary closed
+//! form), the linear model vs the nonlinear error over 1800 s, and the covariance propagation vs
 //! Monte Carlo σ.
 //!
 //! The long cases are `#[ignore]` (run with `cargo test --release -- --ignored`).
@@ -28,7 +28,8 @@ struct T9Case {
     gyro_dph: [f64; 3],
     accel_ug: [f64; 3],
     phi0: [f64; 3],
-    /// (channel, hour, reference INS value \[m\]) — docs/validation.md §"error propagation" T9 table, INS column
+    /// (channel, hour, reference INS value \[m\]) — docs/validation.md §"error propagation" T9
+    /// table, INS column
     spec_points: &'static [(usize, f64, f64)],
 }
 
@@ -98,9 +99,10 @@ fn t9_cases() -> Vec<T9Case> {
     ]
 }
 
-/// docs/validation.md §"error propagation" T9: 24 h nonlinear free-inertial INS (vertical held, L = 37.5°, body = NED,
-/// spherical earth R0 = 6371 km, g = 9.79949) vs the stationary closed form:
-/// max |INS − closed| ≤ 1 % of the peak + 50 m, per horizontal channel, over 0–24 h; and
+/// docs/validation.md §"error propagation" T9: 24 h nonlinear free-inertial INS (vertical held, L =
+/// 37.5°, body = NED,
+/// spherical earth R0 = 6371 km, g = 9.79949) vs the stationary closed form: max |INS − closed| ≤ 1
+/// % of the peak + 50 m, per horizontal channel, over 0–24 h; and
 /// the INS values at the reference table's epochs within the same tolerance.
 ///
 /// IMU 20 Hz, N = 2 (10 Hz updates), `songlee-complete`: with constant rates the
@@ -313,9 +315,9 @@ const REF_BIASES: &str =
     "[imu.errors]\ngyro_bias_dph = [0.01, -0.02, 0.015]\naccel_bias_ug = [50.0, -80.0, 30.0]";
 
 /// Linear error model vs the nonlinear difference over 1800 s within 12 % (relative to
-/// the channel's peak), for the REF biases (docs/validation.md §"error propagation") in body axes: stationary at the REF
-/// attitude (roll 2°, pitch −3°, yaw 40°) and the Mach-1 cruise (100 Hz IMU, N = 2: the
-/// bias-driven error does not depend on the IMU rate, and the ideal run is subtracted).
+/// the channel's peak), for the REF biases (docs/validation.md §"error propagation") in body axes:
+/// stationary at the REF attitude (roll 2°, pitch −3°, yaw 40°) and the Mach-1 cruise (100 Hz IMU,
+/// N = 2: the bias-driven error does not depend on the IMU rate, and the ideal run is subtracted).
 #[test]
 fn linear_model_matches_nonlinear_difference_1800s() {
     let alignment = scenario_with("alignment", 100.0, 2, REF_BIASES);

@@ -42,7 +42,8 @@ fn stationary_increments_closed_form() {
 
 #[test]
 fn mach1_rk4_reproduces_closed_form() {
-    // docs/theory/mechanizations.md §"Truth generation": with the turn disabled the general generator reproduces the A1 closed-form
+    // docs/theory/mechanizations.md §"Truth generation": with the turn disabled the general
+    // generator reproduces the A1 closed-form
     // increments (5e-23 rad, 3.5e-18 m/s in the reference prototype) and position.
     let scn = Scenario::load("mach1-east").unwrap();
     let c = cfg(&scn, 16);
@@ -110,7 +111,8 @@ fn refinement_turn_and_sturn() {
 
 #[test]
 fn classical_coning_increments_closed_form() {
-    // Cone about body z (docs/theory/coning-sculling.md §"Classical coning and sculling truth") on a flat, non-rotating earth: the generator's Δθ equals
+    // Cone about body z (docs/theory/coning-sculling.md §"Classical coning and sculling truth") on
+    // a flat, non-rotating earth: the generator's Δθ equals
     // [sinα(cosΩt2 − cosΩt1), sinα(sinΩt2 − sinΩt1), −Ω(1−cosα)(t2−t1)] to 1e-14 relative.
     let (alpha, omega) = (1.0 * D2R, 2.0 * std::f64::consts::PI * 1.0);
     let tr = Trajectory::new(
@@ -242,7 +244,8 @@ fn scenario_reference_lists_every_accepted_key() {
 
 #[test]
 fn mach1_truth_satisfies_navigation_equations() {
-    // Numerically differentiated truth against the increments (A1, docs/validation.md §"Song–Lee Table 1"): the
+    // Numerically differentiated truth against the increments (A1, docs/validation.md
+    // §"Song–Lee Table 1"): the
     // longitude advances at v_E/((R_N+h)cosL) (central difference of the truth), latitude
     // and height stay put, and the increments close the velocity equation
     // v̇ = C_b^n f + g − (2ω_ie + ω_en)×v = 0 to roundoff on every sample.

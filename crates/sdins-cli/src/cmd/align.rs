@@ -1,5 +1,6 @@
-//! `sdins align`: initial alignment of a stationary IMU (docs/theory/alignment.md): coarse 1-step / 2-step, 12-state Kalman fine alignment, multi-heading
-//! (Algorithm A, or B for scenarios), and the observability rank tables.
+//! `sdins align`: initial alignment of a stationary IMU (docs/theory/alignment.md): coarse 1-step /
+//! 2-step, 12-state Kalman fine alignment, multi-heading (Algorithm A, or B for scenarios), and the
+//! observability rank tables.
 //!
 //! Input is an IMU file (`--imu`) or a scenario (built-in name or file; its IMU error
 //! model applies with run index `--run`). Outputs in `--out` (if given):
@@ -34,7 +35,8 @@ use std::path::PathBuf;
 /// Alignment method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
-    /// 1-step analytic (TRIAD-type), polar-orthonormalised (docs/theory/alignment.md §"Coarse alignment")
+    /// 1-step analytic (TRIAD-type), polar-orthonormalised (docs/theory/alignment.md
+    /// §"Coarse alignment")
     Coarse1,
     /// 2-step: levelling + gyrocompassing (docs/theory/alignment.md §"Coarse alignment")
     Coarse2,
@@ -43,7 +45,8 @@ pub enum Method {
     I0,
     /// 12-state zero-velocity Kalman fine alignment (docs/theory/alignment.md §"Fine alignment")
     Fine,
-    /// multi-heading: one filter with body-frame bias states across rotations (docs/theory/alignment.md §"Multi-heading alignment")
+    /// multi-heading: one filter with body-frame bias states across rotations
+    /// (docs/theory/alignment.md §"Multi-heading alignment")
     Multiheading,
 }
 
@@ -52,8 +55,8 @@ pub enum Method {
 pub enum Alg {
     /// Algorithm A (docs/theory/alignment.md §"Multi-heading alignment"), recommended
     A,
-    /// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment", pseudo-error least squares; scenarios only: needs the
-    /// static phases)
+    /// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment", pseudo-error least
+    /// squares; scenarios only: needs the static phases)
     B,
 }
 
@@ -124,7 +127,8 @@ pub struct Args {
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
-    /// print the observability rank tables (docs/theory/alignment.md §"Observability at one heading") and exit
+    /// print the observability rank tables (docs/theory/alignment.md
+    /// §"Observability at one heading") and exit
     #[arg(long)]
     pub observability: bool,
 }
@@ -572,9 +576,10 @@ fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> String {
     s
 }
 
-/// The observability rank tables of docs/theory/alignment.md §"Observability at one heading" (single heading, NED bias states; pseudo
-/// 9-state model) and of the multi-heading case (stripped observability matrix, body-frame bias states,
-/// attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
+/// The observability rank tables of docs/theory/alignment.md §"Observability at one heading"
+/// (single heading, NED bias states; pseudo
+/// 9-state model) and of the multi-heading case (stripped observability matrix, body-frame bias
+/// states, attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
 pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     if !(lat_deg.is_finite() && lat_deg.abs() <= 80.0) {
         return Err(CliError::bad(format!(

@@ -1,5 +1,6 @@
 //! `sdins demo`: the papers' headline comparisons on built-in scenarios, with the
-//! the papers' reference numbers (docs/validation.md) printed beside ours, and one self-contained HTML report.
+//! papers' reference numbers (docs/validation.md) printed beside ours, and one
+//! self-contained HTML report.
 
 use super::run::{
     error_figure, execute_full, print_table, summary_rows, Args as RunArgs, Outcome, SUMMARY_HEADER,
@@ -63,7 +64,7 @@ fn section(
     r.para(&o.scn.description);
     r.table(&SUMMARY_HEADER, &summary_rows(&o.sums));
     if !paper_rows.is_empty() {
-        r.para("The papers' (reconstructed) and the specification's numbers for comparison:");
+        r.para("The papers' numbers (reconstructed, docs/validation.md) for comparison:");
         r.table(paper_header, paper_rows);
     }
     r.para(note);
@@ -129,7 +130,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 sl.final_err.vel_err_ned_mps,
             ))
             .min(ratio(sav.final_err.att_err_rad, sl.final_err.att_err_rad));
-        ratio_text = format!("Smallest Savage/Song-Lee ratio over all nine components: {q:.1} (the paper claims > 50). East and down agree with the paper within 2 %; the north error does not: the paper prints 0.01 m, we and the specification's independent reconstruction get 0.044 m. The paper states neither its latitude, constants nor exact evaluation time, and the north error of this due-east flight is the small residue of a Schuler oscillation, the component most sensitive to them; we report the difference rather than claim a reproduction.");
+        ratio_text = format!("Smallest Savage/Song-Lee ratio over all nine components: {q:.1} (the paper claims > 50). East and down agree with the paper within 2 %; the north error does not: the paper prints 0.01 m, we and an independent reconstruction get 0.044 m. The paper states neither its latitude, constants nor exact evaluation time, and the north error of this due-east flight is the small residue of a Schuler oscillation, the component most sensitive to them; we report the difference rather than claim a reproduction.");
         println!("  {ratio_text}");
     }
     let t1_header = [

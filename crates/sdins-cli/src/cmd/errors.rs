@@ -1,8 +1,9 @@
 //! `sdins errors`: analytic INS error propagation.
 //!
-//! Prints the full stationary closed form (docs/theory/error-analysis.md §"Full stationary closed form") for a
-//! set of NED sensor biases, next to the 15-state linear model's deterministic error and
-//! 1σ covariance envelope, at a few epochs; or, with `--schuler-share`, the
+//! Prints the full stationary closed form (docs/theory/error-analysis.md
+//! §"Full stationary closed form") for a set of NED sensor biases, next to the 15-state linear
+//! model's deterministic error and 1σ covariance envelope, at a few epochs; or, with
+//! `--schuler-share`, the
 //! reconstruction of \[P2\] Table 1 (docs/theory/error-analysis.md §"The Schuler share").
 //!
 //! Examples:

@@ -1,4 +1,6 @@
-//! Initial alignment of a stationary strapdown INS (docs/theory/alignment.md §"Coarse alignment"; docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md §"Multi-heading alignment").
+//! Initial alignment of a stationary strapdown INS (docs/theory/alignment.md §"Coarse alignment";
+//! docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md
+//! §"Multi-heading alignment").
 //!
 //! One file per concept:
 //! * [`coarse`]: 1-step analytic (TRIAD-type, polar-orthonormalised) and 2-step
@@ -6,22 +8,26 @@
 //!   and the corrected first-order error table (docs/theory/alignment.md §"Coarse alignment").
 //! * [`model`]: the 12-state stationary error model `F`, its discretisation, the null
 //!   space `n1, n2, n3`, the pseudo (observable) coordinates and the finite-prior
-//!   residual projector `Π` (docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md §"Observability at one heading").
+//! residual projector `Π` (docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md
+//!   §"Observability at one heading").
 //! * [`i0`]: inertial-frame coarse alignment on a disturbed (swaying, heaving) base
 //!   (gravity's apparent motion in the inertially frozen body frame, Wahba fit).
 //! * [`kf`]: the generic Kalman filter core (prediction, Joseph-form update).
 //! * [`fine`]: the 12-state zero-velocity Kalman fine alignment with its own stationary
-//!   attitude/velocity propagation, closed-loop reset or feed-forward (docs/theory/alignment.md §"Fine alignment",
+//! attitude/velocity propagation, closed-loop reset or feed-forward (docs/theory/alignment.md
+//!   §"Fine alignment",
 //!   Algorithm A with body-frame bias states, §"Multi-heading alignment").
 //! * [`observability`]: numerical rank and unobservable directions of piece-wise
-//!   constant `(F_j, H)` (docs/theory/alignment.md §"Observability at one heading": rank procedure, stripped observability matrix).
-//! * [`multiheading`]: Algorithm B of docs/theory/alignment.md §"Multi-heading alignment" (pseudo-error least squares) with the
-//!   exact attitude-error transition `Φ_k, Γ_k`.
+//! constant `(F_j, H)` (docs/theory/alignment.md §"Observability at one heading": rank procedure,
+//!   stripped observability matrix).
+//! * [`multiheading`]: Algorithm B of docs/theory/alignment.md §"Multi-heading alignment"
+//! (pseudo-error least squares) with the exact attitude-error transition `Φ_k, Γ_k`.
 //!
 //! Conventions: NED / FRD, `c_b_n`, attitude error convention G,
-//! `Ĉ_b^n = (I + [φ×]) C_b^n` (docs/conventions.md §"Errors"); use [`phi_tw_from_g`] for Titterton & Weston's
-//! ψ. Biases are "measured − true" (docs/theory/imu-errors.md §"IMU error model"); estimator bias states are residuals
-//! (true − current estimate).
+//! `Ĉ_b^n = (I + [φ×]) C_b^n` (docs/conventions.md §"Errors"); use [`phi_tw_from_g`] for Titterton
+//! & Weston's
+//! ψ. Biases are "measured − true" (docs/theory/imu-errors.md §"IMU error model"); estimator bias
+//! states are residuals (true − current estimate).
 //!
 //! Everything is `no_std` and allocation-free (fixed-size nalgebra matrices).
 
@@ -35,8 +41,8 @@ pub mod observability;
 
 use crate::math::Vec3;
 
-/// Converts a convention-G attitude error φ to Titterton & Weston's ψ (docs/conventions.md §"Errors":
-/// `ψ_TW = −φ_G`).
+/// Converts a convention-G attitude error φ to Titterton & Weston's ψ (docs/conventions.md
+/// §"Errors": `ψ_TW = −φ_G`).
 #[inline]
 pub fn phi_tw_from_g(phi_g: &Vec3) -> Vec3 {
     -phi_g
@@ -69,7 +75,8 @@ impl core::fmt::Display for AlignError {
 }
 
 /// Site constants used by every alignment algorithm: latitude, gravity magnitude and
-/// earth rate (docs/theory/error-analysis.md §"Constants and units"). The truth and the algorithm must use the same `g`.
+/// earth rate (docs/theory/error-analysis.md §"Constants and units"). The truth and the algorithm
+/// must use the same `g`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Site {
     /// geodetic latitude L \[rad\]

@@ -1,8 +1,9 @@
 //! Local-level (NED) mechanizations: Savage baseline (SAV), Song–Lee paper mode (SL)
-//! and Song–Lee complete (SLC) (docs/theory/mechanizations.md §"Song–Lee three-sample local-level algorithm").
+//! and Song–Lee complete (SLC) (docs/theory/mechanizations.md
+//! §"Song–Lee three-sample local-level algorithm").
 //!
-//! Computation order per update (S1 §IV, docs/theory/mechanizations.md §"Order per update"): velocity, then position, then
-//! attitude; every rate term is evaluated at t_{k−1}.
+//! Computation order per update (S1 §IV, docs/theory/mechanizations.md §"Order per update"):
+//! velocity, then position, then attitude; every rate term is evaluated at t_{k−1}.
 
 use super::{
     transport_matrix, transport_matrix_sc, wrap_pi, InitialState, Mechanization, NavState,
@@ -23,7 +24,8 @@ pub enum VelocityMode {
     SongLeeComplete,
 }
 
-/// Attitude-update formula (docs/theory/mechanizations.md §"Attitude by DCM separation"; docs/theory/mechanizations.md §"Order per update").
+/// Attitude-update formula (docs/theory/mechanizations.md §"Attitude by DCM separation";
+/// docs/theory/mechanizations.md §"Order per update").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AttitudeMode {
     /// S1 eq. (6)/(32): gyro-only quaternion `Q_k = Q_{k−1} ⊗ q(Δφ)`, `C_b^n = T(L, l, t) C(Q)`
@@ -34,14 +36,16 @@ pub enum AttitudeMode {
     Savage,
 }
 
-/// Which rotation vector the rotation compensation `½ x × Δv` uses (docs/theory/coning-sculling.md §"Coning and sculling").
+/// Which rotation vector the rotation compensation `½ x × Δv` uses (docs/theory/coning-sculling.md
+/// §"Coning and sculling").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RotVector {
     /// `½ Δθ × Δv`, Savage's `α_m × υ_m` (the summed gyro increment)
     Theta,
     /// `½ Δφ × Δv`, S1 eq. (30) (the coning-compensated rotation vector). Differs from
-    /// `Theta` by O(ΔT³)·coning; under 1 Hz coning (docs/validation.md §"dual-quaternion paper case") it is the more exact one
-    /// (closer to the dual-quaternion screw exponential, which contains it).
+    /// `Theta` by O(ΔT³)·coning; under 1 Hz coning (docs/validation.md
+    /// §"dual-quaternion paper case") it is the more exact one (closer to the dual-quaternion screw
+    /// exponential, which contains it).
     Phi,
 }
 
@@ -64,7 +68,8 @@ pub struct LocalLevelConfig {
     /// `½ΔT² Ȧ v`, i.e. first order globally; near the poles Ȧ is large (tanL grows with
     /// the northward motion) and this dominates. Used by `songlee-complete`.
     pub midpoint_rates: bool,
-    /// third-order rotation compensation `+ (1/6) Δφ×(Δφ×Δv)` (docs/theory/coning-sculling.md §"Coning and sculling")
+    /// third-order rotation compensation `+ (1/6) Δφ×(Δφ×Δv)` (docs/theory/coning-sculling.md
+    /// §"Coning and sculling")
     pub rot3: bool,
     /// earth model (must equal the truth's)
     pub earth: EarthModel,
@@ -77,7 +82,8 @@ pub struct LocalLevelConfig {
 pub struct LocalLevel {
     cfg: LocalLevelConfig,
     dt_update_s: f64,
-    // position carried as offsets from the start (docs/theory/mechanizations.md §"Position" roundoff recommendation)
+    // position carried as offsets from the start (docs/theory/mechanizations.md §"Position"
+    // roundoff recommendation)
     lat0_rad: f64,
     lon0_rad: f64,
     s_lat0: f64,
@@ -187,7 +193,8 @@ impl Mechanization for LocalLevel {
             }
         }
 
-        // 4. position, trapezoid with a latitude predictor (docs/theory/mechanizations.md §"Position")
+        // 4. position, trapezoid with a latitude predictor (docs/theory/mechanizations.md
+        //    §"Position")
         let h_new = h - 0.5 * (v.z + v_new.z) * dt;
         let h_bar = 0.5 * (h + h_new);
         let vn_bar = 0.5 * (v.x + v_new.x);

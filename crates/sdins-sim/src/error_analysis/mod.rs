@@ -7,14 +7,19 @@
 //! [`phi_g_from_psi_tw`] / [`psi_tw_from_phi_g`]. Units are SI (m, m/s, rad, rad/s, m/s²)
 //! unless a name says otherwise (`_ug`, `_dph`, `_h`).
 //!
-//! * [`periods`]: Schuler, Foucault and Earth-rate periods (docs/theory/error-analysis.md §"Periods"; docs/theory/error-analysis.md §"Constants and units").
-//! * [`short_term`]: the corrected single-channel formulas, the paper's (1)–(3) (docs/theory/error-analysis.md §"Single-channel formulas"),
-//!   with the 2 h validity limit enforced by a typed error.
-//! * [`stationary`]: the full stationary closed form (Schuler + 24 h + Foucault, docs/theory/error-analysis.md §"Full stationary closed form").
+//! * [`periods`]: Schuler, Foucault and Earth-rate periods (docs/theory/error-analysis.md
+//!   §"Periods"; docs/theory/error-analysis.md §"Constants and units").
+//! * [`short_term`]: the corrected single-channel formulas, the paper's (1)–(3)
+//! (docs/theory/error-analysis.md §"Single-channel formulas"), with the 2 h validity limit enforced
+//!   by a typed error.
+//! * [`stationary`]: the full stationary closed form (Schuler + 24 h + Foucault,
+//!   docs/theory/error-analysis.md §"Full stationary closed form").
 //! * [`linear_model`]: the 15-state phi-angle error model along any trajectory and the
 //!   covariance propagation `P = ΦPΦᵀ + Q`.
-//! * [`schuler_share`]: the reconstruction of the paper's Table 1 (docs/theory/error-analysis.md §"The Schuler share").
-//! * [`nonlinear`]: stationary nonlinear free-inertial runs with injected biases (docs/validation.md §"error propagation" T9).
+//! * [`schuler_share`]: the reconstruction of the paper's Table 1 (docs/theory/error-analysis.md
+//!   §"The Schuler share").
+//! * [`nonlinear`]: stationary nonlinear free-inertial runs with injected biases
+//!   (docs/validation.md §"error propagation" T9).
 //! * [`reference`](mod@reference): reference trajectories and error statistics for the linear model from
 //!   scenarios and IMU error models.
 //! * [`grades`]: the sensor-grade bias/noise values of docs/imu-errors.md §"Grades" used here.
@@ -45,7 +50,8 @@ pub fn phi_g_from_psi_tw(psi_tw: &Vec3) -> Vec3 {
     -psi_tw
 }
 
-/// Convert a convention-G attitude error to convention TW: `ψ_TW = −φ_G` (docs/conventions.md §"Errors").
+/// Convert a convention-G attitude error to convention TW: `ψ_TW = −φ_G` (docs/conventions.md
+/// §"Errors").
 pub fn psi_tw_from_phi_g(phi_g: &Vec3) -> Vec3 {
     -phi_g
 }

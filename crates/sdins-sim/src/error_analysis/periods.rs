@@ -1,4 +1,5 @@
-//! Schuler, Foucault and Earth-rate periods (docs/theory/error-analysis.md §"Periods", constants of its §"Constants and units").
+//! Schuler, Foucault and Earth-rate periods (docs/theory/error-analysis.md §"Periods", constants of
+//! its §"Constants and units").
 //!
 //! * Schuler: `ω_s = √(g/R0)`, `T_s = 2π √(R0/g)` = 84.41 min for R0 = 6371 km,
 //!   g = 9.80665 m/s². (The paper \[P2\] calls `√(g/R0)` "about 84.4 min"; that is the
@@ -9,7 +10,8 @@
 
 use core::f64::consts::TAU;
 
-/// Spherical-Earth constants of the Schuler analysis (docs/theory/error-analysis.md §"Constants and units").
+/// Spherical-Earth constants of the Schuler analysis (docs/theory/error-analysis.md
+/// §"Constants and units").
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct SchulerParams {
     /// Earth radius R0 \[m\]
@@ -21,16 +23,16 @@ pub struct SchulerParams {
 }
 
 impl SchulerParams {
-    /// The constants of the single-channel formula tables and the Schuler-share reconstruction:
-    /// R0 = 6 371 000 m, g = 9.80665 m/s², Ω = 7.292115e-5 rad/s.
+    /// The constants of the single-channel formula tables and the Schuler-share reconstruction: R0
+    /// = 6 371 000 m, g = 9.80665 m/s², Ω = 7.292115e-5 rad/s.
     pub const P2: SchulerParams = SchulerParams {
         r0_m: 6_371_000.0,
         g_mps2: 9.806_65,
         omega_ie_rps: 7.292_115e-5,
     };
 
-    /// The constants of the T9 24 h comparisons (docs/validation.md §"error propagation"): R0 = 6371 km with the local gravity of
-    /// the INS run, g(37.5°, 0) = 9.79949 m/s².
+    /// The constants of the T9 24 h comparisons (docs/validation.md §"error propagation"): R0 =
+    /// 6371 km with the local gravity of the INS run, g(37.5°, 0) = 9.79949 m/s².
     pub const T9: SchulerParams = SchulerParams {
         r0_m: 6_371_000.0,
         g_mps2: 9.799_49,
@@ -80,7 +82,8 @@ pub fn foucault_frequency(omega_ie_rps: f64, lat_rad: f64) -> f64 {
     omega_ie_rps * lat_rad.sin()
 }
 
-/// Foucault period `T_F = 2π/|Ω sin L|` \[s\] (docs/theory/error-analysis.md §"Periods"); infinite on the equator.
+/// Foucault period `T_F = 2π/|Ω sin L|` \[s\] (docs/theory/error-analysis.md §"Periods"); infinite
+/// on the equator.
 pub fn foucault_period_s(omega_ie_rps: f64, lat_rad: f64) -> f64 {
     TAU / foucault_frequency(omega_ie_rps, lat_rad).abs()
 }
@@ -98,7 +101,8 @@ mod tests {
     #[test]
     fn periods_match_spec_4_1() {
         let p = SchulerParams::P2;
-        // ω_s = 1.24067e-3 rad/s, T_s = 5064.4 s = 84.41 min (docs/theory/error-analysis.md §"Constants and units", rounded)
+        // ω_s = 1.24067e-3 rad/s, T_s = 5064.4 s = 84.41 min (docs/theory/error-analysis.md
+        // §"Constants and units", rounded)
         assert!((p.omega_s() - 1.240_67e-3).abs() < 0.000_005e-3);
         // 5064.4 s is the rounded value; 2π√(6371000/9.80665) = 5064.33 s (84.41 min holds)
         assert!((p.schuler_period_s() - 5064.4).abs() < 0.1);

@@ -67,7 +67,8 @@ pub const DPH: f64 = DEG / 3600.0;
 pub const DPSH: f64 = DEG / 60.0;
 /// Units: 1 °/h/√h in rad/s/√s.
 pub const DPHPSH: f64 = DPH / 60.0;
-/// Standard gravity for μg and g conversions \[m/s²\] (docs/theory/error-analysis.md §"Constants and units").
+/// Standard gravity for μg and g conversions \[m/s²\] (docs/theory/error-analysis.md
+/// §"Constants and units").
 pub const G0: f64 = 9.80665;
 /// Units: 1 μg in m/s².
 pub const UG: f64 = 1e-6 * G0;
@@ -433,7 +434,8 @@ mod tests {
 
     #[test]
     fn units_match_spec_table() {
-        // docs/theory/error-analysis.md §"Constants and units": 1 °/√h = 2.9089e-4 rad/√s, 1 °/h = 4.8481368e-6 rad/s,
+        // docs/theory/error-analysis.md §"Constants and units": 1 °/√h = 2.9089e-4 rad/√s, 1 °/h =
+        // 4.8481368e-6 rad/s,
         // 1 μg/√Hz = 5.88e-4 m/s/√h
         assert!((DPSH - 2.9089e-4).abs() < 1e-8);
         assert!((DPH - 4.8481368e-6).abs() < 1e-13);

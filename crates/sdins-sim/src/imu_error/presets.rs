@@ -46,7 +46,8 @@ use super::{ImuErrorModel, ImuErrorModelError, DEG, UG};
 use serde::Serialize;
 
 /// \[P2\]'s grade box of one grade: the bias ranges and Schuler-share range the paper
-/// reports (docs/theory/error-analysis.md §"The Schuler share"). These are the *paper's* boxes, used only to reproduce its Schuler
+/// reports (docs/theory/error-analysis.md §"The Schuler share"). These are the *paper's* boxes,
+/// used only to reproduce its Schuler
 /// share table (`sdins errors --schuler-share`); they are not a second set of sensor values
 /// (a grade's sensor is the row's turn-on biases and noise).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
