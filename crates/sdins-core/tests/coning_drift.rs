@@ -78,7 +78,7 @@ fn predicted(set: ConingSet, lambda: f64, alpha: f64) -> f64 {
 
 const ALPHA: f64 = 0.1 * std::f64::consts::PI / 180.0;
 
-/// docs/validation.md §"coning drift of all 7 sets" "meas" columns (λ = 0.4, λ = 0.8).
+/// Reference "meas" columns of docs/validation.md §"coning drift of all 7 sets" (λ = 0.4, λ = 0.8).
 const MEAS: [(ConingSet, f64, f64); 7] = [
     (ConingSet::None, -2.686e-6, -2.098e-5),
     (ConingSet::OnePrev, -8.501e-8, -2.569e-6),

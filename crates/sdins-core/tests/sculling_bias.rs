@@ -78,8 +78,7 @@ fn bias_z(set: ConingSet, lambda: f64) -> f64 {
     sum / updates as f64
 }
 
-/// docs/theory/coning-sculling.md §"Classical coning and sculling truth" "meas" columns (λ = 0.4, λ
-/// = 0.8) \[m/s²\].
+/// Reference "meas" columns of docs/validation.md §"sculling bias" (λ = 0.4, λ = 0.8) \[m/s²\].
 const MEAS: [(ConingSet, f64, f64, i32); 4] = [
     (ConingSet::Two, -4.632e-9, -7.306e-8, 4),
     (ConingSet::ThreePoly, 6.820e-10, 1.055e-8, 4),

@@ -675,7 +675,7 @@ impl Trajectory {
                 // roll and pitch and the heading's sin/cos from above
                 let [sr, cr, sp, cp] = self.consts.roll_pitch;
                 let c_nom = sdins_core::math::c_b_n_from_sin_cos((sr, cr), (sp, cp), (sh, ch));
-                // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (docs/conventions.md §"Quaternions")
+                // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (docs/conventions.md §"Euler angles")
                 let w_nom = Vec3::new(
                     -n.heading_dot * sp,
                     n.heading_dot * cp * sr,

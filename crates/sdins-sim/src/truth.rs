@@ -13,7 +13,7 @@
 //!   `[L, l, h, ∫ω_ib^b, ∫f^b]` with Gauss–Legendre collocation: one 3-node panel per
 //!   sample up to 16 substeps, else 4-node panels, `⌈substeps/32⌉` per sample (split
 //!   further at segment and overlay boundaries inside a sample, so that no panel straddles
-//! a kink); see [`TruthScheme::Gauss`] for the error bound. The classical RK4
+//!   a kink); see [`TruthScheme::Gauss`] for the error bound. The classical RK4
 //!   (docs/theory/mechanizations.md §"Truth generation"), with `substeps` steps per sample and
 //!   the analytic branch selected by the substep midpoint, is kept as the independent
 //!   reference ([`TruthGenerator::reference_rk4`], [`TruthScheme::Rk4`]).

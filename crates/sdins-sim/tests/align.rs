@@ -103,7 +103,7 @@ fn t1_coarse_noise_free_matches_corrected_table() {
     .unwrap();
     let c = tr.c_b_n0;
     let (da, eps) = (c * ref_ba(), c * ref_bg());
-    // docs/validation.md §"error propagation" REF: NED biases
+    // docs/theory/alignment.md §"Reference case": NED biases
     assert!((da / UG - Vec3::new(89.2243, -30.8676, 29.7693)).norm() < 1e-3);
     assert!((eps / DPH - Vec3::new(0.020261, -0.009774, 0.014797)).norm() < 1e-6);
     for (m, want_spec) in [

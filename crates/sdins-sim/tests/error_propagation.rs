@@ -99,10 +99,9 @@ fn t9_cases() -> Vec<T9Case> {
     ]
 }
 
-/// docs/validation.md §"error propagation" T9: 24 h nonlinear free-inertial INS (vertical held, L =
-/// 37.5°, body = NED,
-/// spherical earth R0 = 6371 km, g = 9.79949) vs the stationary closed form: max |INS − closed| ≤ 1
-/// % of the peak + 50 m, per horizontal channel, over 0–24 h; and
+/// docs/validation.md §"error propagation" T9: 24 h nonlinear free-inertial INS (vertical held,
+/// L = 37.5°, body = NED, spherical earth R0 = 6371 km, g = 9.79949) vs the stationary closed
+/// form: max |INS − closed| ≤ 1 % of the peak + 50 m, per horizontal channel, over 0–24 h; and
 /// the INS values at the reference table's epochs within the same tolerance.
 ///
 /// IMU 20 Hz, N = 2 (10 Hz updates), `songlee-complete`: with constant rates the
@@ -315,8 +314,8 @@ const REF_BIASES: &str =
     "[imu.errors]\ngyro_bias_dph = [0.01, -0.02, 0.015]\naccel_bias_ug = [50.0, -80.0, 30.0]";
 
 /// Linear error model vs the nonlinear difference over 1800 s within 12 % (relative to
-/// the channel's peak), for the REF biases (docs/validation.md §"error propagation") in body axes:
-/// stationary at the REF attitude (roll 2°, pitch −3°, yaw 40°) and the Mach-1 cruise (100 Hz IMU,
+/// the channel's peak), for the REF biases (docs/theory/alignment.md §"Reference case") in
+/// body axes: stationary at the REF attitude (roll 2°, pitch −3°, yaw 40°) and the Mach-1 cruise (100 Hz IMU,
 /// N = 2: the bias-driven error does not depend on the IMU rate, and the ideal run is subtracted).
 #[test]
 fn linear_model_matches_nonlinear_difference_1800s() {

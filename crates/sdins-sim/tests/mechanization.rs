@@ -1,7 +1,6 @@
 //! End-to-end acceptance of the mechanizations against the exact truth
 //! (docs/validation.md). Reference values are the signed numbers of the papers' cases as
-//! reconstructed
-//! there; tolerances ±5 % / ±10 % / bars. The 90-minute runs are release-mode `#[ignore]` tests.
+//! reconstructed there; tolerances ±5 % / ±10 % / bars. The 90-minute runs are release-mode `#[ignore]` tests.
 #![allow(clippy::unwrap_used)]
 mod common;
 use common::*;
@@ -99,8 +98,8 @@ fn dual_quaternion_paper_case_spec_7_5() {
         false,
     );
     let [c, dq, sav, conv_phi] = [&got[0][0], &got[1][0], &got[2][0], &got[3][0]];
-    // Conventional row (docs/validation.md §"dual-quaternion paper case" was computed with ½Δθ×Δv
-    // rotation compensation): ±10 %
+    // Conventional row (the reference values of docs/validation.md
+    // §"dual-quaternion paper case" were computed with ½Δθ×Δv rotation compensation): ±10 %
     let row = |e: &NavError| -> Vec<f64> {
         vec![
             e.pos_err_ned_m[0],

@@ -577,9 +577,8 @@ fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> String {
 }
 
 /// The observability rank tables of docs/theory/alignment.md §"Observability at one heading"
-/// (single heading, NED bias states; pseudo
-/// 9-state model) and of the multi-heading case (stripped observability matrix, body-frame bias
-/// states, attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
+/// (single heading, NED bias states; pseudo 9-state model) and of the multi-heading case
+/// (stripped observability matrix, body-frame bias states, attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
 pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     if !(lat_deg.is_finite() && lat_deg.abs() <= 80.0) {
         return Err(CliError::bad(format!(

@@ -3,8 +3,8 @@
 //! Prints the full stationary closed form (docs/theory/error-analysis.md
 //! §"Full stationary closed form") for a set of NED sensor biases, next to the 15-state linear
 //! model's deterministic error and 1σ covariance envelope, at a few epochs; or, with
-//! `--schuler-share`, the
-//! reconstruction of \[P2\] Table 1 (docs/theory/error-analysis.md §"The Schuler share").
+//! `--schuler-share`, the reconstruction of \[P2\] Table 1 (docs/theory/error-analysis.md
+//! §"The Schuler share").
 //!
 //! Examples:
 //! ```text

@@ -2,7 +2,7 @@
 //! docs/theory/alignment.md §"Multi-heading alignment" Algorithm A with body-frame bias states).
 //!
 //! The filter runs its own stationary attitude/velocity propagation at the IMU rate
-//! (docs/theory/alignment.md §"Fine alignment" "navigation in alignment mode"; position fixed), per
+//! (docs/theory/alignment.md §"Fine alignment", alignment mode; position fixed), per
 //! sample `j` of period δt:
 //!
 //! ```text
@@ -13,7 +13,7 @@
 //!
 //! The `½ Δθ' × Δv'` term (body-rotation compensation) keeps the velocity exact to first
 //! order while the IMU turns (multi-heading rotations at 10 °/s, docs/theory/alignment.md
-//! §"Multi-heading alignment": "a first-order increment update is exact enough"); the
+//! §"Multi-heading alignment": a first-order increment update is exact enough); the
 //! `−½ (ω_ie^n δt) × Ĉ Δv'` term is the matching navigation-frame rotation over the sample. At rest
 //! the two cancel exactly (without the second one the first leaves a spurious `½ ω_ie^n × f^n δt` ≈
 //! 0.3 μg east at 100 Hz). Every `kf_dt_s` seconds the

@@ -8,20 +8,20 @@
 //!   and the corrected first-order error table (docs/theory/alignment.md §"Coarse alignment").
 //! * [`model`]: the 12-state stationary error model `F`, its discretisation, the null
 //!   space `n1, n2, n3`, the pseudo (observable) coordinates and the finite-prior
-//! residual projector `Π` (docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md
+//!   residual projector `Π` (docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md
 //!   §"Observability at one heading").
 //! * [`i0`]: inertial-frame coarse alignment on a disturbed (swaying, heaving) base
 //!   (gravity's apparent motion in the inertially frozen body frame, Wahba fit).
 //! * [`kf`]: the generic Kalman filter core (prediction, Joseph-form update).
 //! * [`fine`]: the 12-state zero-velocity Kalman fine alignment with its own stationary
-//! attitude/velocity propagation, closed-loop reset or feed-forward (docs/theory/alignment.md
+//!   attitude/velocity propagation, closed-loop reset or feed-forward (docs/theory/alignment.md
 //!   §"Fine alignment",
 //!   Algorithm A with body-frame bias states, §"Multi-heading alignment").
 //! * [`observability`]: numerical rank and unobservable directions of piece-wise
-//! constant `(F_j, H)` (docs/theory/alignment.md §"Observability at one heading": rank procedure,
+//!   constant `(F_j, H)` (docs/theory/alignment.md §"Observability at one heading": rank procedure,
 //!   stripped observability matrix).
 //! * [`multiheading`]: Algorithm B of docs/theory/alignment.md §"Multi-heading alignment"
-//! (pseudo-error least squares) with the exact attitude-error transition `Φ_k, Γ_k`.
+//!   (pseudo-error least squares) with the exact attitude-error transition `Φ_k, Γ_k`.
 //!
 //! Conventions: NED / FRD, `c_b_n`, attitude error convention G,
 //! `Ĉ_b^n = (I + [φ×]) C_b^n` (docs/conventions.md §"Errors"); use [`phi_tw_from_g`] for Titterton
@@ -52,7 +52,8 @@ pub fn phi_tw_from_g(phi_g: &Vec3) -> Vec3 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum AlignError {
-    /// |latitude| > 80°: the sec L terms diverge (docs/theory/alignment.md §"Coarse alignment" "Validity").
+    /// |latitude| > 80°: the sec L terms diverge (docs/theory/alignment.md
+    /// §"Coarse alignment", validity).
     LatitudeTooHigh,
     /// The averaged specific force or rate is zero / not finite, or a matrix is singular.
     Degenerate,

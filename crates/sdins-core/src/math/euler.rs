@@ -1,5 +1,5 @@
 //! Euler angles, 3-2-1 sequence (yaw ψ, pitch θ, roll φ): `c_b_n = Rz(ψ) Ry(θ) Rx(φ)`
-//! (docs/conventions.md §"Quaternions", docs/conventions.md §"Frames").
+//! (docs/conventions.md §"Euler angles", §"Frames").
 
 use super::Mat3;
 

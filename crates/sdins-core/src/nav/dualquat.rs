@@ -165,7 +165,7 @@ pub struct DualQuatNav {
 }
 
 impl DualQuatNav {
-    /// Initialise (docs/theory/mechanizations.md §"Dual quaternion" "Initialisation").
+    /// Initialise (docs/theory/mechanizations.md §"Dual quaternion").
     pub fn new(
         earth: EarthModel,
         dt_s: f64,

@@ -3,7 +3,7 @@
 //!
 //! * [`LocalLevel`]: local-level NED mechanizations: the Savage baseline (`savage`), the
 //!   Song–Lee three-sample algorithm (`songlee`) and our complete version
-//! (`songlee-complete`) (docs/theory/mechanizations.md
+//!   (`songlee-complete`) (docs/theory/mechanizations.md
 //!   §"Song–Lee three-sample local-level algorithm").
 //! * [`DualQuatNav`]: Wu's dual-quaternion mechanization (`dualquat`, docs/theory/mechanizations.md
 //!   §"Dual quaternion").

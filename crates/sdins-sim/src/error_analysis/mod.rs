@@ -10,8 +10,8 @@
 //! * [`periods`]: Schuler, Foucault and Earth-rate periods (docs/theory/error-analysis.md
 //!   §"Periods"; docs/theory/error-analysis.md §"Constants and units").
 //! * [`short_term`]: the corrected single-channel formulas, the paper's (1)–(3)
-//! (docs/theory/error-analysis.md §"Single-channel formulas"), with the 2 h validity limit enforced
-//!   by a typed error.
+//!   (docs/theory/error-analysis.md §"Single-channel formulas"), with the 2 h validity limit
+//!   enforced by a typed error.
 //! * [`stationary`]: the full stationary closed form (Schuler + 24 h + Foucault,
 //!   docs/theory/error-analysis.md §"Full stationary closed form").
 //! * [`linear_model`]: the 15-state phi-angle error model along any trajectory and the

@@ -18,7 +18,7 @@ use super::periods::SchulerParams;
 use sdins_core::Vec3;
 
 /// Validity limit of the single-channel formulas: 2 h (docs/theory/error-analysis.md
-/// §"Single-channel formulas" "use (1)–(3) only for t ≲ 2 h").
+/// §"Single-channel formulas": t ≲ 2 h).
 pub const VALIDITY_LIMIT_S: f64 = 7200.0;
 
 /// Error of the checked short-term formulas.

@@ -580,7 +580,7 @@ mod tests {
         assert!(((s3 - acc.eval(H).dp_n[0]) / s3).abs() < 0.01);
     }
 
-    /// docs/validation.md §"error propagation" REF: body biases b_a = \[50, −80, 30\] μg, b_g =
+    /// docs/theory/alignment.md §"Reference case": body biases b_a = \[50, −80, 30\] μg, b_g =
     /// \[0.01, −0.02, 0.015\] °/h at roll 2°, pitch −3°, yaw 40° resolve to δa = \[89.2243,
     /// −30.8676, 29.7693\] μg and ε = \[0.020261, −0.009774, 0.014797\] °/h (printed digits).
     #[test]
