@@ -4,8 +4,8 @@
 //!
 //! For a coefficient set `k_ij` the rotation vector over the update interval is
 //! `Δφ = Σ Δθ_j + Σ_{i<j} k_ij Δθ_i × Δθ_j` (docs/theory/coning-sculling.md
-//! §"Coning and sculling"), and by the Ignagni duality the
-//! sculling term is `ΔV_scul = Σ_{i<j} k_ij (Δθ_i × Δv_j + Δv_i × Δθ_j)` (§"Coefficient sets"; for
+//! §"Coning and sculling"), and by the Ignagni duality the sculling term is
+//! `ΔV_scul = Σ_{i<j} k_ij (Δθ_i × Δv_j + Δv_i × Δθ_j)` (§"Coefficient sets"; for
 //! `three_poly` this is exactly S1 eq. (27)).
 
 use crate::math::Vec3;

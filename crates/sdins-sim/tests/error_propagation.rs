@@ -1,7 +1,6 @@
-//! Error propagation against nonlinear simulation:
-//! docs/validation.md §"error propagation" T9 (24 h free-running INS vs the stationary closed
-//! form), the linear model vs the nonlinear error over 1800 s, and the covariance propagation vs
-//! Monte Carlo σ.
+//! Error propagation against nonlinear simulation: docs/validation.md §"error propagation" T9 (24 h
+//! free-running INS vs the stationary closed form), the linear model vs the nonlinear error over
+//! 1800 s, and the covariance propagation vs Monte Carlo σ.
 //!
 //! The long cases are `#[ignore]` (run with `cargo test --release -- --ignored`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]

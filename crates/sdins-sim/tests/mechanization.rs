@@ -98,8 +98,8 @@ fn dual_quaternion_paper_case_spec_7_5() {
         false,
     );
     let [c, dq, sav, conv_phi] = [&got[0][0], &got[1][0], &got[2][0], &got[3][0]];
-    // Conventional row (the reference values of docs/validation.md
-    // §"dual-quaternion paper case" were computed with ½Δθ×Δv rotation compensation): ±10 %
+    // Conventional row (the reference values of docs/validation.md §"dual-quaternion paper case"
+    // were computed with ½Δθ×Δv rotation compensation): ±10 %
     let row = |e: &NavError| -> Vec<f64> {
         vec![
             e.pos_err_ned_m[0],

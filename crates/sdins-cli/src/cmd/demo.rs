@@ -1,6 +1,6 @@
 //! `sdins demo`: the papers' headline comparisons on built-in scenarios, with the
-//! papers' reference numbers (docs/validation.md) printed beside ours, and one
-//! self-contained HTML report.
+//! papers' reference numbers (docs/validation.md) printed beside ours, and one self-contained HTML
+//! report.
 
 use super::run::{
     error_figure, execute_full, print_table, summary_rows, Args as RunArgs, Outcome, SUMMARY_HEADER,

@@ -79,9 +79,8 @@ fn check(f_b: &Vec3, w_b: &Vec3, site: &Site) -> Result<(), AlignError> {
 /// ```
 ///
 /// followed by the **symmetric (polar) orthonormalisation** `Ĉ = U Vᵀ` (docs/theory/alignment.md
-/// §"Coarse alignment":
-/// only then does the error table of docs/theory/alignment.md §"Coarse alignment" hold; `C_n^b` and
-/// `M_n M_b^{-1}` share the polar factor).
+/// §"Coarse alignment": only then does the error table of docs/theory/alignment.md
+/// §"Coarse alignment" hold; `C_n^b` and `M_n M_b^{-1}` share the polar factor).
 pub fn one_step(f_b: &Vec3, w_b: &Vec3, site: &Site) -> Result<Mat3, AlignError> {
     check(f_b, w_b, site)?;
     let g = site.g_mps2;

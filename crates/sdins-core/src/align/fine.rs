@@ -16,10 +16,9 @@
 //! §"Multi-heading alignment": a first-order increment update is exact enough); the
 //! `−½ (ω_ie^n δt) × Ĉ Δv'` term is the matching navigation-frame rotation over the sample. At rest
 //! the two cancel exactly (without the second one the first leaves a spurious `½ ω_ie^n × f^n δt` ≈
-//! 0.3 μg east at 100 Hz). Every `kf_dt_s` seconds the
-//! filter predicts with `F(Ĉ)` (re-evaluated each cycle, docs/theory/alignment.md
-//! §"Fine alignment"), updates with the
-//! zero-velocity measurement `z = v̂ − 0` (docs/theory/alignment.md §"Fine alignment") and, in
+//! 0.3 μg east at 100 Hz). Every `kf_dt_s` seconds the filter predicts with `F(Ĉ)` (re-evaluated
+//! each cycle, docs/theory/alignment.md §"Fine alignment"), updates with the zero-velocity
+//! measurement `z = v̂ − 0` (docs/theory/alignment.md §"Fine alignment") and, in
 //! closed loop, resets:
 //!
 //! ```text
@@ -252,9 +251,8 @@ impl FineAlign {
 }
 
 /// Reference settings of docs/theory/alignment.md §"Fine alignment"; docs/validation.md
-/// §"fine alignment" T4 with NED bias states, closed loop, KF at 1 Hz,
-/// σ_z = 1 mm/s and P0 of docs/theory/alignment.md §"Fine alignment"; `vrw` \[m/s/√s\], `arw`
-/// \[rad/√s\].
+/// §"fine alignment" T4 with NED bias states, closed loop, KF at 1 Hz, σ_z = 1 mm/s and P0 of
+/// docs/theory/alignment.md §"Fine alignment"; `vrw` \[m/s/√s\], `arw` \[rad/√s\].
 pub fn reference_config(site: Site, vrw: f64, arw: f64) -> FineConfig {
     FineConfig {
         site,

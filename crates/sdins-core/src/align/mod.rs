@@ -15,8 +15,7 @@
 //! * [`kf`]: the generic Kalman filter core (prediction, Joseph-form update).
 //! * [`fine`]: the 12-state zero-velocity Kalman fine alignment with its own stationary
 //!   attitude/velocity propagation, closed-loop reset or feed-forward (docs/theory/alignment.md
-//!   §"Fine alignment",
-//!   Algorithm A with body-frame bias states, §"Multi-heading alignment").
+//!   §"Fine alignment", Algorithm A with body-frame bias states, §"Multi-heading alignment").
 //! * [`observability`]: numerical rank and unobservable directions of piece-wise
 //!   constant `(F_j, H)` (docs/theory/alignment.md §"Observability at one heading": rank procedure,
 //!   stripped observability matrix).
@@ -25,9 +24,8 @@
 //!
 //! Conventions: NED / FRD, `c_b_n`, attitude error convention G,
 //! `Ĉ_b^n = (I + [φ×]) C_b^n` (docs/conventions.md §"Errors"); use [`phi_tw_from_g`] for Titterton
-//! & Weston's
-//! ψ. Biases are "measured − true" (docs/theory/imu-errors.md §"IMU error model"); estimator bias
-//! states are residuals (true − current estimate).
+//! & Weston's ψ. Biases are "measured − true" (docs/theory/imu-errors.md §"IMU error model");
+//! estimator bias states are residuals (true − current estimate).
 //!
 //! Everything is `no_std` and allocation-free (fixed-size nalgebra matrices).
 
@@ -52,8 +50,8 @@ pub fn phi_tw_from_g(phi_g: &Vec3) -> Vec3 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum AlignError {
-    /// |latitude| > 80°: the sec L terms diverge (docs/theory/alignment.md
-    /// §"Coarse alignment", validity).
+    /// |latitude| > 80°: the sec L terms diverge (docs/theory/alignment.md §"Coarse alignment",
+    /// validity).
     LatitudeTooHigh,
     /// The averaged specific force or rate is zero / not finite, or a matrix is singular.
     Degenerate,

@@ -22,8 +22,8 @@ pub type Mat9 = SMatrix<f64, 9, 9>;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BiasFrame {
     /// NED-resolved `δa = C_b^n b_a`, `ε = C_b^n b_g` (docs/theory/alignment.md §"Fine alignment";
-    /// single heading only —
-    /// docs/theory/alignment.md §"Multi-heading alignment" shows it fails across rotations)
+    /// single heading only — docs/theory/alignment.md §"Multi-heading alignment" shows it fails
+    /// across rotations)
     Ned,
     /// body-frame residuals, bias blocks `Ĉ_b^n(t)` (docs/theory/alignment.md
     /// §"Multi-heading alignment" Algorithm A)

@@ -5,8 +5,8 @@
 //! For segments `j = 1..J` with system matrices `F_j` and a common `H`, the stripped
 //! observability matrix is `SOM = [O_1; …; O_J]`, `O_j = [H; H F_j; …; H F_j^{N−1}]`
 //! (Goshen-Meskin & Bar-Itzhack; valid here because `null(O_j) ⊂ null(F_j)`,
-//! docs/theory/alignment.md §"Observability at one heading").
-//! Procedure (docs/theory/alignment.md §"Observability at one heading"):
+//! docs/theory/alignment.md §"Observability at one heading"). Procedure (docs/theory/alignment.md
+//! §"Observability at one heading"):
 //!
 //! 1. build the rows of O in f64;
 //! 2. scale the columns by `D` (`scale`), i.e. use `O D`;

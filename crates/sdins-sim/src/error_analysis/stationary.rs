@@ -45,9 +45,8 @@
 //! only with `k = 1` (with `k` they are 4–23 m off, e.g. −4108 m at 6 h). Against the 15-state
 //! linear model (`linear_model`) over 24 h the maximum deviation is 7.8 m (`k = 1`) vs 18.5 m (`k`)
 //! for the down gyro, equal within 0.2 m for the other single-source cases and 90.6 vs 82.2 m for
-//! the combined T9 case: neither is uniformly
-//! better. Default: [`SlowGain::Unity`] (matches the T9 reference numbers); [`SlowGain::SchulerK`]
-//! is step 4 taken literally.
+//! the combined T9 case: neither is uniformly better. Default: [`SlowGain::Unity`] (matches the T9
+//! reference numbers); [`SlowGain::SchulerK`] is step 4 taken literally.
 //!
 //! Body-frame biases are accepted through [`StationaryErrors::from_body`] (`δa = C_b^n b_a`,
 //! `ε = C_b^n b_g`, docs/theory/imu-errors.md §"IMU error model").
