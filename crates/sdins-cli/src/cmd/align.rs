@@ -1,6 +1,6 @@
-//! `sdins align`: initial alignment of a stationary IMU (spec `alignment_and_errors.md`
-//! §1–§3): coarse 1-step / 2-step, 12-state Kalman fine alignment, multi-heading
-//! (Algorithm A, or B for scenarios), and the observability rank tables.
+//! `sdins align`: initial alignment of a stationary IMU (docs/theory/alignment.md): coarse 1-step /
+//! 2-step, 12-state Kalman fine alignment, multi-heading (Algorithm A, or B for scenarios), and the
+//! observability rank tables.
 //!
 //! Input is an IMU file (`--imu`) or a scenario (built-in name or file; its IMU error
 //! model applies with run index `--run`). Outputs in `--out` (if given):
@@ -35,26 +35,28 @@ use std::path::PathBuf;
 /// Alignment method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
-    /// 1-step analytic (TRIAD-type), polar-orthonormalised (spec §1.1)
+    /// 1-step analytic (TRIAD-type), polar-orthonormalised (docs/theory/alignment.md
+    /// §"Coarse alignment")
     Coarse1,
-    /// 2-step: levelling + gyrocompassing (spec §1.2)
+    /// 2-step: levelling + gyrocompassing (docs/theory/alignment.md §"Coarse alignment")
     Coarse2,
     /// inertial-frame coarse alignment, robust to sway, rocking, heave and surge
     /// (docs/alignment_i0.md); the attitude at the end of the window
     I0,
-    /// 12-state zero-velocity Kalman fine alignment (spec §2)
+    /// 12-state zero-velocity Kalman fine alignment (docs/theory/alignment.md §"Fine alignment")
     Fine,
-    /// multi-heading: one filter with body-frame bias states across rotations (spec §3.2)
+    /// multi-heading: one filter with body-frame bias states across rotations
+    /// (docs/theory/alignment.md §"Multi-heading alignment")
     Multiheading,
 }
 
 /// Multi-heading algorithm.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Alg {
-    /// Algorithm A (spec §3.2), recommended
+    /// Algorithm A (docs/theory/alignment.md §"Multi-heading alignment"), recommended
     A,
-    /// Algorithm B (spec §3.3, pseudo-error least squares; scenarios only: needs the
-    /// static phases)
+    /// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment", pseudo-error least
+    /// squares; scenarios only: needs the static phases)
     B,
 }
 
@@ -125,7 +127,8 @@ pub struct Args {
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
-    /// print the observability rank tables (spec §2.4, §3.1) and exit
+    /// print the observability rank tables (docs/theory/alignment.md
+    /// §"Observability at one heading") and exit
     #[arg(long)]
     pub observability: bool,
 }
@@ -587,9 +590,9 @@ fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> Result<String, 
     crate::csv_out::table(&HEADER, [(r.method.to_string(), cells)])
 }
 
-/// The observability rank tables of spec §2.4 (single heading, NED bias states; pseudo
-/// 9-state model) and §3.1 (stripped observability matrix, body-frame bias states,
-/// attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
+/// The observability rank tables of docs/theory/alignment.md §"Observability at one heading"
+/// (single heading, NED bias states; pseudo 9-state model) and of the multi-heading case
+/// (stripped observability matrix, body-frame bias states, attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
 pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     if !(lat_deg.is_finite() && lat_deg.abs() <= 80.0) {
         return Err(CliError::bad(format!(
@@ -657,7 +660,7 @@ pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     }
     let _ = writeln!(
         s,
-        "\nUnobservable directions, 1 heading (spec §2.4): n1 = φ_N + (−tan L) φ_D + (−g) δa_E; \
+        "\nUnobservable directions, 1 heading (docs/theory/alignment.md): n1 = φ_N + (−tan L) φ_D + (−g) δa_E; \
          n2 = φ_D + (−Ω cos L) ε_E; n3 = φ_E + g δa_N + Ω sin L ε_N + Ω cos L ε_D"
     );
     Ok(s)
