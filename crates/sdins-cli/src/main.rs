@@ -31,8 +31,6 @@ struct Cli {
     command: Command,
 }
 
-// parsed once per process: the size of the largest variant (`fuse`'s options) costs nothing
-#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Run the built-in showcase (the papers' comparisons) and print the tables.
