@@ -387,8 +387,71 @@ impl VibrationReport {
     }
 }
 
-/// Per-axis coefficients of one component: `[a, b, a/ω, b/ω]` for x, y, z.
-type Coef = [f64; 12];
+/// Per-axis coefficients of the components, by column: `4·axis + j` holds `a`, `b`, `a/ω`,
+/// `b/ω` (j = 0..3) of every component (structure of arrays, so that the sums vectorise).
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Coefs {
+    col: [Vec<f64>; 12],
+}
+
+impl Coefs {
+    fn is_empty(&self) -> bool {
+        self.col[0].is_empty()
+    }
+    fn amp(&self, k: usize, ax: usize) -> f64 {
+        self.col[4 * ax][k].hypot(self.col[4 * ax + 1][k])
+    }
+}
+
+/// Components per block of the vectorised sums.
+const LANES: usize = 2;
+
+/// `Σ_k (a cos + b sin)` and `Σ_k (a/ω sin − b/ω cos)` per axis, with the `(sin, cos)`
+/// of component `k`'s phase being the angle sum of `base[k]` and `off[k]`; summed in
+/// `LANES` partial sums per axis (fixed order: the same numbers on every machine and
+/// thread count).
+#[inline(always)]
+fn sums(c: &Coefs, base: &[(f64, f64)], off: &[(f64, f64)]) -> ([f64; 3], [f64; 3]) {
+    let n = c.col[0].len().min(base.len()).min(off.len());
+    let mut d = [[0.0; LANES]; 3];
+    let mut v = [[0.0; LANES]; 3];
+    let blocks = n / LANES;
+    let (bb, ob) = (&base[..blocks * LANES], &off[..blocks * LANES]);
+    for (blk, (b4, o4)) in bb.chunks_exact(LANES).zip(ob.chunks_exact(LANES)).enumerate() {
+        let k0 = blk * LANES;
+        let mut sn = [0.0; LANES];
+        let mut cs = [0.0; LANES];
+        for l in 0..LANES {
+            let ((sb, cb), (so, co)) = (b4[l], o4[l]);
+            sn[l] = sb * co + cb * so;
+            cs[l] = cb * co - sb * so;
+        }
+        for ax in 0..3 {
+            let a: &[f64; LANES] = c.col[4 * ax][k0..k0 + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let b: &[f64; LANES] = c.col[4 * ax + 1][k0..k0 + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let aw: &[f64; LANES] = c.col[4 * ax + 2][k0..k0 + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let bw: &[f64; LANES] = c.col[4 * ax + 3][k0..k0 + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            for l in 0..LANES {
+                d[ax][l] += a[l] * cs[l] + b[l] * sn[l];
+                v[ax][l] += aw[l] * sn[l] - bw[l] * cs[l];
+            }
+        }
+    }
+    for k in blocks * LANES..n {
+        let ((sb, cb), (so, co)) = (base[k], off[k]);
+        let (sn, cs) = (sb * co + cb * so, cb * co - sb * so);
+        let l = k % LANES;
+        for ax in 0..3 {
+            d[ax][l] += c.col[4 * ax][k] * cs + c.col[4 * ax + 1][k] * sn;
+            v[ax][l] += c.col[4 * ax + 2][k] * sn - c.col[4 * ax + 3][k] * cs;
+        }
+    }
+    let red = |x: [f64; LANES]| x[0] + x[1];
+    (
+        [red(v[0]), red(v[1]), red(v[2])],
+        [red(d[0]), red(d[1]), red(d[2])],
+    )
+}
 
 /// A realised random vibration: the kept frequencies and their coefficients.
 #[derive(Clone, Debug, PartialEq)]
@@ -396,9 +459,9 @@ pub struct RandomVibration {
     /// angular frequencies ω_k \[rad/s\]
     omega: Vec<f64>,
     /// specific-force coefficients (empty without an accel PSD)
-    lin: Vec<Coef>,
+    lin: Coefs,
     /// angular-rate coefficients (empty without a gyro PSD)
-    ang: Vec<Coef>,
+    ang: Coefs,
     /// `U(0)`, `Θ(0)`: subtracted so that the motion starts from rest
     u0: [f64; 3],
     th0: [f64; 3],
@@ -419,14 +482,25 @@ pub struct VibState {
     pub theta_dot: [f64; 3],
 }
 
-/// A Gauss–Legendre remainder bound: `Σ_k A_k δt (ω_k δt/P)^(2N)/D_N` for `P` panels.
-fn gauss_bound(omega: &[f64], coef: &[Coef], dt: f64, p: f64, two_n: i32, d: f64) -> f64 {
-    omega
-        .iter()
-        .zip(coef)
-        .map(|(&w, c)| {
-            let amp: f64 = (0..3).map(|i| c[4 * i].hypot(c[4 * i + 1])).sum();
-            amp * dt * (w * dt / p).powi(two_n) / d
+/// The Gauss–Legendre remainder of the vibration per sample for `P` panels: the
+/// remainder of a panel is `H^(2N+1) f^(2N)(ξ)/D_N`, and `f^(2N)` of the realised sum is
+/// itself a Gaussian sum `Σ_k ω_k^(2N) (a_k cos + b_k sin)` of variance
+/// `Σ_k ω_k^(4N) (a_k² + b_k²)/2` per axis; its peak over ≤ 1e8 nodes stays below 6σ
+/// (two-sided 2e-9), so the bound is `6·√(Σ_k (a_k² + b_k²)/2 · (ω_k H)^(4N)) · δt/D_N`
+/// summed over the axes (a strict `Σ |A_k|` bound would charge every component at its
+/// peak at once, ~√K/6 times more).
+fn gauss_bound(omega: &[f64], coef: &Coefs, dt: f64, p: f64, two_n: i32, d: f64) -> f64 {
+    if coef.is_empty() {
+        return 0.0;
+    }
+    (0..3)
+        .map(|ax| {
+            let var: f64 = omega
+                .iter()
+                .enumerate()
+                .map(|(k, &w)| 0.5 * coef.amp(k, ax).powi(2) * (w * dt / p).powi(2 * two_n))
+                .sum();
+            6.0 * var.sqrt() * dt / d
         })
         .sum()
 }
@@ -498,12 +572,15 @@ impl RandomVibration {
         }
         let kept: Vec<usize> = (1..=k_max).filter(|&k| keep[k]).collect();
         let omega: Vec<f64> = kept.iter().map(|&k| 2.0 * PI * k as f64 * df).collect();
-        let mut coefs: [Vec<Coef>; 2] = [Vec::new(), Vec::new()];
+        let mut coefs: [Coefs; 2] = Default::default();
         for kind in 0..2 {
             if tables[kind].is_none() {
                 continue;
             }
-            let mut c = vec![[0.0; 12]; kept.len()];
+            let mut c = Coefs::default();
+            for col in c.col.iter_mut() {
+                *col = vec![0.0; kept.len()];
+            }
             for ax in 0..3 {
                 // one stream per (overlay, kind, axis); draws for every k ≤ k_max in order,
                 // so the threshold does not shift the numbers of other components
@@ -519,7 +596,9 @@ impl RandomVibration {
                     let s = sig[kind][ax][k];
                     let (a, b) = (s * draws[k].0, s * draws[k].1);
                     let w = omega[j];
-                    c[j][4 * ax..4 * ax + 4].copy_from_slice(&[a, b, a / w, b / w]);
+                    for (q, x) in [a, b, a / w, b / w].into_iter().enumerate() {
+                        c.col[4 * ax + q][j] = x;
+                    }
                 }
             }
             coefs[kind] = c;
@@ -563,31 +642,50 @@ impl RandomVibration {
         &self.omega
     }
 
-    /// Gauss panels of 4 nodes per sample of `dt_s` that keep the quadrature remainder
-    /// of the vibration below 1e-17 m/s and 1e-19 rad per sample (0 if one 3-node panel
-    /// does): the bound `Σ_k A_k δt (ω_k H)^(2N)/D_N` of the Gauss rule
-    /// (`D₃ = 2 016 000`, `D₄ = 1 778 112 000`; [`crate::truth::TruthScheme::Gauss`]).
-    pub fn gauss_panels(&self, dt_s: f64) -> usize {
-        let ok = |p: f64, two_n: i32, d: f64| {
-            gauss_bound(&self.omega, &self.lin, dt_s, p, two_n, d) <= 1e-17
-                && gauss_bound(&self.omega, &self.ang, dt_s, p, two_n, d) <= 1e-19
+    /// The Gauss remainder bounds `(m/s, rad)` per sample of `dt_s` for `panels` panels
+    /// of `nodes` (3 or 4) nodes: the 6σ bound of the realised sum (`D₃ = 2 016 000`, `D₄ = 1 778 112 000`;
+    /// [`crate::truth::TruthScheme::Gauss`]).
+    pub fn gauss_remainder(&self, dt_s: f64, panels: usize, nodes: usize) -> (f64, f64) {
+        let (two_n, d) = if nodes == 3 {
+            (6, 2_016_000.0)
+        } else {
+            (8, 1_778_112_000.0)
         };
-        if ok(1.0, 6, 2_016_000.0) {
+        let p = panels as f64;
+        (
+            gauss_bound(&self.omega, &self.lin, dt_s, p, two_n, d),
+            gauss_bound(&self.omega, &self.ang, dt_s, p, two_n, d),
+        )
+    }
+
+    /// Gauss panels of 4 nodes per sample of `dt_s` that keep the remainder bound
+    /// ([`RandomVibration::gauss_remainder`]) of the vibration below one rounding of the
+    /// increments, `ε·g·δt` m/s and `ε·max(ω_ie, σ_ω)·δt` rad (`ε = 2.2e-16`, `σ_ω` the
+    /// realised RMS angular rate); 0 if one 3-node panel does.
+    pub fn gauss_panels(&self, dt_s: f64) -> usize {
+        let eps = f64::EPSILON;
+        let tol_v = eps * 9.81 * dt_s;
+        let (_, pw) = self.coefficient_power();
+        let sigma_w = (pw[0] + pw[1] + pw[2]).sqrt();
+        let tol_th = eps * sigma_w.max(7.292_115e-5) * dt_s;
+        let ok = |p: usize, n: usize| {
+            let (v, th) = self.gauss_remainder(dt_s, p, n);
+            v <= tol_v && th <= tol_th
+        };
+        if ok(1, 3) {
             return 0;
         }
-        (1..=4096)
-            .find(|&p| ok(p as f64, 8, 1_778_112_000.0))
-            .unwrap_or(4096)
+        (1..=128).find(|&p| ok(p, 4)).unwrap_or(128)
     }
 
     /// Realised variance of the specific force (per axis) from the coefficients:
     /// `Σ (a_k² + b_k²)/2`, the exact mean square over a whole window.
     pub fn coefficient_power(&self) -> ([f64; 3], [f64; 3]) {
-        let p = |c: &[Coef]| {
+        let p = |c: &Coefs| {
             let mut s = [0.0; 3];
-            for c in c {
-                for (ax, s) in s.iter_mut().enumerate() {
-                    *s += 0.5 * (c[4 * ax] * c[4 * ax] + c[4 * ax + 1] * c[4 * ax + 1]);
+            for (ax, s) in s.iter_mut().enumerate() {
+                for (a, b) in c.col[4 * ax].iter().zip(&c.col[4 * ax + 1]) {
+                    *s += 0.5 * (a * a + b * b);
                 }
             }
             s
@@ -604,33 +702,18 @@ impl RandomVibration {
     /// `ω_k τ` (else computed).
     fn raw(&self, tau: f64, phases: Option<(&[(f64, f64)], &[(f64, f64)])>) -> VibState {
         let mut st = VibState::default();
-        let acc = |coef: &[Coef], val: &mut [f64; 3], der: &mut [f64; 3]| {
+        let acc = |coef: &Coefs, val: &mut [f64; 3], der: &mut [f64; 3]| {
             if coef.is_empty() {
                 return;
             }
-            let (mut v, mut d) = ([0.0; 3], [0.0; 3]);
-            let mut add = |c: &Coef, s: f64, co: f64| {
-                for ax in 0..3 {
-                    let [a, b, aw, bw] = [c[4 * ax], c[4 * ax + 1], c[4 * ax + 2], c[4 * ax + 3]];
-                    d[ax] += a * co + b * s;
-                    v[ax] += aw * s - bw * co;
+            (*val, *der) = match phases {
+                Some((base, off)) => sums(coef, base, off),
+                None => {
+                    let ph: Vec<(f64, f64)> =
+                        self.omega.iter().map(|w| (w * tau).sin_cos()).collect();
+                    sums(coef, &ph, &vec![(0.0, 1.0); ph.len()])
                 }
             };
-            match phases {
-                Some((base, off)) => {
-                    for ((c, &(sb, cb)), &(so, c_o)) in coef.iter().zip(base).zip(off) {
-                        add(c, sb * c_o + cb * so, cb * c_o - sb * so);
-                    }
-                }
-                None => {
-                    for (c, w) in coef.iter().zip(&self.omega) {
-                        let (s, co) = (w * tau).sin_cos();
-                        add(c, s, co);
-                    }
-                }
-            }
-            *val = v;
-            *der = d;
         };
         acc(&self.lin, &mut st.u, &mut st.u_dot);
         acc(&self.ang, &mut st.theta, &mut st.theta_dot);
