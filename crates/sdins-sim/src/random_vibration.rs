@@ -387,24 +387,45 @@ impl VibrationReport {
     }
 }
 
-/// Per-axis coefficients of the components, by column: `4·axis + j` holds `a`, `b`, `a/ω`,
-/// `b/ω` (j = 0..3) of every component (structure of arrays, so that the sums vectorise).
+/// Components per block of the vectorised sums.
+const LANES: usize = 2;
+/// Floats per block: per axis `a`, `b`, `a/ω`, `b/ω` of the `LANES` components.
+const BLOCK: usize = 12 * LANES;
+
+/// Per-axis coefficients of the components `a`, `b`, `a/ω`, `b/ω`, interleaved in blocks of
+/// `LANES` components (`[axis][quantity][lane]` within a block), so that the sums run
+/// through one contiguous array; the last block is padded with zeros.
 #[derive(Clone, Debug, Default, PartialEq)]
 struct Coefs {
-    col: [Vec<f64>; 12],
+    n: usize,
+    data: Vec<f64>,
 }
 
 impl Coefs {
+    fn new(n: usize) -> Self {
+        Coefs {
+            n,
+            data: vec![0.0; n.div_ceil(LANES) * BLOCK],
+        }
+    }
     fn is_empty(&self) -> bool {
-        self.col[0].is_empty()
+        self.n == 0
+    }
+    #[inline]
+    fn idx(k: usize, ax: usize, q: usize) -> usize {
+        (k / LANES) * BLOCK + (4 * ax + q) * LANES + k % LANES
+    }
+    fn get(&self, k: usize, ax: usize, q: usize) -> f64 {
+        self.data[Self::idx(k, ax, q)]
+    }
+    fn set(&mut self, k: usize, ax: usize, q: usize, x: f64) {
+        let i = Self::idx(k, ax, q);
+        self.data[i] = x;
     }
     fn amp(&self, k: usize, ax: usize) -> f64 {
-        self.col[4 * ax][k].hypot(self.col[4 * ax + 1][k])
+        self.get(k, ax, 0).hypot(self.get(k, ax, 1))
     }
 }
-
-/// Components per block of the vectorised sums.
-const LANES: usize = 2;
 
 /// `Σ_k (a cos + b sin)` and `Σ_k (a/ω sin − b/ω cos)` per axis, with the `(sin, cos)`
 /// of component `k`'s phase being the angle sum of `base[k]` and `off[k]`; summed in
@@ -412,41 +433,42 @@ const LANES: usize = 2;
 /// thread count).
 #[inline(always)]
 fn sums(c: &Coefs, base: &[(f64, f64)], off: &[(f64, f64)]) -> ([f64; 3], [f64; 3]) {
-    let n = c.col[0].len().min(base.len()).min(off.len());
     let mut d = [[0.0; LANES]; 3];
     let mut v = [[0.0; LANES]; 3];
-    let blocks = n / LANES;
-    let (bb, ob) = (&base[..blocks * LANES], &off[..blocks * LANES]);
-    for (blk, (b4, o4)) in bb.chunks_exact(LANES).zip(ob.chunks_exact(LANES)).enumerate() {
-        let k0 = blk * LANES;
+    let n = c.n.min(base.len()).min(off.len());
+    let full = n / LANES;
+    let blocks = c.data.chunks_exact(BLOCK);
+    for ((blk, b2), o2) in blocks
+        .clone()
+        .zip(base.chunks_exact(LANES))
+        .zip(off.chunks_exact(LANES))
+        .take(full)
+    {
         let mut sn = [0.0; LANES];
         let mut cs = [0.0; LANES];
         for l in 0..LANES {
-            let ((sb, cb), (so, co)) = (b4[l], o4[l]);
+            let ((sb, cb), (so, co)) = (b2[l], o2[l]);
             sn[l] = sb * co + cb * so;
             cs[l] = cb * co - sb * so;
         }
         for ax in 0..3 {
-            let a: &[f64; LANES] = c.col[4 * ax][k0..k0 + LANES].try_into().unwrap_or(&[0.0; LANES]);
-            let b: &[f64; LANES] = c.col[4 * ax + 1][k0..k0 + LANES].try_into().unwrap_or(&[0.0; LANES]);
-            let aw: &[f64; LANES] = c.col[4 * ax + 2][k0..k0 + LANES].try_into().unwrap_or(&[0.0; LANES]);
-            let bw: &[f64; LANES] = c.col[4 * ax + 3][k0..k0 + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let q = &blk[4 * LANES * ax..4 * LANES * (ax + 1)];
             for l in 0..LANES {
-                d[ax][l] += a[l] * cs[l] + b[l] * sn[l];
-                v[ax][l] += aw[l] * sn[l] - bw[l] * cs[l];
+                d[ax][l] += q[l] * cs[l] + q[LANES + l] * sn[l];
+                v[ax][l] += q[2 * LANES + l] * sn[l] - q[3 * LANES + l] * cs[l];
             }
         }
     }
-    for k in blocks * LANES..n {
+    for k in full * LANES..n {
         let ((sb, cb), (so, co)) = (base[k], off[k]);
         let (sn, cs) = (sb * co + cb * so, cb * co - sb * so);
         let l = k % LANES;
         for ax in 0..3 {
-            d[ax][l] += c.col[4 * ax][k] * cs + c.col[4 * ax + 1][k] * sn;
-            v[ax][l] += c.col[4 * ax + 2][k] * sn - c.col[4 * ax + 3][k] * cs;
+            d[ax][l] += c.get(k, ax, 0) * cs + c.get(k, ax, 1) * sn;
+            v[ax][l] += c.get(k, ax, 2) * sn - c.get(k, ax, 3) * cs;
         }
     }
-    let red = |x: [f64; LANES]| x[0] + x[1];
+    let red = |x: [f64; LANES]| x.iter().sum::<f64>();
     (
         [red(v[0]), red(v[1]), red(v[2])],
         [red(d[0]), red(d[1]), red(d[2])],
@@ -577,10 +599,7 @@ impl RandomVibration {
             if tables[kind].is_none() {
                 continue;
             }
-            let mut c = Coefs::default();
-            for col in c.col.iter_mut() {
-                *col = vec![0.0; kept.len()];
-            }
+            let mut c = Coefs::new(kept.len());
             for ax in 0..3 {
                 // one stream per (overlay, kind, axis); draws for every k ≤ k_max in order,
                 // so the threshold does not shift the numbers of other components
@@ -597,7 +616,7 @@ impl RandomVibration {
                     let (a, b) = (s * draws[k].0, s * draws[k].1);
                     let w = omega[j];
                     for (q, x) in [a, b, a / w, b / w].into_iter().enumerate() {
-                        c.col[4 * ax + q][j] = x;
+                        c.set(j, ax, q, x);
                     }
                 }
             }
@@ -684,7 +703,8 @@ impl RandomVibration {
         let p = |c: &Coefs| {
             let mut s = [0.0; 3];
             for (ax, s) in s.iter_mut().enumerate() {
-                for (a, b) in c.col[4 * ax].iter().zip(&c.col[4 * ax + 1]) {
+                for k in 0..c.n {
+                    let (a, b) = (c.get(k, ax, 0), c.get(k, ax, 1));
                     *s += 0.5 * (a * a + b * b);
                 }
             }
