@@ -713,6 +713,20 @@ impl RandomVibration {
         (p(&self.lin), p(&self.ang))
     }
 
+    /// The specific-force variance per axis of the sample means over `dt_s` (what
+    /// `Δv/δt` carries): `Σ (a_k² + b_k²)/2 · sinc²(ω_k δt/2)`.
+    pub fn coefficient_power_filtered(&self, dt_s: f64) -> [f64; 3] {
+        let mut s = [0.0; 3];
+        for (ax, s) in s.iter_mut().enumerate() {
+            for (k, &w) in self.omega.iter().enumerate().take(self.lin.n) {
+                let x = 0.5 * w * dt_s;
+                let (a, b) = (self.lin.get(k, ax, 0), self.lin.get(k, ax, 1));
+                *s += 0.5 * (a * a + b * b) * (x.sin() / x).powi(2);
+            }
+        }
+        s
+    }
+
     /// `(sin, cos)` of `ω_k τ` for every component, appended to `out`.
     pub(crate) fn push_phases(&self, tau: f64, out: &mut Vec<(f64, f64)>) {
         out.extend(self.omega.iter().map(|w| (w * tau).sin_cos()));
