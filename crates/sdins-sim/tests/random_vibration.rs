@@ -44,7 +44,7 @@ fn bad_psd_input_is_a_located_error() {
         ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,-1e-3,1e-3\n", "p.csv:3:8: negative PSD"),
         ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n0,1e-3,1e-3,1e-3\n", "p.csv:3:1: frequency 0 Hz does not increase"),
         ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,NaN,1e-3\n", "p.csv:3:8: NaN: must be finite"),
-        ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,1e-3\n", "p.csv:3:1: 3 columns"),
+        ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,1e-3\n", "p.csv:3:1: expected 2 (freq, psd) or 4 (freq, x, y, z) columns, found 3"),
     ] {
         let p = dir.join("p.csv");
         std::fs::write(&p, body).unwrap();
