@@ -528,8 +528,8 @@ fn welch_angular_rate_matches_breakpoints() {
     let bp = vec![
         vec![0.5, 1e-7, 2e-7, 5e-8],
         vec![2.0, 4e-6, 8e-6, 2e-6],
-        vec![8.0, 4e-6, 8e-6, 2e-6],
-        vec![20.0, 1e-8, 2e-8, 5e-9],
+        vec![5.0, 4e-6, 8e-6, 2e-6],
+        vec![10.0, 1e-8, 2e-8, 5e-9],
     ];
     let psd = PsdTable::from_breakpoints(&bp, "bp").unwrap();
     let rows: Vec<String> = bp
