@@ -321,6 +321,7 @@ def fuse(
     until_s: Optional[float] = None,
     smooth: Optional[bool] = None,
     in_motion: Optional[bool] = None,
+    scale_factors_ppm: Optional[Tuple[float, float]] = None,
 ) -> FuseResult:
     """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``); the scenario's
     ``[gnss]`` table sets the receiver.
@@ -332,12 +333,17 @@ def fuse(
     ``nhc_sigma_mps`` None (off), ``until_s`` None (whole scenario), ``smooth`` False
     (True: the Rauch–Tung–Striebel smoother; ``result.smoothed`` then holds the smoothed
     epochs with the same fields as the forward ones), ``in_motion`` False (True: in-motion
-    alignment from an unknown heading, started at the first fix at ≥ 5 m/s).
+    alignment from an unknown heading, started at the first fix at ≥ 5 m/s),
+    ``scale_factors_ppm`` None (15 states; ``(accel_ppm, gyro_ppm)``: the 21-state filter
+    that also estimates the accelerometer and gyro scale factors with that prior σ per
+    axis; the result then has ``scale_factor_error`` / ``scale_factor_sigma`` (n × 6,
+    dimensionless, accel x y z then gyro x y z) and the ``accel_scale_est`` /
+    ``accel_scale_true`` / ``gyro_scale_est`` / ``gyro_scale_true`` summaries).
     """
     return FuseResult(
         _sdins.fuse(
             _scenario(scenario), algo, samples, run, cov_rate_hz, gate, exact_start,
-            zupt_sigma_mps, nhc_sigma_mps, until_s, smooth, in_motion,
+            zupt_sigma_mps, nhc_sigma_mps, until_s, smooth, in_motion, scale_factors_ppm,
         )
     )
 
@@ -362,6 +368,7 @@ def fuse_files(
     gate: Optional[bool] = None,
     nhc_sigma_mps: Optional[float] = None,
     gnss_offset_s: Optional[float] = None,
+    scale_factors_ppm: Optional[Tuple[float, float]] = None,
 ) -> Dict[str, Any]:
     """INS/GNSS filter (and smoother) on recorded files (``sdins fuse --imu --gnss``).
 
@@ -375,7 +382,10 @@ def fuse_files(
     with per navigation update ``t_s`` (IMU clock) [s], ``lat_rad``, ``lon_rad``, ``h_m``,
     ``v_ned_mps`` (n, 3), ``euler_rad`` (n, 3: roll, pitch, yaw), ``sigma_nav`` (n, 9:
     N, E, D [m], v N, E, D [m/s], ε N, E, D [rad]), ``sigma_euler_rad`` (n, 3), ``bias``
-    (n, 6: accelerometer [m/s²], gyro [rad/s]); ``innovations`` (t_s, nis, dof,
+    (n, 6: accelerometer [m/s²], gyro [rad/s]), ``scale_factor`` and
+    ``sigma_scale_factor`` (n, 6: accelerometer then gyro, dimensionless; zero unless
+    ``scale_factors_ppm = (accel_ppm, gyro_ppm)`` selects the 21-state filter with that
+    prior σ); ``innovations`` (t_s, nis, dof,
     accepted); ``fixes_used``, ``rejected``, ``fixes_outside`` (before, after),
     ``imu_samples``; with ``truth``: ``forward_rmse`` / ``smoothed_rmse`` (roll, pitch,
     yaw [rad], v N, E, D [m/s], N, E, D [m]) and their ``*_inside_3sigma`` fractions.
@@ -387,4 +397,5 @@ def fuse_files(
         static_s,
         None if lever_arm_m is None else [float(x) for x in lever_arm_m],
         truth, smooth, algo, samples, cov_rate_hz, gate, nhc_sigma_mps, gnss_offset_s,
+        scale_factors_ppm,
     )

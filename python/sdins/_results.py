@@ -361,7 +361,11 @@ class FuseResult:
     ``accepted``, ``forced``, ``innovation`` (m, 6; first ``dof`` used). Summary:
     ``fixes``, ``rejected``, ``nav_updates``, ``accel_bias_est_mps2``,
     ``accel_bias_true_mps2``, ``gyro_bias_est_rps``, ``gyro_bias_true_rps``, ``samples``,
-    ``run``."""
+    ``run``. With ``scale_factors_ppm`` (the 21-state filter) also
+    ``scale_factor_error`` / ``scale_factor_sigma`` (n, 6; true error ``s − ŝ`` and 1σ,
+    dimensionless, accelerometer x y z then gyro x y z) and ``accel_scale_est``,
+    ``accel_scale_true``, ``gyro_scale_est``, ``gyro_scale_true``; otherwise those are
+    None."""
 
     def __init__(self, d: Dict[str, Any]):
         self.t_s: np.ndarray = d["t_s"]
@@ -382,6 +386,10 @@ class FuseResult:
             "innovation": inn["innovation"],
         }
         self.smoothed: Optional[Dict[str, Any]] = d.get("smoothed")
+        self.scale_factor_error: Optional[np.ndarray] = d.get("scale_factor_error")
+        self.scale_factor_sigma: Optional[np.ndarray] = d.get("scale_factor_sigma")
+        for k in ("accel_scale_est", "accel_scale_true", "gyro_scale_est", "gyro_scale_true"):
+            setattr(self, k, d.get(k))
         for k in (
             "fixes", "rejected", "nav_updates", "accel_bias_est_mps2", "accel_bias_true_mps2",
             "gyro_bias_est_rps", "gyro_bias_true_rps", "samples", "run",

@@ -177,3 +177,21 @@ def test_fuse_files_bad_input_raises_located_error(tmp_path):
                          init="37.5,127,0,0,0,0,0,0,0")
     with pytest.raises(sdins.SdinsError, match="--grade"):
         sdins.fuse_files(str(imu), str(g), init="37.5,127,0,0,0,0,0,0,0")
+
+
+def test_fuse_scale_factors_equal_cli(cli, tmp_path):
+    code, out, err = cli(
+        "fuse", "dq-paper", "--json", "--scale-factors-ppm", "300,500", "--out", str(tmp_path / "f")
+    )
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.fuse("dq-paper", scale_factors_ppm=(300.0, 500.0))
+    n = r.t_s.shape[0]
+    assert r.scale_factor_error.shape == (n, 6) and r.scale_factor_sigma.shape == (n, 6)
+    # the prior σ at the first epoch (the scale factors barely move in one epoch)
+    assert abs(r.scale_factor_sigma[0, 0] - 300e-6) < 30e-6
+    assert abs(r.scale_factor_sigma[0, 3] - 500e-6) < 50e-6
+    assert [x * 1e6 for x in r.gyro_scale_est] == js["gyro_scale_est_ppm"]
+    assert [x * 1e6 for x in r.accel_scale_true] == js["accel_scale_true_ppm"]
+    # without the option: no scale-factor states
+    assert sdins.fuse("dq-paper", until_s=5.0).scale_factor_error is None

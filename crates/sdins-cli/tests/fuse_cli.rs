@@ -36,11 +36,29 @@ fn fuse_writes_outputs_and_rejects_bad_options() {
     }
     let nav = std::fs::read_to_string(out.join("nav.csv")).unwrap();
     assert!(nav.lines().count() > 290);
+    assert!(j.get("gyro_scale_est_ppm").is_none());
+    // the 21-state filter: its estimates and the truth in the summary and run.toml
+    let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args(["fuse", scn.to_str().unwrap(), "--json", "--out"])
+        .arg(&out)
+        .args(["--scale-factors-ppm", "300,500"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["gyro_scale_true_ppm"], serde_json::json!([0.0, 0.0, 0.0]));
+    assert_eq!(j["gyro_scale_est_ppm"].as_array().unwrap().len(), 3);
+    let run = std::fs::read_to_string(out.join("run.toml")).unwrap();
+    assert!(run.contains("scale_factor_prior_gyro_ppm = 500"), "{run}");
     for bad in [
         ["--cov-rate-hz", "nan"],
         ["--nhc-sigma-mps=-1", ""],
         ["--samples", "5"],
         ["--algo", "kalman"],
+        ["--scale-factors-ppm", "300"],
+        ["--scale-factors-ppm", "300,nan"],
+        ["--scale-factors-ppm", "0,300"],
+        ["--scale-factors-ppm", "300,1e6"],
     ] {
         let bad: Vec<&str> = bad.iter().copied().filter(|a| !a.is_empty()).collect();
         let o = Command::new(env!("CARGO_BIN_EXE_sdins"))

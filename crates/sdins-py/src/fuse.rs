@@ -19,7 +19,7 @@ const NX: usize = 15;
 #[pyfunction]
 #[pyo3(signature = (scenario, algo=None, samples=None, run=None, cov_rate_hz=None,
     gate=None, exact_start=None, zupt_sigma_mps=None, nhc_sigma_mps=None, until_s=None,
-    smooth=None, in_motion=None))]
+    smooth=None, in_motion=None, scale_factors_ppm=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse<'py>(
     py: Python<'py>,
@@ -35,6 +35,7 @@ pub fn fuse<'py>(
     until_s: Option<f64>,
     smooth: Option<bool>,
     in_motion: Option<bool>,
+    scale_factors_ppm: Option<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scn = scenario.scn.clone();
     let d = FuseOptions::default();
@@ -77,6 +78,10 @@ pub fn fuse<'py>(
             Some(false) => None,
             None => d.in_motion,
         },
+        scale_factors: scale_factors_ppm.map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior {
+            accel_ppm: [a; 3],
+            gyro_ppm: [g; 3],
+        }),
         ..d
     };
     let gnss = scn.gnss.clone().unwrap_or_default();
@@ -90,6 +95,8 @@ pub fn fuse<'py>(
         att_rad: Vec<f64>,
         sigma: Vec<f64>,
         nees: Vec<f64>,
+        sf_err: Vec<f64>,
+        sf_sigma: Vec<f64>,
     }
     impl Ep {
         fn push(&mut self, e: &sdins_sim::fuse::FuseEpoch) {
@@ -104,9 +111,18 @@ pub fn fuse<'py>(
                 e.nees_block(I_VEL),
                 e.nees_block(I_ATT),
             ]);
+            if let Some(sf) = &e.scale_factors {
+                self.sf_err.extend(sf.err.iter());
+                self.sf_sigma
+                    .extend((0..6).map(|i| sf.p[(i, i)].max(0.0).sqrt()));
+            }
         }
         fn dict<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
             let out = PyDict::new(py);
+            if !self.sf_err.is_empty() {
+                out.set_item("scale_factor_error", matrix(py, self.sf_err, 6)?)?;
+                out.set_item("scale_factor_sigma", matrix(py, self.sf_sigma, 6)?)?;
+            }
             out.set_item("t_s", vector(py, self.t))?;
             out.set_item("error", matrix(py, self.err, NX)?)?;
             out.set_item("pos_error_ned_m", matrix(py, self.pos_m, 3)?)?;
@@ -119,14 +135,8 @@ pub fn fuse<'py>(
     }
     #[derive(Default)]
     struct Acc {
+        forward: Ep,
         smoothed: Ep,
-        t: Vec<f64>,
-        err: Vec<f64>,
-        pos_m: Vec<f64>,
-        vel_mps: Vec<f64>,
-        att_rad: Vec<f64>,
-        sigma: Vec<f64>,
-        nees: Vec<f64>,
         it: Vec<f64>,
         kind: Vec<&'static str>,
         dof: Vec<usize>,
@@ -138,19 +148,7 @@ pub fn fuse<'py>(
     let (acc, s) = interrupt::run(py, |tok| {
         let mut a = Acc::default();
         let r = fuse_scenario(&scn, &gnss, &opts, run, tok, |ev| match ev {
-            FuseEvent::Epoch(e) => {
-                a.t.push(e.t_s);
-                a.err.extend(e.err.iter());
-                a.pos_m.extend(e.nav.pos_err_ned_m);
-                a.vel_mps.extend(e.nav.vel_err_ned_mps);
-                a.att_rad.extend(e.nav.att_err_rad);
-                a.sigma.extend((0..NX).map(|i| e.sigma(i)));
-                a.nees.extend([
-                    e.nees_block(I_POS),
-                    e.nees_block(I_VEL),
-                    e.nees_block(I_ATT),
-                ]);
-            }
+            FuseEvent::Epoch(e) => a.forward.push(e),
             FuseEvent::Update(u) => {
                 a.it.push(u.t_s);
                 a.kind.push(match u.kind {
@@ -174,14 +172,7 @@ pub fn fuse<'py>(
         FuseError::Cancelled(_) => pyo3::exceptions::PyKeyboardInterrupt::new_err("cancelled"),
         other => err(other),
     })?;
-    let out = PyDict::new(py);
-    out.set_item("t_s", vector(py, acc.t))?;
-    out.set_item("error", matrix(py, acc.err, NX)?)?;
-    out.set_item("pos_error_ned_m", matrix(py, acc.pos_m, 3)?)?;
-    out.set_item("vel_error_ned_mps", matrix(py, acc.vel_mps, 3)?)?;
-    out.set_item("att_error_rad", matrix(py, acc.att_rad, 3)?)?;
-    out.set_item("sigma", matrix(py, acc.sigma, NX)?)?;
-    out.set_item("nees", matrix(py, acc.nees, 3)?)?;
+    let out = acc.forward.dict(py)?;
     let inn = PyDict::new(py);
     inn.set_item("t_s", vector(py, acc.it))?;
     inn.set_item("kind", acc.kind)?;
@@ -202,6 +193,12 @@ pub fn fuse<'py>(
     out.set_item("accel_bias_true_mps2", v3(&s.true_bias.0))?;
     out.set_item("gyro_bias_est_rps", v3(&s.est_bias.1))?;
     out.set_item("gyro_bias_true_rps", v3(&s.true_bias.1))?;
+    if let Some((ta, tg)) = s.true_scale {
+        out.set_item("accel_scale_est", v3(&s.est_scale.0))?;
+        out.set_item("accel_scale_true", v3(&ta))?;
+        out.set_item("gyro_scale_est", v3(&s.est_scale.1))?;
+        out.set_item("gyro_scale_true", v3(&tg))?;
+    }
     out.set_item("samples", samples)?;
     out.set_item("run", run)?;
     Ok(out)
@@ -219,6 +216,8 @@ struct Track {
     sigma_nav: Vec<f64>,
     sigma_euler: Vec<f64>,
     bias: Vec<f64>,
+    scale: Vec<f64>,
+    sigma_scale: Vec<f64>,
 }
 
 impl Track {
@@ -235,6 +234,9 @@ impl Track {
         self.sigma_euler.extend(p.sigma_euler_rad);
         let (ba, bg) = p.bias;
         self.bias.extend([ba.x, ba.y, ba.z, bg.x, bg.y, bg.z]);
+        let (sa, sg) = p.scale;
+        self.scale.extend([sa.x, sa.y, sa.z, sg.x, sg.y, sg.z]);
+        self.sigma_scale.extend(p.sigma_scale);
     }
     fn dict<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
@@ -247,6 +249,8 @@ impl Track {
         d.set_item("sigma_nav", matrix(py, self.sigma_nav, 9)?)?;
         d.set_item("sigma_euler_rad", matrix(py, self.sigma_euler, 3)?)?;
         d.set_item("bias", matrix(py, self.bias, 6)?)?;
+        d.set_item("scale_factor", matrix(py, self.scale, 6)?)?;
+        d.set_item("sigma_scale_factor", matrix(py, self.sigma_scale, 6)?)?;
         Ok(d)
     }
 }
@@ -257,7 +261,7 @@ impl Track {
 #[pyo3(signature = (imu, gnss, imu_format=None, gnss_format=None, grade=None,
     navego_params=None, init=None, attitude_deg=None, attitude_sigma_deg=None, static_s=None,
     lever_arm_m=None, truth=None, smooth=None, algo=None, samples=None, cov_rate_hz=None,
-    gate=None, nhc_sigma_mps=None, gnss_offset_s=None))]
+    gate=None, nhc_sigma_mps=None, gnss_offset_s=None, scale_factors_ppm=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse_files<'py>(
     py: Python<'py>,
@@ -280,6 +284,7 @@ pub fn fuse_files<'py>(
     gate: Option<bool>,
     nhc_sigma_mps: Option<f64>,
     gnss_offset_s: Option<f64>,
+    scale_factors_ppm: Option<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use sdins_sim::fuse_files::{FilesError, FilesInput, InitSource, SensorModelSource};
     use sdins_sim::fuse_records::{RecordEvent, RecordOptions};
@@ -340,6 +345,10 @@ pub fn fuse_files<'py>(
         lever_arm_b_m: lever_arm_m.unwrap_or(d.lever_arm_b_m),
         nhc_sigma_mps,
         smooth: smooth.unwrap_or(d.smooth),
+        scale_factors: scale_factors_ppm.map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior {
+            accel_ppm: [a; 3],
+            gyro_ppm: [g; 3],
+        }),
         ..d
     };
     #[derive(Default)]

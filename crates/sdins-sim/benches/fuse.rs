@@ -1,6 +1,7 @@
 //! INS/GNSS benchmark (criterion): one hour of 200 Hz IMU increments with 1 Hz GNSS held
 //! in memory (`bench/scenarios/drive-1h-200hz.toml`, tactical grade), forward filter and
-//! RTS smoother with full-rate smoothed output, covariance at 1 Hz and at 10 Hz; one
+//! RTS smoother with full-rate smoothed output, covariance at 1 Hz and at 10 Hz (and the
+//! 21-state filter with scale factors at 1 Hz); one
 //! GNSS position + velocity update; and, separately, parsing the hour's IMU text file.
 //!
 //! `cargo bench -p sdins-sim --bench fuse` (docs/performance.md has the numbers).
@@ -41,19 +42,31 @@ fn fuse(c: &mut Criterion) {
         .sample_size(10)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(10));
-    for (smooth, cov) in [(false, 1.0), (true, 1.0), (false, 10.0), (true, 10.0)] {
+    let sf = sdins_sim::fuse::ScaleFactorPrior {
+        accel_ppm: [300.0; 3],
+        gyro_ppm: [300.0; 3],
+    };
+    for (smooth, cov, states) in [
+        (false, 1.0, 15),
+        (true, 1.0, 15),
+        (false, 10.0, 15),
+        (true, 10.0, 15),
+        (true, 1.0, 21),
+    ] {
         let opts = RecordOptions {
             smooth,
             cov_rate_hz: cov,
+            scale_factors: (states == 21).then_some(sf),
             ..Default::default()
         };
         let name = format!(
-            "{}/cov_{cov}hz",
+            "{}/cov_{cov}hz{}",
             if smooth {
                 "forward+smoother"
             } else {
                 "forward"
-            }
+            },
+            if states == 21 { "/21_states" } else { "" }
         );
         g.bench_function(name, |b| {
             b.iter(|| {

@@ -3,9 +3,14 @@
 //!
 //! * Filter noise from the scenario's IMU error model: ARW, VRW, turn-on bias σ (prior
 //!   of random-constant bias states), Gauss–Markov bias (σ, T; `q = 2σ²/T`), rate random
-//!   walk; the fixed bias is known (initial estimate). Not modelled (and therefore not to
-//!   be simulated in consistency runs): scale factor, misalignment, g-sensitivity, flicker,
-//!   quantization, saturation.
+//!   walk; the fixed bias is known (initial estimate). With
+//!   [`FuseOptions::scale_factors`] the filter has 21 states and estimates the
+//!   accelerometer and gyro scale factors (random constants, prior σ from the option,
+//!   initial estimate 0); the scenario's `accel_scale_ppm` / `gyro_scale_ppm` plus the
+//!   diagonal of the misalignment matrices are then the true values. Not modelled (and
+//!   therefore not to be simulated in consistency runs): scale factor (15-state filter),
+//!   scale asymmetry, off-diagonal misalignment, g-sensitivity, flicker, quantization,
+//!   saturation.
 //! * Initial errors: position/velocity/attitude σ of [`FuseOptions::init_sigma`], drawn
 //!   per run from P0 (`draw_initial_errors`, stream channel 10–12 of the GNSS seed) or
 //!   zero; the attitude error is applied as `Ĉ = exp([ε×]) C` (convention G). The
@@ -29,6 +34,7 @@ use crate::pipeline::nav_error;
 use crate::scenario::Scenario;
 use crate::smoother::{SmootherError, SmootherLog};
 use crate::truth::{lon_diff, TruthGenerator, TruthSample};
+use nalgebra::{SMatrix, SVector};
 use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -36,7 +42,10 @@ use sdins_core::aiding::ekf::{
     correct_nav_state, Ekf, EkfConfig, FilterError, GnssMeasurement, NoiseModel, UpdateReport,
     CHI2_999,
 };
-use sdins_core::aiding::error_model::{StateMat, StateVec, I_ATT, I_BA, I_BG, I_POS, I_VEL};
+use sdins_core::aiding::error_model::{
+    StateMat, StateMatN, StateVec, I_ATT, I_BA, I_BG, I_POS, I_SA, I_SG, I_VEL, N_STATES,
+    N_STATES_SF,
+};
 use sdins_core::coning::Increment;
 use sdins_core::math::{Mat3, Quat, Vec3};
 use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, NavState};
@@ -89,6 +98,35 @@ pub struct FuseOptions {
     pub smooth: bool,
     /// in-motion alignment from the GNSS track instead of a known initial attitude
     pub in_motion: Option<InMotionInit>,
+    /// estimate accelerometer and gyro scale factors (the 21-state filter) with this prior
+    pub scale_factors: Option<ScaleFactorPrior>,
+}
+
+/// Prior 1σ of the scale-factor states of the 21-state filter, per body axis \[ppm\].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScaleFactorPrior {
+    /// accelerometer scale-factor σ \[ppm\]
+    pub accel_ppm: [f64; 3],
+    /// gyro scale-factor σ \[ppm\]
+    pub gyro_ppm: [f64; 3],
+}
+
+impl ScaleFactorPrior {
+    /// Every σ finite and in \[0, 100 000\] ppm.
+    pub fn validate(&self) -> Result<(), FuseError> {
+        if self
+            .accel_ppm
+            .iter()
+            .chain(self.gyro_ppm.iter())
+            .any(|x| !x.is_finite() || *x < 0.0 || *x > 1e5)
+        {
+            return Err(FuseError::Option(
+                "scale_factors",
+                "prior σ must be finite and in [0, 100000] ppm".into(),
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// In-motion alignment for a ground vehicle from an unknown heading: the filter starts at
@@ -138,6 +176,7 @@ impl Default for FuseOptions {
             until_s: None,
             smooth: false,
             in_motion: None,
+            scale_factors: None,
         }
     }
 }
@@ -182,6 +221,27 @@ pub struct FuseEpoch {
     pub nav: crate::pipeline::NavError,
     /// the true attitude at the epoch
     pub c_b_n_true: sdins_core::math::Mat3,
+    /// 21-state filter: the scale-factor states (accel 0–2, gyro 3–5)
+    pub scale_factors: Option<ScaleFactorEpoch>,
+}
+
+/// The scale-factor states of an epoch of the 21-state filter: true error `s − ŝ`
+/// (dimensionless; accelerometer x, y, z then gyro x, y, z) and its covariance block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScaleFactorEpoch {
+    /// true error `s − ŝ`
+    pub err: SVector<f64, 6>,
+    /// the filter's covariance of those states
+    pub p: SMatrix<f64, 6, 6>,
+}
+
+impl ScaleFactorEpoch {
+    /// NEES of the accelerometer (`i0 = 0`) or gyro (`i0 = 3`) scale factors (3 dof).
+    pub fn nees_block(&self, i0: usize) -> f64 {
+        let x = self.err.fixed_rows::<3>(i0).into_owned();
+        let p = self.p.fixed_view::<3, 3>(i0, i0).into_owned();
+        p.cholesky().map_or(f64::INFINITY, |c| x.dot(&c.solve(&x)))
+    }
 }
 
 impl FuseEpoch {
@@ -231,8 +291,12 @@ pub struct FuseSummary {
     pub true_bias: (Vec3, Vec3),
     /// final bias estimates
     pub est_bias: (Vec3, Vec3),
-    /// final covariance
+    /// final covariance (the 15 navigation and bias states)
     pub p_final: StateMat,
+    /// true scale factors (accel, gyro; dimensionless) when they were estimated
+    pub true_scale: Option<(Vec3, Vec3)>,
+    /// final scale-factor estimates (zero without the scale-factor states)
+    pub est_scale: (Vec3, Vec3),
     /// navigation updates
     pub nav_updates: u64,
 }
@@ -295,8 +359,37 @@ pub fn fuse_scenario_with(
     opts: &FuseOptions,
     run: u64,
     cancel: &CancelToken,
+    observe: impl FnMut(FuseEvent<'_>),
+) -> Result<FuseSummary, FuseError> {
+    match opts.scale_factors {
+        None => fuse_impl::<N_STATES>(scn, cached, gnss, opts, run, cancel, observe),
+        Some(_) => fuse_impl::<N_STATES_SF>(scn, cached, gnss, opts, run, cancel, observe),
+    }
+}
+
+/// The true scale factors of an IMU error model (dimensionless): `s + M_ii` (the
+/// misalignment matrix's diagonal adds to the scale factor, see [`crate::imu_error`]).
+pub fn true_scale_factors(m: &ImuErrorModel) -> (Vec3, Vec3) {
+    let sf = |s: [f64; 3], mis: [[f64; 3]; 3]| Vec3::from_fn(|i, _| s[i] * 1e-6 + mis[i][i] * 1e-3);
+    (
+        sf(m.accel_scale_ppm, m.accel_misalignment_mrad),
+        sf(m.gyro_scale_ppm, m.gyro_misalignment_mrad),
+    )
+}
+
+fn fuse_impl<const N: usize>(
+    scn: &Scenario,
+    cached: Option<&[TruthSample]>,
+    gnss: &GnssConfig,
+    opts: &FuseOptions,
+    run: u64,
+    cancel: &CancelToken,
     mut observe: impl FnMut(FuseEvent<'_>),
 ) -> Result<FuseSummary, FuseError> {
+    let sf_prior = opts.scale_factors.filter(|_| N > N_STATES);
+    if let Some(sp) = &sf_prior {
+        sp.validate()?;
+    }
     if scn.mounting.imu.is_some() {
         return Err(FuseError::Option(
             "mounting",
@@ -459,7 +552,14 @@ pub fn fuse_scenario_with(
         c_b_n: Quat::from_rotvec(&eps).to_dcm() * init_true.c_b_n,
     };
     let mut init = init;
-    let mut p0 = StateMat::zeros();
+    let mut p0 = StateMatN::<N>::zeros();
+    if let Some(sp) = &sf_prior {
+        for i in 0..3 {
+            p0[(I_SA + i, I_SA + i)] = (sp.accel_ppm[i] * 1e-6).powi(2);
+            p0[(I_SG + i, I_SG + i)] = (sp.gyro_ppm[i] * 1e-6).powi(2);
+        }
+    }
+    let true_sf = sf_prior.map(|_| true_scale_factors(&scn.imu.model));
     for i in 0..3 {
         p0[(I_POS + i, I_POS + i)] = (s.pos_ned_m[i] / t0[i]).powi(2);
         p0[(I_VEL + i, I_VEL + i)] = s.vel_ned_mps[i].powi(2);
@@ -527,7 +627,7 @@ pub fn fuse_scenario_with(
         gate_chi2: opts.gate_chi2,
         max_consecutive_rejections: opts.max_consecutive_rejections,
     };
-    let mut ekf = Ekf::new(mech, ekf_cfg, p0, known_ba, known_bg);
+    let mut ekf = Ekf::<_, N>::new(mech, ekf_cfg, p0, known_ba, known_bg);
 
     let mut total = len_samples.saturating_sub(skipped) / n as u64;
     if let Some(t) = opts.until_s {
@@ -544,13 +644,18 @@ pub fn fuse_scenario_with(
     let mut smooth = opts.smooth.then(|| {
         let epochs = (total / cov_updates as u64 + 2) as usize;
         (
-            SmootherLog::with_capacity(epochs),
-            Vec::<(NavState, (Vec3, Vec3), TruthSample)>::with_capacity(epochs),
+            SmootherLog::<N>::with_capacity(epochs),
+            Vec::<(NavState, Estimates, TruthSample)>::with_capacity(epochs),
         )
     });
+    let truths = Truths {
+        ba: true_ba,
+        bg: true_bg,
+        sf: true_sf,
+    };
     if let Some((log, fwd)) = smooth.as_mut() {
         log.push(&ekf.initial_epoch())?;
-        fwd.push((ekf.state(), ekf.biases(), prev_truth));
+        fwd.push((ekf.state(), estimates(&ekf), prev_truth));
     }
     let mut fixes = 0u64;
     let mut last_cur = prev_truth;
@@ -610,18 +715,17 @@ pub fn fuse_scenario_with(
         if let Some(ep) = ekf.take_epoch() {
             let mut e = epoch_of(
                 &ekf.state(),
-                ekf.biases(),
+                &estimates(&ekf),
                 ekf.covariance(),
                 &cur,
                 &earth,
-                true_ba,
-                true_bg,
+                &truths,
             );
             e.t_s += t_start;
             observe(FuseEvent::Epoch(&e));
             if let Some((log, fwd)) = smooth.as_mut() {
                 log.push(&ep)?;
-                fwd.push((ekf.state(), ekf.biases(), cur));
+                fwd.push((ekf.state(), estimates(&ekf), cur));
             }
         }
     }
@@ -629,13 +733,16 @@ pub fn fuse_scenario_with(
     if let Some((log, fwd)) = smooth {
         let mut out: Vec<Option<FuseEpoch>> = vec![None; fwd.len()];
         log.smooth(cancel, |k, _, sm| {
-            if let (Some((st, (ba, bg), tr)), Some(slot)) = (fwd.get(k), out.get_mut(k)) {
+            if let (Some((st, est, tr)), Some(slot)) = (fwd.get(k), out.get_mut(k)) {
                 let s_state = correct_nav_state(st, &sm.dx);
-                let b = (
-                    ba + sm.dx.fixed_rows::<3>(I_BA),
-                    bg + sm.dx.fixed_rows::<3>(I_BG),
-                );
-                let mut e = epoch_of(&s_state, b, &sm.p, tr, &earth, true_ba, true_bg);
+                let mut est = *est;
+                est.ba += sm.dx.fixed_rows::<3>(I_BA);
+                est.bg += sm.dx.fixed_rows::<3>(I_BG);
+                if N > N_STATES {
+                    est.sa += sm.dx.fixed_rows::<3>(I_SA);
+                    est.sg += sm.dx.fixed_rows::<3>(I_SG);
+                }
+                let mut e = epoch_of(&s_state, &est, &sm.p, tr, &earth, &truths);
                 e.t_s += t_start;
                 *slot = Some(e);
             }
@@ -650,20 +757,46 @@ pub fn fuse_scenario_with(
         rejected: ekf.rejected_total(),
         true_bias: (true_ba, true_bg),
         est_bias: (ba, bg),
-        p_final: *ekf.covariance(),
+        p_final: ekf
+            .covariance()
+            .fixed_view::<N_STATES, N_STATES>(0, 0)
+            .into_owned(),
+        true_scale: true_sf,
+        est_scale: ekf.scale_factors(),
         nav_updates: total,
     })
 }
 
-fn epoch_of(
+/// The filter's sensor-error estimates at an epoch.
+#[derive(Clone, Copy, Debug)]
+struct Estimates {
+    ba: Vec3,
+    bg: Vec3,
+    sa: Vec3,
+    sg: Vec3,
+}
+
+fn estimates<M: sdins_core::nav::Mechanization, const N: usize>(ekf: &Ekf<M, N>) -> Estimates {
+    let ((ba, bg), (sa, sg)) = (ekf.biases(), ekf.scale_factors());
+    Estimates { ba, bg, sa, sg }
+}
+
+/// The true sensor errors of the run (scale factors only when estimated).
+struct Truths {
+    ba: Vec3,
+    bg: Vec3,
+    sf: Option<(Vec3, Vec3)>,
+}
+
+fn epoch_of<const N: usize>(
     st: &NavState,
-    (ba, bg): (Vec3, Vec3),
-    p: &StateMat,
+    est: &Estimates,
+    p: &StateMatN<N>,
     truth: &TruthSample,
     earth: &sdins_core::earth::EarthModel,
-    true_ba: Vec3,
-    true_bg: Vec3,
+    tr: &Truths,
 ) -> FuseEpoch {
+    let (ba, bg, true_ba, true_bg) = (est.ba, est.bg, tr.ba, tr.bg);
     let ne = nav_error(earth, st, truth);
     let mut err = StateVec::zeros();
     err[I_POS] = st.lat_rad - truth.lat_rad;
@@ -675,11 +808,26 @@ fn epoch_of(
         err[I_BA + i] = true_ba[i] - ba[i];
         err[I_BG + i] = true_bg[i] - bg[i];
     }
+    let scale_factors = match (tr.sf, N > N_STATES) {
+        (Some((sa, sg)), true) => {
+            let mut e = SVector::<f64, 6>::zeros();
+            for i in 0..3 {
+                e[i] = sa[i] - est.sa[i];
+                e[3 + i] = sg[i] - est.sg[i];
+            }
+            Some(ScaleFactorEpoch {
+                err: e,
+                p: p.fixed_view::<6, 6>(I_SA, I_SA).into_owned(),
+            })
+        }
+        _ => None,
+    };
     let r = earth.radii(truth.lat_rad);
     FuseEpoch {
         t_s: st.t_s,
         err,
-        p: *p,
+        p: p.fixed_view::<N_STATES, N_STATES>(0, 0).into_owned(),
+        scale_factors,
         pos_scale: Vec3::new(
             r.r_m_m + truth.h_m,
             (r.r_n_m + truth.h_m) * truth.lat_rad.cos(),

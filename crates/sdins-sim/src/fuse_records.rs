@@ -21,9 +21,14 @@
 //!   the first fix the position, zero velocity. The attitude σ is the first-order
 //!   coarse-alignment error of the bias priors (tilt `σ_ba/g`, heading
 //!   `σ_bg/(Ω cos L)`), refused beyond the linearised filter's 10° limit.
+//!
+//! ## Scale factors
+//! With [`RecordOptions::scale_factors`] the 21-state filter also estimates the
+//! accelerometer and gyro scale factors (random constants from 0 with the given prior σ;
+//! `sdins_core::aiding::ekf`).
 
 use crate::cancel::CancelToken;
-use crate::fuse::{noise_from_model, FuseError, InitSigma};
+use crate::fuse::{noise_from_model, FuseError, InitSigma, ScaleFactorPrior};
 use crate::gnss_fix::GnssFix;
 use crate::imu_error::{ImuErrorModel, DEG};
 use crate::imu_file::ImuData;
@@ -33,7 +38,8 @@ use sdins_core::aiding::ekf::{
     correct_nav_state, Ekf, EkfConfig, GnssMeasurement, NoiseModel, UpdateReport, CHI2_999,
 };
 use sdins_core::aiding::error_model::{
-    position_scale, StateMat, StateVec, I_ATT, I_BA, I_BG, I_POS, I_VEL,
+    position_scale, StateMat, StateMatN, StateVecN, I_ATT, I_BA, I_BG, I_POS, I_SA, I_SG, I_VEL,
+    N_STATES, N_STATES_SF,
 };
 use sdins_core::align::coarse::{align as coarse_align, CoarseMethod, StaticMean};
 use sdins_core::align::Site;
@@ -159,6 +165,8 @@ pub struct RecordOptions {
     pub nhc_sigma_mps: Option<f64>,
     /// run the smoother
     pub smooth: bool,
+    /// estimate accelerometer and gyro scale factors (the 21-state filter)
+    pub scale_factors: Option<ScaleFactorPrior>,
 }
 
 impl Default for RecordOptions {
@@ -172,6 +180,7 @@ impl Default for RecordOptions {
             lever_arm_b_m: [0.0; 3],
             nhc_sigma_mps: None,
             smooth: false,
+            scale_factors: None,
         }
     }
 }
@@ -192,6 +201,10 @@ pub struct RecordPoint {
     pub sigma_euler_rad: [f64; 3],
     /// 1σ of the accelerometer \[m/s²\] and gyro \[rad/s\] bias errors
     pub sigma_bias: [f64; 6],
+    /// scale-factor estimates (accelerometer, gyro; dimensionless; zero with 15 states)
+    pub scale: (Vec3, Vec3),
+    /// 1σ of the accelerometer and gyro scale-factor errors (zero with 15 states)
+    pub sigma_scale: [f64; 6],
 }
 
 /// What the observer receives.
@@ -224,6 +237,8 @@ pub struct RecordSummary {
     pub init: InitialState,
     /// final bias estimates (accelerometer \[m/s²\], gyro \[rad/s\])
     pub final_bias: (Vec3, Vec3),
+    /// final scale-factor estimates (zero with 15 states)
+    pub final_scale: (Vec3, Vec3),
     /// bytes held by the smoother log (0 without smoothing)
     pub smoother_bytes: usize,
 }
@@ -251,7 +266,16 @@ pub fn euler_error_matrix(c_b_n: &Mat3) -> Mat3 {
     )
 }
 
-fn sigmas(p: &StateMat, c_b_n: &Mat3, scale: &Vec3) -> ([f64; 9], [f64; 3], [f64; 6]) {
+/// 1σ of a covariance epoch in output units.
+#[derive(Clone, Copy, Debug, Default)]
+struct Sig {
+    nav: [f64; 9],
+    eul: [f64; 3],
+    bias: [f64; 6],
+    scale: [f64; 6],
+}
+
+fn sigmas<const N: usize>(p: &StateMatN<N>, c_b_n: &Mat3, scale: &Vec3) -> Sig {
     let sd = |i: usize| p[(i, i)].max(0.0).sqrt();
     let mut nav = [0.0; 9];
     for i in 0..3 {
@@ -271,8 +295,22 @@ fn sigmas(p: &StateMat, c_b_n: &Mat3, scale: &Vec3) -> ([f64; 9], [f64; 3], [f64
     for (i, bi) in b.iter_mut().enumerate() {
         *bi = sd(I_BA + i);
     }
-    (nav, eul, b)
+    let mut sf = [0.0; 6];
+    if N > N_STATES {
+        for (i, si) in sf.iter_mut().enumerate() {
+            *si = sd(I_SA + i);
+        }
+    }
+    Sig {
+        nav,
+        eul,
+        bias: b,
+        scale: sf,
+    }
 }
+
+/// Sensor-error estimates of an epoch: biases and scale factors (accel, gyro).
+type Est = ((Vec3, Vec3), (Vec3, Vec3));
 
 fn scale_at(earth: &EarthModel, s: &NavState) -> Vec3 {
     let r = earth.radii(s.lat_rad);
@@ -322,6 +360,21 @@ fn opt_err(name: &'static str, msg: impl Into<String>) -> FuseError {
 /// clock and in time order (the readers guarantee it); fixes outside the record are
 /// ignored (clip them first with `gnss_file::clip_to_imu_span` to count them).
 pub fn fuse_records(
+    imu: &ImuData,
+    fixes: &[GnssFix],
+    model: &RecordModel,
+    init: &RecordInit,
+    opts: &RecordOptions,
+    cancel: &CancelToken,
+    observe: impl FnMut(RecordEvent<'_>),
+) -> Result<RecordSummary, FuseError> {
+    match opts.scale_factors {
+        None => records_impl::<N_STATES>(imu, fixes, model, init, opts, cancel, observe),
+        Some(_) => records_impl::<N_STATES_SF>(imu, fixes, model, init, opts, cancel, observe),
+    }
+}
+
+fn records_impl<const N: usize>(
     imu: &ImuData,
     fixes: &[GnssFix],
     model: &RecordModel,
@@ -440,6 +493,16 @@ pub fn fuse_records(
     if !p0.iter().all(|x| x.is_finite()) {
         return Err(opt_err("init", "initial covariance is not finite"));
     }
+    let mut p0n = StateMatN::<N>::zeros();
+    p0n.fixed_view_mut::<N_STATES, N_STATES>(0, 0)
+        .copy_from(&p0);
+    if let (Some(sp), true) = (&opts.scale_factors, N > N_STATES) {
+        sp.validate()?;
+        for i in 0..3 {
+            p0n[(I_SA + i, I_SA + i)] = (sp.accel_ppm[i] * 1e-6).powi(2);
+            p0n[(I_SG + i, I_SG + i)] = (sp.gyro_ppm[i] * 1e-6).powi(2);
+        }
+    }
     let t_start = t_rec0 + dt * start_k as f64;
     let mech = AnyMechanization::new(&opts.algo, earth, dt, &init_state);
     let cfg = EkfConfig {
@@ -451,39 +514,42 @@ pub fn fuse_records(
         gate_chi2: opts.gate_chi2,
         max_consecutive_rejections: opts.max_consecutive_rejections,
     };
-    let mut ekf = Ekf::new(mech, cfg, p0, model.accel_bias0_mps2, model.gyro_bias0_rps);
+    let mut ekf = Ekf::<_, N>::new(mech, cfg, p0n, model.accel_bias0_mps2, model.gyro_bias0_rps);
     let samples = &imu.increments[start_k.min(imu.increments.len())..];
     let total = samples.len() / n;
     let mut log_and_track = opts.smooth.then(|| {
         let epochs = total / cov_updates + 2;
         (
-            SmootherLog::with_capacity(epochs),
+            SmootherLog::<N>::with_capacity(epochs),
             Vec::<Compact>::with_capacity(total + 1),
-            Vec::<((Vec3, Vec3), Mat3, Vec3)>::with_capacity(epochs),
+            Vec::<(Est, Mat3, Vec3)>::with_capacity(epochs),
         )
     });
     // σ change only at covariance epochs and updates: computed there, reused in between
-    let sig_of = |ekf: &Ekf<AnyMechanization>| {
+    let sig_of = |ekf: &Ekf<AnyMechanization, N>| {
         let s = ekf.state();
         sigmas(ekf.covariance(), &s.c_b_n, &scale_at(&earth, &s))
     };
-    let point = |ekf: &Ekf<AnyMechanization>, sig: &([f64; 9], [f64; 3], [f64; 6])| {
+    let point = |ekf: &Ekf<AnyMechanization, N>, sig: &Sig| {
         let s = ekf.state();
         RecordPoint {
             t_s: t_start + s.t_s,
             state: s,
             bias: ekf.biases(),
-            sigma_nav: sig.0,
-            sigma_euler_rad: sig.1,
-            sigma_bias: sig.2,
+            sigma_nav: sig.nav,
+            sigma_euler_rad: sig.eul,
+            sigma_bias: sig.bias,
+            scale: ekf.scale_factors(),
+            sigma_scale: sig.scale,
         }
     };
+    let est = |ekf: &Ekf<AnyMechanization, N>| -> Est { (ekf.biases(), ekf.scale_factors()) };
     let mut sig_now = sig_of(&ekf);
     if let Some((log, track, bias)) = log_and_track.as_mut() {
         log.push(&ekf.initial_epoch())?;
         track.push(Compact::of(&ekf.state()));
         let s = ekf.state();
-        bias.push((ekf.biases(), s.c_b_n, scale_at(&earth, &s)));
+        bias.push((est(&ekf), s.c_b_n, scale_at(&earth, &s)));
     }
     observe(RecordEvent::Forward(&point(&ekf, &sig_now)));
     let mut next_fix = skip_fixes;
@@ -527,7 +593,7 @@ pub fn fuse_records(
         if let (Some(ep), Some((log, _, bias))) = (ep, log_and_track.as_mut()) {
             log.push(&ep)?;
             let s = ekf.state();
-            bias.push((ekf.biases(), s.c_b_n, scale_at(&earth, &s)));
+            bias.push((est(&ekf), s.c_b_n, scale_at(&earth, &s)));
         }
         if let Some((_, track, _)) = log_and_track.as_mut() {
             track.push(Compact::of(&ekf.state()));
@@ -538,8 +604,7 @@ pub fn fuse_records(
     if let Some((log, track, bias)) = log_and_track {
         smoother_bytes = log.bytes();
         // σ of the smoothed epochs, from the backward pass
-        let mut sig: Vec<([f64; 9], [f64; 3], [f64; 6])> =
-            vec![([0.0; 9], [0.0; 3], [0.0; 6]); log.len()];
+        let mut sig: Vec<Sig> = vec![Sig::default(); log.len()];
         let corr = log.smooth(cancel, |k, _, sm| {
             if let (Some(slot), Some((_, c, sc))) = (sig.get_mut(k), bias.get(k)) {
                 *slot = sigmas(&sm.p, c, sc);
@@ -553,11 +618,19 @@ pub fn fuse_records(
             while e + 1 < corr.len() && log.t_s(e + 1).is_some_and(|t| t <= c.t_s + 1e-9) {
                 e += 1;
             }
-            let x: StateVec = corr.at(e, c.t_s);
+            let x: StateVecN<N> = corr.at(e, c.t_s);
             let fwd = c.state();
             let s = correct_nav_state(&fwd, &x);
-            let ((ba, bg), _, _) = bias[e];
-            let (nav, eul, b) = sig[e];
+            let (((ba, bg), (sa, sg)), _, _) = bias[e];
+            let sg_e = sig[e];
+            let scale = if N > N_STATES {
+                (
+                    sa + x.fixed_rows::<3>(I_SA).into_owned(),
+                    sg + x.fixed_rows::<3>(I_SG).into_owned(),
+                )
+            } else {
+                (sa, sg)
+            };
             let p = RecordPoint {
                 t_s: t_start + s.t_s,
                 state: s,
@@ -565,9 +638,11 @@ pub fn fuse_records(
                     ba + x.fixed_rows::<3>(I_BA).into_owned(),
                     bg + x.fixed_rows::<3>(I_BG).into_owned(),
                 ),
-                sigma_nav: nav,
-                sigma_euler_rad: eul,
-                sigma_bias: b,
+                sigma_nav: sg_e.nav,
+                sigma_euler_rad: sg_e.eul,
+                sigma_bias: sg_e.bias,
+                scale,
+                sigma_scale: sg_e.scale,
             };
             observe(RecordEvent::Smoothed(&p));
         }
@@ -580,6 +655,7 @@ pub fn fuse_records(
         t_start_s: t_start,
         init: init_state,
         final_bias: ekf.biases(),
+        final_scale: ekf.scale_factors(),
         smoother_bytes,
     })
 }

@@ -3,9 +3,10 @@
 //! smoothed corrections re-applied to the forward navigation states at full rate.
 //!
 //! ## Storage
-//! Per covariance epoch the log keeps `Φ` (15 × 15), `P(k|k−1)` and `P(k|k)` (symmetric,
-//! packed upper triangles of 120 values) and the applied correction δx̂: 3 848 bytes, so
-//! an hour at 1 Hz is 13.9 MB and at 10 Hz 139 MB. [`SmootherLog::bytes`] reports it.
+//! Per covariance epoch the log keeps `Φ` (N × N), `P(k|k−1)` and `P(k|k)` (symmetric,
+//! packed upper triangles of N(N+1)/2 values) and the applied correction δx̂: for the
+//! 15-state filter 3 848 bytes, so an hour at 1 Hz is 13.9 MB and at 10 Hz 139 MB; for the
+//! 21-state filter 7 400 bytes. [`SmootherLog::bytes`] reports it.
 //!
 //! ## Full-rate output
 //! Between epochs k and k+1 the forward state is propagated from the corrected state at
@@ -18,31 +19,32 @@
 
 use crate::cancel::{CancelToken, Cancelled};
 use sdins_core::aiding::ekf::{CovEpoch, FilterError};
-use sdins_core::aiding::error_model::{StateMat, StateVec, N_STATES};
+use sdins_core::aiding::error_model::{StateMatN, StateVecN, N_STATES};
 use sdins_core::aiding::rts::{rts_step, Smoothed};
 
-/// Packed upper triangle of a symmetric 15 × 15 matrix.
-const PACKED: usize = N_STATES * (N_STATES + 1) / 2;
-
-fn pack(m: &StateMat) -> [f64; PACKED] {
-    let mut out = [0.0; PACKED];
-    let mut k = 0;
-    for i in 0..N_STATES {
-        for j in i..N_STATES {
-            out[k] = m[(i, j)];
-            k += 1;
-        }
-    }
-    out
+/// Length of the packed upper triangle of a symmetric N × N matrix.
+const fn packed_len(n: usize) -> usize {
+    n * (n + 1) / 2
 }
 
-fn unpack(p: &[f64; PACKED]) -> StateMat {
-    let mut m = StateMat::zeros();
+/// Append the packed upper triangle of `m` to `out`.
+fn pack_into<const N: usize>(m: &StateMatN<N>, out: &mut Vec<f64>) {
+    for i in 0..N {
+        for j in i..N {
+            out.push(m[(i, j)]);
+        }
+    }
+}
+
+/// The symmetric matrix of a packed upper triangle (`p.len() ≥ N(N+1)/2`).
+fn unpack<const N: usize>(p: &[f64]) -> StateMatN<N> {
+    let mut m = StateMatN::<N>::zeros();
     let mut k = 0;
-    for i in 0..N_STATES {
-        for j in i..N_STATES {
-            m[(i, j)] = p[k];
-            m[(j, i)] = p[k];
+    for i in 0..N {
+        for j in i..N {
+            let v = p.get(k).copied().unwrap_or(0.0);
+            m[(i, j)] = v;
+            m[(j, i)] = v;
             k += 1;
         }
     }
@@ -50,12 +52,10 @@ fn unpack(p: &[f64; PACKED]) -> StateMat {
 }
 
 #[derive(Clone, Debug)]
-struct Record {
+struct Record<const N: usize> {
     t_s: f64,
-    phi: StateMat,
-    p_pred: [f64; PACKED],
-    p_post: [f64; PACKED],
-    dx: StateVec,
+    phi: StateMatN<N>,
+    dx: StateVecN<N>,
 }
 
 /// Why smoothing stopped.
@@ -81,13 +81,26 @@ pub enum SmootherError {
     Cancelled(#[from] Cancelled),
 }
 
-/// The forward filter's covariance epochs, in time order.
-#[derive(Clone, Debug, Default)]
-pub struct SmootherLog {
-    recs: Vec<Record>,
+/// The forward filter's covariance epochs, in time order (`N` = 15 or 21 states).
+#[derive(Clone, Debug)]
+pub struct SmootherLog<const N: usize = N_STATES> {
+    recs: Vec<Record<N>>,
+    /// per epoch the packed P(k|k−1) then P(k|k)
+    packed: Vec<f64>,
 }
 
-impl SmootherLog {
+impl<const N: usize> Default for SmootherLog<N> {
+    fn default() -> Self {
+        Self {
+            recs: Vec::new(),
+            packed: Vec::new(),
+        }
+    }
+}
+
+impl<const N: usize> SmootherLog<N> {
+    const PACKED: usize = packed_len(N);
+
     /// An empty log.
     pub fn new() -> Self {
         Self::default()
@@ -96,10 +109,11 @@ impl SmootherLog {
     pub fn with_capacity(n: usize) -> Self {
         Self {
             recs: Vec::with_capacity(n),
+            packed: Vec::with_capacity(n * 2 * Self::PACKED),
         }
     }
     /// Append an epoch (from `Ekf::initial_epoch` first, then `Ekf::take_epoch`).
-    pub fn push(&mut self, e: &CovEpoch) -> Result<(), SmootherError> {
+    pub fn push(&mut self, e: &CovEpoch<N>) -> Result<(), SmootherError> {
         if let Some(prev) = self.recs.last() {
             if e.t_s.partial_cmp(&prev.t_s) != Some(std::cmp::Ordering::Greater) {
                 return Err(SmootherError::Order {
@@ -111,10 +125,10 @@ impl SmootherLog {
         self.recs.push(Record {
             t_s: e.t_s,
             phi: e.phi,
-            p_pred: pack(&e.p_pred),
-            p_post: pack(&e.p_post),
             dx: e.dx,
         });
+        pack_into(&e.p_pred, &mut self.packed);
+        pack_into(&e.p_post, &mut self.packed);
         Ok(())
     }
     /// Number of epochs.
@@ -127,19 +141,23 @@ impl SmootherLog {
     }
     /// Bytes held by the log (its allocation).
     pub fn bytes(&self) -> usize {
-        self.recs.capacity() * std::mem::size_of::<Record>()
+        self.recs.capacity() * std::mem::size_of::<Record<N>>()
+            + self.packed.capacity() * std::mem::size_of::<f64>()
     }
     /// Time of epoch `k` \[s\].
     pub fn t_s(&self, k: usize) -> Option<f64> {
         self.recs.get(k).map(|r| r.t_s)
     }
     /// The forward record of epoch `k`.
-    pub fn epoch(&self, k: usize) -> Option<CovEpoch> {
-        self.recs.get(k).map(|r| CovEpoch {
+    pub fn epoch(&self, k: usize) -> Option<CovEpoch<N>> {
+        let r = self.recs.get(k)?;
+        let p = Self::PACKED;
+        let packed = self.packed.get(2 * p * k..2 * p * (k + 1))?;
+        Some(CovEpoch {
             t_s: r.t_s,
             phi: r.phi,
-            p_pred: unpack(&r.p_pred),
-            p_post: unpack(&r.p_post),
+            p_pred: unpack(&packed[..p]),
+            p_post: unpack(&packed[p..]),
             dx: r.dx,
         })
     }
@@ -150,13 +168,13 @@ impl SmootherLog {
     pub fn smooth(
         &self,
         cancel: &CancelToken,
-        mut visit: impl FnMut(usize, &CovEpoch, &Smoothed),
-    ) -> Result<SmoothedCorrections, SmootherError> {
+        mut visit: impl FnMut(usize, &CovEpoch<N>, &Smoothed<N>),
+    ) -> Result<SmoothedCorrections<N>, SmootherError> {
         let n = self.recs.len();
         let Some(last) = n.checked_sub(1).and_then(|k| self.epoch(k)) else {
             return Err(SmootherError::Empty);
         };
-        let mut dx = vec![StateVec::zeros(); n];
+        let mut dx = vec![StateVecN::<N>::zeros(); n];
         let mut s = Smoothed::last(&last);
         visit(n - 1, &last, &s);
         let mut next = last;
@@ -182,13 +200,13 @@ impl SmootherLog {
 
 /// The smoothed corrections of every epoch, to be re-applied at full rate.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SmoothedCorrections {
+pub struct SmoothedCorrections<const N: usize = N_STATES> {
     t_s: Vec<f64>,
-    applied: Vec<StateVec>,
-    dx: Vec<StateVec>,
+    applied: Vec<StateVecN<N>>,
+    dx: Vec<StateVecN<N>>,
 }
 
-impl SmoothedCorrections {
+impl<const N: usize> SmoothedCorrections<N> {
     /// Number of epochs.
     pub fn len(&self) -> usize {
         self.t_s.len()
@@ -198,17 +216,17 @@ impl SmoothedCorrections {
         self.t_s.is_empty()
     }
     /// `ê⁺_k` of epoch `k`.
-    pub fn at_epoch(&self, k: usize) -> Option<&StateVec> {
+    pub fn at_epoch(&self, k: usize) -> Option<&StateVecN<N>> {
         self.dx.get(k)
     }
     /// The correction for a forward state at time `t_s` \[s\] (see the module
     /// documentation); `epoch` is the index of the latest epoch at or before `t_s`
     /// (the caller tracks it as it walks forward). Before the first and after the last
     /// epoch the nearest epoch's correction is used.
-    pub fn at(&self, epoch: usize, t_s: f64) -> StateVec {
+    pub fn at(&self, epoch: usize, t_s: f64) -> StateVecN<N> {
         let n = self.t_s.len();
         if n == 0 {
-            return StateVec::zeros();
+            return StateVecN::<N>::zeros();
         }
         let k = epoch.min(n - 1);
         let tk = self.t_s[k];
@@ -230,17 +248,26 @@ impl SmoothedCorrections {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+    use sdins_core::aiding::error_model::{StateMat, StateVec, N_STATES_SF};
 
-    #[test]
-    fn pack_roundtrip_and_size() {
-        let mut m = StateMat::zeros();
-        for i in 0..N_STATES {
-            for j in 0..N_STATES {
+    fn roundtrip<const N: usize>() -> usize {
+        let mut m = StateMatN::<N>::zeros();
+        for i in 0..N {
+            for j in 0..N {
                 m[(i, j)] = (i.min(j) * 100 + i.max(j)) as f64;
             }
         }
-        assert_eq!(unpack(&pack(&m)), m);
-        assert_eq!(std::mem::size_of::<Record>(), 3848);
+        let mut v = Vec::new();
+        pack_into(&m, &mut v);
+        assert_eq!(v.len(), packed_len(N));
+        assert_eq!(unpack::<N>(&v), m);
+        std::mem::size_of::<Record<N>>() + 2 * 8 * packed_len(N)
+    }
+
+    #[test]
+    fn pack_roundtrip_and_size() {
+        assert_eq!(roundtrip::<N_STATES>(), 3848);
+        assert_eq!(roundtrip::<N_STATES_SF>(), 7400);
     }
 
     #[test]
@@ -252,7 +279,7 @@ mod tests {
             p_post: StateMat::identity(),
             dx: StateVec::zeros(),
         };
-        let mut log = SmootherLog::new();
+        let mut log = SmootherLog::<N_STATES>::new();
         assert!(matches!(
             log.smooth(&CancelToken::new(), |_, _, _| {}),
             Err(SmootherError::Empty)

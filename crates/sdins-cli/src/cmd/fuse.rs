@@ -69,6 +69,10 @@ pub struct Args {
     /// ≥ 5 m/s, heading from the GNSS track)
     #[arg(long)]
     pub in_motion: bool,
+    /// also estimate accelerometer and gyro scale factors (21 states) with prior σ
+    /// ACCEL_PPM,GYRO_PPM per axis
+    #[arg(long)]
+    pub scale_factors_ppm: Option<String>,
     /// output folder (default ./sdins-out/fuse-<scenario>)
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -135,6 +139,25 @@ fn err_row(e: &sdins_sim::fuse::FuseEpoch) -> ErrRow {
     (e.t_s, v, sg)
 }
 
+/// `--scale-factors-ppm ACCEL,GYRO`: prior σ of the scale-factor states, in (0, 1e5] ppm.
+pub(crate) fn scale_factor_prior(s: &str) -> Result<sdins_sim::fuse::ScaleFactorPrior, CliError> {
+    let v: Vec<&str> = s.split(',').map(str::trim).collect();
+    let parsed: Vec<f64> = v.iter().filter_map(|t| t.parse::<f64>().ok()).collect();
+    let prior = match parsed[..] {
+        [a, g] if v.len() == 2 && a > 0.0 && g > 0.0 => Some(sdins_sim::fuse::ScaleFactorPrior {
+            accel_ppm: [a; 3],
+            gyro_ppm: [g; 3],
+        }),
+        _ => None,
+    };
+    match prior {
+        Some(p) if p.validate().is_ok() => Ok(p),
+        _ => Err(CliError::bad(format!(
+            "--scale-factors-ppm: expected ACCEL_PPM,GYRO_PPM, two numbers in (0, 100000], got `{s}`"
+        ))),
+    }
+}
+
 fn check_sigma(name: &str, v: Option<f64>) -> Result<(), CliError> {
     match v {
         Some(x) if !(x.is_finite() && x > 0.0) => Err(CliError::bad(format!(
@@ -184,6 +207,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     check_sigma("--zupt-sigma-mps", args.zupt_sigma_mps)?;
     check_sigma("--nhc-sigma-mps", args.nhc_sigma_mps)?;
+    let scale_factors = args
+        .scale_factors_ppm
+        .as_deref()
+        .map(scale_factor_prior)
+        .transpose()?;
     let gnss = scn.gnss.clone().unwrap_or_default();
     let opts = FuseOptions {
         algo,
@@ -194,6 +222,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         nhc_sigma_mps: args.nhc_sigma_mps,
         smooth: args.smooth,
         in_motion: args.in_motion.then(sdins_sim::fuse::InMotionInit::default),
+        scale_factors,
         ..FuseOptions::default()
     };
     let out = args
@@ -348,6 +377,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         "gyro_bias_est_rps": v3(&s.est_bias.1),
         "gyro_bias_true_rps": v3(&s.true_bias.1),
     });
+    let mut summary = summary;
+    if let Some((ta, tg)) = s.true_scale {
+        let ppm = |v: &sdins_core::math::Vec3| [v.x * 1e6, v.y * 1e6, v.z * 1e6];
+        summary["accel_scale_est_ppm"] = ppm(&s.est_scale.0).into();
+        summary["accel_scale_true_ppm"] = ppm(&ta).into();
+        summary["gyro_scale_est_ppm"] = ppm(&s.est_scale.1).into();
+        summary["gyro_scale_true_ppm"] = ppm(&tg).into();
+    }
     let mut fields = toml::Table::new();
     fields.insert("scenario".into(), scn.name.clone().into());
     fields.insert("algo".into(), args.algo.clone().into());
@@ -355,6 +392,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     fields.insert("run".into(), (args.run as i64).into());
     fields.insert("cov_rate_hz".into(), args.cov_rate_hz.into());
     fields.insert("gate".into(), (!args.no_gate).into());
+    if let Some(sp) = &scale_factors {
+        fields.insert(
+            "scale_factor_prior_accel_ppm".into(),
+            sp.accel_ppm[0].into(),
+        );
+        fields.insert("scale_factor_prior_gyro_ppm".into(), sp.gyro_ppm[0].into());
+    }
     crate::report::write_run_toml(&out, fields)?;
     if args.json {
         println!("{summary:#}");

@@ -160,6 +160,11 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         lever_arm_b_m: lever,
         nhc_sigma_mps: args.nhc_sigma_mps,
         smooth: args.smooth,
+        scale_factors: args
+            .scale_factors_ppm
+            .as_deref()
+            .map(super::fuse::scale_factor_prior)
+            .transpose()?,
         ..RecordOptions::default()
     };
     let stem = imu
@@ -313,6 +318,8 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         "t_start_s": r.summary.t_start_s,
         "accel_bias_est_mps2": v3(&r.summary.final_bias.0),
         "gyro_bias_est_rps": v3(&r.summary.final_bias.1),
+        "accel_scale_est_ppm": v3(&(r.summary.final_scale.0 * 1e6)),
+        "gyro_scale_est_ppm": v3(&(r.summary.final_scale.1 * 1e6)),
         "final": last_fwd.map(|p| serde_json::json!({
             "t_s": p.t_s, "lat_deg": p.state.lat_rad.to_degrees(), "lon_deg": p.state.lon_rad.to_degrees(), "h_m": p.state.h_m
         })),

@@ -4,20 +4,26 @@
 //!
 //! ## State and conventions
 //! The 15 error states of [`super::error_model`] (δL, δλ, δh; δv^n; ε; b_a; b_g), all
-//! **estimate − truth**. Attitude: convention G of `docs/conventions.md`,
+//! **estimate − truth**, or 21 with the accelerometer and gyro scale factors
+//! (`Ekf<M, 21>`; states 15–20 = `s − ŝ`, random constants with prior σ from P0 and no
+//! process noise). Attitude: convention G of `docs/conventions.md`,
 //! `Ĉ_b^n = (I + [ε×]) C_b^n`. The bias states are the residual errors of the
 //! *compensated* sensor outputs (`f̂ − f`, `ω̂ − ω`, i.e. true bias − estimated bias), so
 //! that `δv̇ ∋ C_b^n b_a` and `ε̇ ∋ C_b^n b_g` as in the error model.
 //!
 //! ## Propagation
-//! The navigation state is advanced every update by the mechanization with bias-compensated
-//! increments `Δθ − b̂_g δt`, `Δv − b̂_a δt`. The covariance is propagated at a lower rate,
+//! The navigation state is advanced every update by the mechanization with compensated
+//! increments `(Δθ − b̂_g δt) ⊘ (1 + ŝ_g)`, `(Δv − b̂_a δt) ⊘ (1 + ŝ_a)` (per axis; the exact
+//! inverse of the sensor model `f̃ = (1 + s) f + b`; `ŝ = 0` in the 15-state filter). The covariance is propagated at a lower rate,
 //! every `cov_updates` navigation updates (and at every measurement), over the interval
 //! `τ` since the last covariance epoch:
 //! * `F` of the error model at the epoch's state with the interval-mean specific force
 //!   `f^n = Σ Ĉ_b^n Δv / τ`, plus the bias models: a first-order Gauss–Markov bias of
 //!   steady-state σ and correlation time T has `ḃ = −b/T + w`, `q = 2σ²/T`; `T = ∞` is a
-//!   random constant (optionally plus a random walk of density K, `q = K²`);
+//!   random constant (optionally plus a random walk of density K, `q = K²`); in the
+//!   21-state filter the scale-factor columns `∂δv̇/∂δs_a = C_b^n diag(f^b)` and
+//!   `∂ε̇/∂δs_g = C_b^n diag(ω_ib^b)` are the interval means `Σ Ĉ diag(Δv)/τ` and
+//!   `Σ Ĉ diag(Δθ)/τ` (Groves 2nd ed. §14.2, the "additional IMU error states");
 //! * `Φ = I + Fτ + (Fτ)²/2 + (Fτ)³/6` (Groves (3.34) truncated, §14.2.3);
 //! * `Q = ½(Φ Q_c Φᵀ + Q_c) τ` (trapezoidal rule), `Q_c = G diag(ARW², VRW², q_b) Gᵀ`, the
 //!   white noises entering through `C_b^n` (Groves §14.2.2);
@@ -28,7 +34,8 @@
 //!   (14.110)); `ν_p = T (L̂_a − L, λ̂_a − λ, ĥ_a − h)` with `T = diag(R_M+h, (R_N+h)cos L, −1)`
 //!   \[m, NED\]; `H_p = [T, 0, −[(Ĉ l)×], 0, 0]`.
 //! * GNSS velocity: `v̂_a = v̂ + Ĉ (ω̂_eb^b × l)`, `ω_eb^b = ω_ib^b − C_n^b ω_ie^n` (Groves
-//!   (14.111)); `H_v = [0, I, −[(Ĉ(ω × l))×], 0, −Ĉ [l×]]`.
+//!   (14.111)); `H_v = [0, I, −[(Ĉ(ω × l))×], 0, −Ĉ [l×]]`, and in the 21-state filter
+//!   `−Ĉ [l×] diag(ω_ib^b)` in the gyro scale-factor columns.
 //! * Time of validity: a fix with time `t` inside the last navigation interval
 //!   `(t_{k−1}, t_k]` is compared with the state interpolated to `t` with constant
 //!   acceleration over the interval: `v(t) = v_k − a τ`, `p(t) = p_k − τ (v_k − ½ a τ)`,
@@ -45,7 +52,7 @@
 //! `NIS = νᵀ S⁻¹ ν`, `K = P Hᵀ S⁻¹`, `x̂ = K ν`, Joseph form
 //! `P⁺ = (I − KH) P (I − KH)ᵀ + K R Kᵀ` (Groves (3.82)... (3.85) family), symmetrised.
 //! Then the closed-loop correction (Groves §14.1.1): `L −= x̂_L`, …, `v −= δv̂`,
-//! `Ĉ ← exp(−[ε̂×]) Ĉ`, `b̂_a += x̂_ba`, `b̂_g += x̂_bg`, `x̂ = 0`.
+//! `Ĉ ← exp(−[ε̂×]) Ĉ`, `b̂_a += x̂_ba`, `b̂_g += x̂_bg` (and `ŝ += x̂_s`), `x̂ = 0`.
 //!
 //! ## Gating and its policy
 //! A GNSS fix whose NIS exceeds the threshold of its degrees of freedom is rejected and
@@ -55,8 +62,8 @@
 //! fix is applied ungated (a reset of position/velocity onto GNSS).
 
 use super::error_model::{
-    f_matrix, position_scale, transition, ModelPoint, StateMat, StateVec, I_ATT, I_BA, I_BG, I_POS,
-    I_VEL, N_STATES,
+    f_matrix, position_scale, transition, ModelPoint, StateMatN, StateVecN, I_ATT, I_BA, I_BG,
+    I_POS, I_SA, I_SG, I_VEL, N_STATES,
 };
 use crate::coning::Increment;
 use crate::earth::EarthModel;
@@ -222,24 +229,24 @@ impl core::error::Error for FilterError {}
 /// epoch (the error of the state *before* the corrections is the error after them plus
 /// `dx`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CovEpoch {
+pub struct CovEpoch<const N: usize = N_STATES> {
     /// time \[s\]
     pub t_s: f64,
     /// transition Φ(k, k−1) used from the previous epoch
-    pub phi: StateMat,
+    pub phi: StateMatN<N>,
     /// predicted covariance P(k|k−1)
-    pub p_pred: StateMat,
+    pub p_pred: StateMatN<N>,
     /// covariance after the epoch's measurements P(k|k) (filled by [`Ekf::take_epoch`])
-    pub p_post: StateMat,
+    pub p_post: StateMatN<N>,
     /// sum of the corrections applied at the epoch (filled by [`Ekf::take_epoch`])
-    pub dx: StateVec,
+    pub dx: StateVecN<N>,
 }
 
 /// A navigation state corrected by an error estimate `x` (estimate − truth, the states of
 /// [`super::error_model`]): `L −= δL`, `λ −= δλ`, `h −= δh`, `v −= δv`,
 /// `Ĉ ← exp(−[ε×]) Ĉ` (Groves §14.1.1). The filter's closed-loop correction and the
-/// smoother's re-applied corrections both use it.
-pub fn correct_nav_state(state: &NavState, x: &StateVec) -> NavState {
+/// smoother's re-applied corrections both use it (only the first 9 states are read).
+pub fn correct_nav_state<const N: usize>(state: &NavState, x: &StateVecN<N>) -> NavState {
     let mut s = *state;
     s.lat_rad -= x[I_POS];
     s.lon_rad = wrap_pi(s.lon_rad - x[I_POS + 1]);
@@ -250,14 +257,20 @@ pub fn correct_nav_state(state: &NavState, x: &StateVec) -> NavState {
     s
 }
 
-/// The filter.
+/// The filter: `N = 15` (biases) or `N = 21` (biases and scale factors).
 #[derive(Clone, Debug)]
-pub struct Ekf<M: Mechanization> {
+pub struct Ekf<M: Mechanization, const N: usize = N_STATES> {
     mech: M,
     cfg: EkfConfig,
-    p: StateMat,
+    p: StateMatN<N>,
     b_a: Vec3,
     b_g: Vec3,
+    /// scale-factor estimates (zero in the 15-state filter)
+    s_a: Vec3,
+    s_g: Vec3,
+    /// Σ Ĉ diag(Δv) and Σ Ĉ diag(Δθ) since the covariance epoch (21 states)
+    sa_acc: Mat3,
+    sg_acc: Mat3,
     prev: NavState,
     cur: NavState,
     /// Σ Ĉ Δv since the covariance epoch, and its interval
@@ -266,9 +279,9 @@ pub struct Ekf<M: Mechanization> {
     updates_acc: usize,
     /// compensated rate of the last update \[rad/s\]
     omega_ib_b: Vec3,
-    last_epoch: Option<CovEpoch>,
+    last_epoch: Option<CovEpoch<N>>,
     /// corrections applied since the last covariance epoch
-    dx_acc: StateVec,
+    dx_acc: StateVecN<N>,
     consecutive_rejections: u32,
     rejected_total: u64,
 }
@@ -281,14 +294,25 @@ fn finite_state(s: &NavState) -> bool {
         && s.c_b_n.iter().all(|x| x.is_finite())
 }
 
-fn cov_ok(p: &StateMat) -> bool {
-    p.iter().all(|x| x.is_finite()) && (0..N_STATES).all(|i| p[(i, i)] >= 0.0)
+fn cov_ok<const N: usize>(p: &StateMatN<N>) -> bool {
+    p.iter().all(|x| x.is_finite()) && (0..N).all(|i| p[(i, i)] >= 0.0)
 }
 
-impl<M: Mechanization> Ekf<M> {
+impl<M: Mechanization, const N: usize> Ekf<M, N> {
+    /// Whether the filter carries the scale-factor states.
+    const SCALE_FACTORS: bool = {
+        assert!(
+            N == N_STATES || N == N_STATES + 6,
+            "the filter has 15 or 21 states"
+        );
+        N > N_STATES
+    };
+
     /// New filter on `mech` (at its initial state), initial covariance `p0`, initial bias
-    /// estimates `b_a0` \[m/s²\], `b_g0` \[rad/s\].
-    pub fn new(mech: M, cfg: EkfConfig, p0: StateMat, b_a0: Vec3, b_g0: Vec3) -> Self {
+    /// estimates `b_a0` \[m/s²\], `b_g0` \[rad/s\]; scale-factor estimates start at zero
+    /// ([`Ekf::with_scale_factors`] sets them).
+    pub fn new(mech: M, cfg: EkfConfig, p0: StateMatN<N>, b_a0: Vec3, b_g0: Vec3) -> Self {
+        let _ = Self::SCALE_FACTORS;
         let s = mech.state();
         Self {
             mech,
@@ -296,6 +320,10 @@ impl<M: Mechanization> Ekf<M> {
             p: (p0 + p0.transpose()) * 0.5,
             b_a: b_a0,
             b_g: b_g0,
+            s_a: Vec3::zeros(),
+            s_g: Vec3::zeros(),
+            sa_acc: Mat3::zeros(),
+            sg_acc: Mat3::zeros(),
             prev: s,
             cur: s,
             f_acc: Vec3::zeros(),
@@ -303,10 +331,20 @@ impl<M: Mechanization> Ekf<M> {
             updates_acc: 0,
             omega_ib_b: Vec3::zeros(),
             last_epoch: None,
-            dx_acc: StateVec::zeros(),
+            dx_acc: StateVecN::<N>::zeros(),
             consecutive_rejections: 0,
             rejected_total: 0,
         }
+    }
+
+    /// Start the scale-factor estimates at `s_a0`, `s_g0` (dimensionless, e.g. 1e-4 =
+    /// 100 ppm); ignored by the 15-state filter.
+    pub fn with_scale_factors(mut self, s_a0: Vec3, s_g0: Vec3) -> Self {
+        if Self::SCALE_FACTORS {
+            self.s_a = s_a0;
+            self.s_g = s_g0;
+        }
+        self
     }
 
     /// Current navigation state (corrected).
@@ -314,12 +352,16 @@ impl<M: Mechanization> Ekf<M> {
         self.cur
     }
     /// Current covariance.
-    pub fn covariance(&self) -> &StateMat {
+    pub fn covariance(&self) -> &StateMatN<N> {
         &self.p
     }
     /// Estimated biases (accelerometer \[m/s²\], gyro \[rad/s\]).
     pub fn biases(&self) -> (Vec3, Vec3) {
         (self.b_a, self.b_g)
+    }
+    /// Estimated scale factors (accelerometer, gyro; dimensionless; zero with 15 states).
+    pub fn scale_factors(&self) -> (Vec3, Vec3) {
+        (self.s_a, self.s_g)
     }
     /// GNSS fixes rejected by the gate so far.
     pub fn rejected_total(&self) -> u64 {
@@ -333,7 +375,7 @@ impl<M: Mechanization> Ekf<M> {
     /// current covariance as `P(k|k)` and the corrections applied since the epoch began.
     /// Call it after each navigation update and its measurements: an epoch not taken
     /// before the next covariance propagation is replaced.
-    pub fn take_epoch(&mut self) -> Option<CovEpoch> {
+    pub fn take_epoch(&mut self) -> Option<CovEpoch<N>> {
         self.last_epoch.take().map(|mut e| {
             e.p_post = self.p;
             e.dx = self.dx_acc;
@@ -343,13 +385,13 @@ impl<M: Mechanization> Ekf<M> {
 
     /// The initial epoch (time of the initial state, `Φ = I`, `P(0|−1) = P(0|0) = P0`,
     /// no correction): the first record of a smoother log.
-    pub fn initial_epoch(&self) -> CovEpoch {
+    pub fn initial_epoch(&self) -> CovEpoch<N> {
         CovEpoch {
             t_s: self.cur.t_s,
-            phi: StateMat::identity(),
+            phi: StateMatN::<N>::identity(),
             p_pred: self.p,
             p_post: self.p,
-            dx: StateVec::zeros(),
+            dx: StateVecN::<N>::zeros(),
         }
     }
     /// The mechanization.
@@ -365,8 +407,12 @@ impl<M: Mechanization> Ekf<M> {
         let n = samples.len().min(4);
         let mut dv_sum = Vec3::zeros();
         let mut dth_sum = Vec3::zeros();
+        let (k_g, k_a) = (Vec3::repeat(1.0) + self.s_g, Vec3::repeat(1.0) + self.s_a);
         for (c, s) in comp.iter_mut().zip(samples.iter()) {
-            *c = Increment::new(s.dtheta_b_rad - self.b_g * dt, s.dv_b_mps - self.b_a * dt);
+            *c = Increment::new(
+                (s.dtheta_b_rad - self.b_g * dt).component_div(&k_g),
+                (s.dv_b_mps - self.b_a * dt).component_div(&k_a),
+            );
             dv_sum += c.dv_b_mps;
             dth_sum += c.dtheta_b_rad;
         }
@@ -383,7 +429,12 @@ impl<M: Mechanization> Ekf<M> {
         } else {
             Vec3::zeros()
         };
-        self.f_acc += 0.5 * (c_before + self.cur.c_b_n) * dv_sum;
+        let c_mid = 0.5 * (c_before + self.cur.c_b_n);
+        self.f_acc += c_mid * dv_sum;
+        if Self::SCALE_FACTORS {
+            self.sa_acc += c_mid * Mat3::from_diagonal(&dv_sum);
+            self.sg_acc += c_mid * Mat3::from_diagonal(&dth_sum);
+        }
         self.tau_acc += tau;
         self.updates_acc += 1;
         if self.updates_acc >= self.cfg.cov_updates.max(1) {
@@ -402,9 +453,17 @@ impl<M: Mechanization> Ekf<M> {
         let s = &self.cur;
         let f_n = self.f_acc / tau;
         let pt = ModelPoint::on_earth(&self.cfg.earth, s.lat_rad, s.h_m, s.v_n_mps, s.c_b_n, f_n);
-        let mut f = f_matrix(&pt, true, false);
+        let f15 = f_matrix(&pt, true, false);
+        let mut f = StateMatN::<N>::zeros();
+        f.fixed_view_mut::<N_STATES, N_STATES>(0, 0).copy_from(&f15);
+        if Self::SCALE_FACTORS {
+            f.fixed_view_mut::<3, 3>(I_VEL, I_SA)
+                .copy_from(&(self.sa_acc / tau));
+            f.fixed_view_mut::<3, 3>(I_ATT, I_SG)
+                .copy_from(&(self.sg_acc / tau));
+        }
         let nm = &self.cfg.noise;
-        let mut qc = StateMat::zeros();
+        let mut qc = StateMatN::<N>::zeros();
         let c = s.c_b_n;
         let sq = |v: &Vec3| Mat3::from_diagonal(&v.component_mul(v));
         qc.fixed_view_mut::<3, 3>(I_VEL, I_VEL)
@@ -432,6 +491,8 @@ impl<M: Mechanization> Ekf<M> {
         let p = phi * self.p * phi.transpose() + q;
         self.p = (p + p.transpose()) * 0.5;
         self.f_acc = Vec3::zeros();
+        self.sa_acc = Mat3::zeros();
+        self.sg_acc = Mat3::zeros();
         self.tau_acc = 0.0;
         self.updates_acc = 0;
         if !cov_ok(&self.p) {
@@ -445,9 +506,9 @@ impl<M: Mechanization> Ekf<M> {
             phi,
             p_pred: self.p,
             p_post: self.p,
-            dx: StateVec::zeros(),
+            dx: StateVecN::<N>::zeros(),
         });
-        self.dx_acc = StateVec::zeros();
+        self.dx_acc = StateVecN::<N>::zeros();
         Ok(())
     }
 
@@ -505,7 +566,7 @@ impl<M: Mechanization> Ekf<M> {
             wrap_pi(lon - m.lon_rad) * t.y + cl_n.y,
             -(h - m.h_m) + cl_n.z,
         );
-        let mut h_p = SMatrix::<f64, 3, N_STATES>::zeros();
+        let mut h_p = SMatrix::<f64, 3, N>::zeros();
         for i in 0..3 {
             h_p[(i, I_POS + i)] = t[i];
         }
@@ -522,14 +583,19 @@ impl<M: Mechanization> Ekf<M> {
                 let w_eb = self.omega_ib_b - c.transpose() * w_ie_n;
                 let wl = c * w_eb.cross(&l);
                 let nu_v = v + wl - v_meas;
-                let mut hm = SMatrix::<f64, 6, N_STATES>::zeros();
-                hm.fixed_view_mut::<3, N_STATES>(0, 0).copy_from(&h_p);
+                let mut hm = SMatrix::<f64, 6, N>::zeros();
+                hm.fixed_view_mut::<3, N>(0, 0).copy_from(&h_p);
                 for i in 0..3 {
                     hm[(3 + i, I_VEL + i)] = 1.0;
                 }
                 hm.fixed_view_mut::<3, 3>(3, I_ATT).copy_from(&(-skew(&wl)));
                 hm.fixed_view_mut::<3, 3>(3, I_BG)
                     .copy_from(&(-(c * skew(&l))));
+                if Self::SCALE_FACTORS {
+                    let w = Mat3::from_diagonal(&self.omega_ib_b);
+                    hm.fixed_view_mut::<3, 3>(3, I_SG)
+                        .copy_from(&(-(c * skew(&l) * w)));
+                }
                 let mut nu = SVector::<f64, 6>::zeros();
                 nu.fixed_rows_mut::<3>(0).copy_from(&nu_p);
                 nu.fixed_rows_mut::<3>(3).copy_from(&nu_v);
@@ -543,7 +609,7 @@ impl<M: Mechanization> Ekf<M> {
 
     fn gated<const D: usize>(
         &mut self,
-        h: &SMatrix<f64, D, N_STATES>,
+        h: &SMatrix<f64, D, N>,
         nu: &SVector<f64, D>,
         r: &SMatrix<f64, D, D>,
         gate: Option<[f64; 6]>,
@@ -588,7 +654,7 @@ impl<M: Mechanization> Ekf<M> {
     /// at rest).
     pub fn update_zupt(&mut self, sigma_mps: f64) -> Result<UpdateReport, FilterError> {
         self.propagate_covariance()?;
-        let mut h = SMatrix::<f64, 3, N_STATES>::zeros();
+        let mut h = SMatrix::<f64, 3, N>::zeros();
         for i in 0..3 {
             h[(i, I_VEL + i)] = 1.0;
         }
@@ -605,7 +671,7 @@ impl<M: Mechanization> Ekf<M> {
         let v_b = ct * v;
         let hv = ct;
         let ha = ct * skew(&v);
-        let mut h = SMatrix::<f64, 2, N_STATES>::zeros();
+        let mut h = SMatrix::<f64, 2, N>::zeros();
         for (row, axis) in [1usize, 2].iter().enumerate() {
             for j in 0..3 {
                 h[(row, I_VEL + j)] = hv[(*axis, j)];
@@ -621,7 +687,7 @@ impl<M: Mechanization> Ekf<M> {
     fn update<const D: usize>(
         &mut self,
         kind: MeasKind,
-        h: &SMatrix<f64, D, N_STATES>,
+        h: &SMatrix<f64, D, N>,
         nu: &SVector<f64, D>,
         r: &SMatrix<f64, D, D>,
         threshold: Option<f64>,
@@ -662,9 +728,9 @@ impl<M: Mechanization> Ekf<M> {
             }
         }
         // K = P Hᵀ S⁻¹  (solve S Kᵀ = H P)
-        let k: SMatrix<f64, N_STATES, D> = chol.solve(&pht.transpose()).transpose();
+        let k: SMatrix<f64, N, D> = chol.solve(&pht.transpose()).transpose();
         let x = k * nu;
-        let ikh = StateMat::identity() - k * h;
+        let ikh = StateMatN::<N>::identity() - k * h;
         let p = ikh * self.p * ikh.transpose() + k * r * k.transpose();
         self.p = (p + p.transpose()) * 0.5;
         if !cov_ok(&self.p) {
@@ -681,11 +747,15 @@ impl<M: Mechanization> Ekf<M> {
     }
 
     /// Closed-loop correction of the navigation state and biases with the error estimate.
-    fn apply_correction(&mut self, x: &StateVec) {
+    fn apply_correction(&mut self, x: &StateVecN<N>) {
         self.dx_acc += x;
         let s = correct_nav_state(&self.cur, x);
         self.b_a += x.fixed_rows::<3>(I_BA).into_owned();
         self.b_g += x.fixed_rows::<3>(I_BG).into_owned();
+        if Self::SCALE_FACTORS {
+            self.s_a += x.fixed_rows::<3>(I_SA).into_owned();
+            self.s_g += x.fixed_rows::<3>(I_SG).into_owned();
+        }
         // the interpolation base moves with the state
         let d_lat = s.lat_rad - self.cur.lat_rad;
         let d_lon = wrap_pi(s.lon_rad - self.cur.lon_rad);

@@ -10,6 +10,13 @@
 //! | 6, 7, 8 | ε (N, E, D), convention G: `Ĉ_b^n = (I + [ε×]) C_b^n` | rad |
 //! | 9, 10, 11 | accelerometer bias (error of the compensated specific force), body | m/s² |
 //! | 12, 13, 14 | gyro bias (error of the compensated angular rate), body | rad/s |
+//! | 15, 16, 17 | accelerometer scale-factor error `s − ŝ` (21-state filter only), body | 1 |
+//! | 18, 19, 20 | gyro scale-factor error `s − ŝ` (21-state filter only), body | 1 |
+//!
+//! The scale-factor states enter as `δf^b = diag(f^b) δs_a`, `δω^b = diag(ω_ib^b) δs_g`
+//! (Groves 2nd ed. §14.2, "additional IMU error states": the accelerometer and gyro error states of the
+//! "scale-factor" model; the sensor model is `f̃ = (1 + s) f + b` per axis, compensated
+//! as `f̂ = (f̃ − b̂)/(1 + ŝ)`, so that `f̂ − f ≈ diag(f)(s − ŝ) + (b − b̂)`).
 //!
 //! Groves' δψ^n_nb is the same attitude convention (`Ĉ Cᵀ ≈ I + [δψ×]`).
 //!
@@ -26,12 +33,18 @@ use crate::earth::EarthModel;
 use crate::math::{skew, Mat3, Vec3};
 use nalgebra::{SMatrix, SVector};
 
-/// Number of states of the navigation-error model.
+/// Number of states of the navigation-error model (position, velocity, attitude, biases).
 pub const N_STATES: usize = 15;
+/// Number of states with the accelerometer and gyro scale factors.
+pub const N_STATES_SF: usize = 21;
 /// State vector.
 pub type StateVec = SVector<f64, N_STATES>;
 /// State matrix (F, Φ, P, Q).
 pub type StateMat = SMatrix<f64, N_STATES, N_STATES>;
+/// State vector of an `N`-state filter (15 or 21).
+pub type StateVecN<const N: usize> = SVector<f64, N>;
+/// State matrix of an `N`-state filter (15 or 21).
+pub type StateMatN<const N: usize> = SMatrix<f64, N, N>;
 /// Index of the first position state (δL).
 pub const I_POS: usize = 0;
 /// Index of the first velocity state.
@@ -42,6 +55,10 @@ pub const I_ATT: usize = 6;
 pub const I_BA: usize = 9;
 /// Index of the first gyro-bias state.
 pub const I_BG: usize = 12;
+/// Index of the first accelerometer scale-factor state (21-state filter).
+pub const I_SA: usize = 15;
+/// Index of the first gyro scale-factor state (21-state filter).
+pub const I_SG: usize = 18;
 
 /// Everything the F matrix depends on at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,9 +190,9 @@ pub fn f_matrix(p: &ModelPoint, bias_states: bool, vertical_held: bool) -> State
 /// `Φ = I + A + A²/2 + A³/6`, `A = F Δt` (third-order Taylor series, Horner form; Groves
 /// (3.34) truncated; the bias → ε → δv → δp chain is nilpotent of length 3 and is
 /// integrated exactly).
-pub fn transition(f: &StateMat, dt: f64) -> StateMat {
+pub fn transition<const N: usize>(f: &StateMatN<N>, dt: f64) -> StateMatN<N> {
     let a = f * dt;
-    let i = StateMat::identity();
+    let i = StateMatN::<N>::identity();
     i + a * (i + a * (i + a / 3.0) / 2.0)
 }
 

@@ -26,22 +26,24 @@
 //! `P(k+1|k)`.
 
 use super::ekf::{CovEpoch, FilterError};
-use super::error_model::{StateMat, StateVec, N_STATES};
+#[cfg(test)]
+use super::error_model::{StateMat, StateVec};
+use super::error_model::{StateMatN, StateVecN, N_STATES};
 
 /// The smoothed error estimate and covariance at one epoch.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Smoothed {
+pub struct Smoothed<const N: usize = N_STATES> {
     /// `ê⁺_k`: smoothed estimate of the error of the forward corrected state
-    pub dx: StateVec,
+    pub dx: StateVecN<N>,
     /// smoothed covariance `P_s(k)`
-    pub p: StateMat,
+    pub p: StateMatN<N>,
 }
 
-impl Smoothed {
+impl<const N: usize> Smoothed<N> {
     /// The start of the backward pass at the last epoch: `ê = 0`, `P_s = P(N|N)`.
-    pub fn last(epoch: &CovEpoch) -> Self {
+    pub fn last(epoch: &CovEpoch<N>) -> Self {
         Self {
-            dx: StateVec::zeros(),
+            dx: StateVecN::<N>::zeros(),
             p: epoch.p_post,
         }
     }
@@ -49,15 +51,15 @@ impl Smoothed {
 
 /// One backward step: from the smoothed result at epoch k+1 (`next`, whose forward record
 /// is `rec_next`) to epoch k (forward record `rec`).
-pub fn rts_step(
-    rec: &CovEpoch,
-    rec_next: &CovEpoch,
-    next: &Smoothed,
-) -> Result<Smoothed, FilterError> {
+pub fn rts_step<const N: usize>(
+    rec: &CovEpoch<N>,
+    rec_next: &CovEpoch<N>,
+    next: &Smoothed<N>,
+) -> Result<Smoothed<N>, FilterError> {
     let pp = &rec_next.p_pred;
     // P(k+1|k) restricted to the states that carry variance
     let scale = pp.diagonal().amax().max(f64::MIN_POSITIVE);
-    let mut active = [false; N_STATES];
+    let mut active = [false; N];
     let mut m = *pp;
     for (i, a) in active.iter_mut().enumerate() {
         *a = pp[(i, i)] > scale * 1e-300;
