@@ -144,9 +144,9 @@ impl PsdTable {
             width = Some(n);
             let mut vals = [0.0; 4];
             for (j, (c, f)) in fields.iter().enumerate() {
-                let v: f64 = f.parse().map_err(|_| {
-                    invalid(file, ln, *c, format!("`{f}` is not a number"))
-                })?;
+                let v: f64 = f
+                    .parse()
+                    .map_err(|_| invalid(file, ln, *c, format!("`{f}` is not a number")))?;
                 if !v.is_finite() {
                     return Err(invalid(file, ln, *c, format!("{f}: must be finite")));
                 }
@@ -162,7 +162,10 @@ impl PsdTable {
                         file,
                         ln,
                         fields[0].0,
-                        format!("frequency {} Hz does not increase (previous row {prev} Hz)", vals[0]),
+                        format!(
+                            "frequency {} Hz does not increase (previous row {prev} Hz)",
+                            vals[0]
+                        ),
                     ));
                 }
             }
@@ -174,12 +177,7 @@ impl PsdTable {
             });
         }
         if freq_hz.len() < 2 {
-            return Err(invalid(
-                file,
-                1,
-                1,
-                "a PSD table needs at least two rows",
-            ));
+            return Err(invalid(file, 1, 1, "a PSD table needs at least two rows"));
         }
         Ok(PsdTable {
             freq_hz,
@@ -238,7 +236,10 @@ impl PsdTable {
                         key,
                         ln,
                         1,
-                        format!("frequency {} Hz does not increase (previous {prev} Hz)", r[0]),
+                        format!(
+                            "frequency {} Hz does not increase (previous {prev} Hz)",
+                            r[0]
+                        ),
                     ));
                 }
             }
@@ -386,6 +387,9 @@ impl VibrationReport {
         s
     }
 }
+
+/// `(base, offset)` phases `(sin, cos)` per component, whose angle sums are the phases.
+pub(crate) type Phases<'a> = (&'a [(f64, f64)], &'a [(f64, f64)]);
 
 /// Components per block of the vectorised sums.
 const LANES: usize = 2;
@@ -537,7 +541,9 @@ impl RandomVibration {
         index: u64,
     ) -> Result<(RandomVibration, VibrationReport), String> {
         if !(window_s.is_finite() && window_s > 0.0) {
-            return Err(format!("the vibration window must be > 0 s, got {window_s}"));
+            return Err(format!(
+                "the vibration window must be > 0 s, got {window_s}"
+            ));
         }
         let df = 1.0 / window_s;
         let tables: [Option<&PsdTable>; 2] = [spec.accel.as_ref(), spec.gyro.as_ref()];
@@ -600,7 +606,7 @@ impl RandomVibration {
                 continue;
             }
             let mut c = Coefs::new(kept.len());
-            for ax in 0..3 {
+            for (ax, sig_ax) in sig[kind].iter().enumerate() {
                 // one stream per (overlay, kind, axis); draws for every k ≤ k_max in order,
                 // so the threshold does not shift the numbers of other components
                 let mut rng = ChaCha20Rng::seed_from_u64(spec.seed);
@@ -612,7 +618,7 @@ impl RandomVibration {
                     *d = (a, b);
                 }
                 for (j, &k) in kept.iter().enumerate() {
-                    let s = sig[kind][ax][k];
+                    let s = sig_ax[k];
                     let (a, b) = (s * draws[k].0, s * draws[k].1);
                     let w = omega[j];
                     for (q, x) in [a, b, a / w, b / w].into_iter().enumerate() {
@@ -734,7 +740,7 @@ impl RandomVibration {
 
     /// `U(τ)`, `u̇`, `Θ(τ)`, `θ̇` without the start offsets; `phases`: `(sin, cos)` of
     /// `ω_k τ` (else computed).
-    fn raw(&self, tau: f64, phases: Option<(&[(f64, f64)], &[(f64, f64)])>) -> VibState {
+    fn raw(&self, tau: f64, phases: Option<Phases<'_>>) -> VibState {
         let mut st = VibState::default();
         let acc = |coef: &Coefs, val: &mut [f64; 3], der: &mut [f64; 3]| {
             if coef.is_empty() {
@@ -756,11 +762,7 @@ impl RandomVibration {
 
     /// The state at `τ` into the window (from rest at τ = 0); `phases`: `(base, offset)`
     /// sin/cos whose angle sum is `ω_k τ`.
-    pub(crate) fn state(
-        &self,
-        tau: f64,
-        phases: Option<(&[(f64, f64)], &[(f64, f64)])>,
-    ) -> VibState {
+    pub(crate) fn state(&self, tau: f64, phases: Option<Phases<'_>>) -> VibState {
         let mut s = self.raw(tau, phases);
         for ax in 0..3 {
             s.u[ax] -= self.u0[ax];
@@ -834,11 +836,8 @@ mod tests {
         assert!((t.integral(0, 0.0, 10.0) - 4.0).abs() < 1e-15);
         assert!((t.integral(0, 0.5, 1.0) - 0.875).abs() < 1e-15);
         // log-log: S = f² on [1, 2]: ∫ = 7/3; S = 1/f on [2, 4]: ∫ = 4 ln 2 · ... (S(2)=4 → 8/f)
-        let b = PsdTable::from_breakpoints(
-            &[vec![1.0, 1.0], vec![2.0, 4.0], vec![4.0, 2.0]],
-            "bp",
-        )
-        .unwrap();
+        let b = PsdTable::from_breakpoints(&[vec![1.0, 1.0], vec![2.0, 4.0], vec![4.0, 2.0]], "bp")
+            .unwrap();
         assert!((b.at(1, 1.5) - 2.25).abs() < 1e-14);
         assert!((b.integral(2, 0.0, 2.0) - 7.0 / 3.0).abs() < 1e-14);
         assert!((b.integral(0, 2.0, 4.0) - 8.0 * 2f64.ln()).abs() < 1e-14);

@@ -1223,9 +1223,18 @@ fn parse_random_vibration(
     for (k, v) in [
         ("overlay.axis", od.axis.as_ref().map(|v| v.span())),
         ("overlay.freq_hz", od.freq_hz.as_ref().map(|v| v.span())),
-        ("overlay.half_angle_deg", od.half_angle_deg.as_ref().map(|v| v.span())),
-        ("overlay.angle_amp_deg", od.angle_amp_deg.as_ref().map(|v| v.span())),
-        ("overlay.accel_amp_mps2", od.accel_amp_mps2.as_ref().map(|v| v.span())),
+        (
+            "overlay.half_angle_deg",
+            od.half_angle_deg.as_ref().map(|v| v.span()),
+        ),
+        (
+            "overlay.angle_amp_deg",
+            od.angle_amp_deg.as_ref().map(|v| v.span()),
+        ),
+        (
+            "overlay.accel_amp_mps2",
+            od.accel_amp_mps2.as_ref().map(|v| v.span()),
+        ),
         ("overlay.phase_deg", od.phase_deg.as_ref().map(|v| v.span())),
     ] {
         if let Some(span) = v {

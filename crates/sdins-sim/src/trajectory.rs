@@ -6,12 +6,12 @@
 //! values (flat turns, as in the papers' scenarios). Overlays add body coning, sculling
 //! and vibration on top.
 
+use crate::random_vibration::RandomVibration;
 use crate::vehicle::{
     aircraft_attitude, car_attitude, velocity_derivs, Track, Vehicle, VehicleError,
 };
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Mat3, Quat, Vec3};
-use crate::random_vibration::RandomVibration;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -688,11 +688,16 @@ impl Trajectory {
                 .iter()
                 .map(|o| (o.kind.omega_rps() * (t_base - o.start_s)).sin_cos()),
         );
-        out.0.extend(prev.0[n..].iter().zip(&step.0[n..]).map(|(&(sp, cp), &(ss, cs))| {
-            let (s, c) = (sp * cs + cp * ss, cp * cs - sp * ss);
-            let r = 1.5 - 0.5 * (s * s + c * c);
-            (s * r, c * r)
-        }));
+        out.0.extend(
+            prev.0[n..]
+                .iter()
+                .zip(&step.0[n..])
+                .map(|(&(sp, cp), &(ss, cs))| {
+                    let (s, c) = (sp * cs + cp * ss, cp * cs - sp * ss);
+                    let r = 1.5 - 0.5 * (s * s + c * c);
+                    (s * r, c * r)
+                }),
+        );
     }
 
     /// `(sin, cos)` of `Ω_k·off` for every overlay `k` into `out`: the per-node part of

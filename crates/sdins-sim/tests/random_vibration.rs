@@ -36,21 +36,42 @@ fn err_of(text: &str) -> String {
 fn bad_psd_input_is_a_located_error() {
     // missing file: names the file (relative to the scenario's folder)
     let e = err_of(&scenario(10.0, "wgs84", "accel_psd_file = \"nope.csv\""));
-    assert!(e.contains("/tmp/sdins-vib-test/nope.csv") && e.contains("cannot read"), "{e}");
+    assert!(
+        e.contains("/tmp/sdins-vib-test/nope.csv") && e.contains("cannot read"),
+        "{e}"
+    );
     // bad rows in a file: file:line:column
     let dir = std::env::temp_dir().join(format!("sdins-vib-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     for (body, want) in [
-        ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,-1e-3,1e-3\n", "p.csv:3:8: negative PSD"),
-        ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n0,1e-3,1e-3,1e-3\n", "p.csv:3:1: frequency 0 Hz does not increase"),
-        ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,NaN,1e-3\n", "p.csv:3:8: NaN: must be finite"),
-        ("freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,1e-3\n", "p.csv:3:1: expected 2 (freq, psd) or 4 (freq, x, y, z) columns, found 3"),
+        (
+            "freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,-1e-3,1e-3\n",
+            "p.csv:3:8: negative PSD",
+        ),
+        (
+            "freq,x,y,z\n0,1e-3,1e-3,1e-3\n0,1e-3,1e-3,1e-3\n",
+            "p.csv:3:1: frequency 0 Hz does not increase",
+        ),
+        (
+            "freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,NaN,1e-3\n",
+            "p.csv:3:8: NaN: must be finite",
+        ),
+        (
+            "freq,x,y,z\n0,1e-3,1e-3,1e-3\n1,1e-3,1e-3\n",
+            "p.csv:3:1: expected 2 (freq, psd) or 4 (freq, x, y, z) columns, found 3",
+        ),
     ] {
         let p = dir.join("p.csv");
         std::fs::write(&p, body).unwrap();
-        let text = scenario(10.0, "wgs84", &format!("accel_psd_file = \"{}\"", p.display()));
+        let text = scenario(
+            10.0,
+            "wgs84",
+            &format!("accel_psd_file = \"{}\"", p.display()),
+        );
         let e = match Scenario::from_toml(&text, "s.toml") {
-            Err(ScenarioError::Invalid { line, key, message, .. }) => {
+            Err(ScenarioError::Invalid {
+                line, key, message, ..
+            }) => {
                 assert_eq!((line, key.as_str()), (14, "overlay.accel_psd_file"));
                 message
             }
@@ -61,20 +82,50 @@ fn bad_psd_input_is_a_located_error() {
     let _ = std::fs::remove_dir_all(&dir);
     // inline breakpoints: row and entry
     for (bp, want) in [
-        ("[[1.0, 1e-3], [0.5, 1e-3]]", "breakpoint 2, entry 1: frequency 0.5 Hz does not increase"),
-        ("[[1.0, 1e-3], [2.0, -1e-3]]", "breakpoint 2, entry 2: PSD -0.001"),
-        ("[[1.0, 1e-3], [2.0, nan]]", "breakpoint 2, entry 2: PSD NaN"),
-        ("[[1.0, 1e-3, 2.0], [2.0, 1e-3]]", "breakpoint 1, entry 1: expected [f_hz, psd]"),
+        (
+            "[[1.0, 1e-3], [0.5, 1e-3]]",
+            "breakpoint 2, entry 1: frequency 0.5 Hz does not increase",
+        ),
+        (
+            "[[1.0, 1e-3], [2.0, -1e-3]]",
+            "breakpoint 2, entry 2: PSD -0.001",
+        ),
+        (
+            "[[1.0, 1e-3], [2.0, nan]]",
+            "breakpoint 2, entry 2: PSD NaN",
+        ),
+        (
+            "[[1.0, 1e-3, 2.0], [2.0, 1e-3]]",
+            "breakpoint 1, entry 1: expected [f_hz, psd]",
+        ),
     ] {
-        let e = err_of(&scenario(10.0, "wgs84", &format!("gyro_psd_breakpoints = {bp}")));
-        assert!(e.contains(want) && e.contains("gyro_psd_breakpoints"), "{e}");
+        let e = err_of(&scenario(
+            10.0,
+            "wgs84",
+            &format!("gyro_psd_breakpoints = {bp}"),
+        ));
+        assert!(
+            e.contains(want) && e.contains("gyro_psd_breakpoints"),
+            "{e}"
+        );
     }
     // no spectrum, keys of other overlay types, both forms at once
     let e = err_of(&scenario(10.0, "wgs84", "seed = 3"));
     assert!(e.contains("needs accel_psd_file"), "{e}");
-    let e = err_of(&scenario(10.0, "wgs84", "accel_psd_breakpoints = [[1.0, 1e-3], [2.0, 1e-3]]\nfreq_hz = 3.0"));
-    assert!(e.contains("overlay.freq_hz") && e.contains("not a key"), "{e}");
-    let e = err_of(&scenario(10.0, "wgs84", "accel_psd_breakpoints = [[1.0, 1e-3], [2.0, 1e-3]]\naccel_psd_file = \"x.csv\""));
+    let e = err_of(&scenario(
+        10.0,
+        "wgs84",
+        "accel_psd_breakpoints = [[1.0, 1e-3], [2.0, 1e-3]]\nfreq_hz = 3.0",
+    ));
+    assert!(
+        e.contains("overlay.freq_hz") && e.contains("not a key"),
+        "{e}"
+    );
+    let e = err_of(&scenario(
+        10.0,
+        "wgs84",
+        "accel_psd_breakpoints = [[1.0, 1e-3], [2.0, 1e-3]]\naccel_psd_file = \"x.csv\"",
+    ));
     assert!(e.contains("not both"), "{e}");
 }
 
@@ -119,14 +170,22 @@ fn vib_psd_csv_power_report() {
     assert!(p.dropped_below_threshold <= 1e-9 * smax * df * 30_000.0);
     // rectangle (components) vs trapezoid (table) rule: within 1e-4 of the total
     let sum = p.realised + p.dropped();
-    assert!((sum - p.specified).abs() <= 1e-4 * p.specified, "{sum} vs {}", p.specified);
+    assert!(
+        (sum - p.specified).abs() <= 1e-4 * p.specified,
+        "{sum} vs {}",
+        p.specified
+    );
     // the realised variance of the draws: Σ(a²+b²)/2 ~ P(1 ± 3.29 σ), σ² = Σ(S Δf)²/P²
     let (lin, _) = rv.coefficient_power();
     let var: f64 = (1..30_000)
         .map(|k| (t.at(2, k as f64 * df) * df).powi(2))
         .sum();
     for x in lin {
-        assert!((x - p.realised).abs() <= 3.29 * var.sqrt(), "{x} vs {}", p.realised);
+        assert!(
+            (x - p.realised).abs() <= 3.29 * var.sqrt(),
+            "{x} vs {}",
+            p.realised
+        );
     }
 }
 
@@ -181,7 +240,12 @@ fn increments_are_the_exact_velocity_change() {
     for ax in 0..3 {
         // the velocity starts from rest: the mean of Δv/δt is (u(T) − u(0))/T = 0 up to
         // rounding, so the mean square is the variance
-        assert!((ms[ax] - want[ax]).abs() <= 1e-12 * want[ax], "{ax}: {} vs {}", ms[ax], want[ax]);
+        assert!(
+            (ms[ax] - want[ax]).abs() <= 1e-12 * want[ax],
+            "{ax}: {} vs {}",
+            ms[ax],
+            want[ax]
+        );
     }
 }
 
@@ -211,18 +275,17 @@ fn refinement_and_determinism_with_vibration() {
     assert!(dth <= 2e-18, "{dth:e}");
     assert!(dv <= 1e-16, "{dv:e}");
     // same seed: same numbers; another seed: others
-    let again: Vec<TruthSample> = TruthGenerator::new(
-        &Scenario::from_toml(text, "t.toml").unwrap().trajectory,
-        c,
-    )
-    .collect();
+    let again: Vec<TruthSample> =
+        TruthGenerator::new(&Scenario::from_toml(text, "t.toml").unwrap().trajectory, c).collect();
     assert_eq!(a, again);
     let other = Scenario::from_toml(&text.replace("seed = 5", "seed = 6"), "t.toml").unwrap();
     let o: Vec<TruthSample> = TruthGenerator::new(&other.trajectory, c).collect();
     assert_ne!(a[100].inc, o[100].inc);
     // the overlay seed key overrides the IMU seed
     let keyed = Scenario::from_toml(
-        &text.replace("end_s = 3.3", "end_s = 3.3\nseed = 5").replace("seed = 5\n[[segment]]", "seed = 6\n[[segment]]"),
+        &text
+            .replace("end_s = 3.3", "end_s = 3.3\nseed = 5")
+            .replace("seed = 5\n[[segment]]", "seed = 6\n[[segment]]"),
         "t.toml",
     )
     .unwrap();
@@ -230,15 +293,13 @@ fn refinement_and_determinism_with_vibration() {
     assert_eq!(a, k);
     // before the window: at rest relative to the turn; after: rates zero, state frozen
     let k0 = s.trajectory.kinematics(0.25, 0.25);
-    let bare = Scenario::from_toml(
-        &text[..text.find("[[overlay]]").unwrap()],
-        "t.toml",
-    )
-    .unwrap();
+    let bare = Scenario::from_toml(&text[..text.find("[[overlay]]").unwrap()], "t.toml").unwrap();
     assert_eq!(k0, bare.trajectory.kinematics(0.25, 0.25));
     let k1 = s.trajectory.kinematics(3.6, 3.6);
     let kb = bare.trajectory.kinematics(3.6, 3.6);
-    assert!((k1.omega_nb_b_rps - k1.c_b_n.transpose() * kb.c_b_n * kb.omega_nb_b_rps).norm() < 1e-15);
+    assert!(
+        (k1.omega_nb_b_rps - k1.c_b_n.transpose() * kb.c_b_n * kb.omega_nb_b_rps).norm() < 1e-15
+    );
 }
 
 // ---------------------------------------------------------------------------------------
@@ -445,7 +506,9 @@ fn welch_check(
             })
             .collect();
         let emax = expect.iter().copied().fold(0.0, f64::max);
-        let tested: Vec<usize> = (1..nseg / 2).filter(|&j| expect[j] >= 1e-4 * emax).collect();
+        let tested: Vec<usize> = (1..nseg / 2)
+            .filter(|&j| expect[j] >= 1e-4 * emax)
+            .collect();
         let outside = tested
             .iter()
             .filter(|&&j| {
@@ -481,7 +544,10 @@ fn power_check(name: &str, y: &[[f64; 3]], rv: &RandomVibration, psd: &PsdTable,
             var += v * v;
         }
         let z = (ms - p) / var.sqrt();
-        println!("{name} axis {ax}: mean square {ms:.6e}, expected {p:.6e} ± {:.3e} (z = {z:.2})", var.sqrt());
+        println!(
+            "{name} axis {ax}: mean square {ms:.6e}, expected {p:.6e} ± {:.3e} (z = {z:.2})",
+            var.sqrt()
+        );
         assert!(z.abs() <= 3.29, "{name} axis {ax}: z = {z}");
     }
 }
@@ -490,7 +556,11 @@ fn welch_case(overlay: &str, name: &str, gyro: bool, psd: PsdTable) {
     // 491.52 s = 6 × 81.92 s: 11 Welch segments with 50 % overlap
     let t = std::time::Instant::now();
     let (s, v) = truth(&scenario(491.52, "wgs84", overlay));
-    println!("{name}: truth of {} samples in {:.1?}", v.len(), t.elapsed());
+    println!(
+        "{name}: truth of {} samples in {:.1?}",
+        v.len(),
+        t.elapsed()
+    );
     let rv = &s.trajectory.random_vibrations()[0];
     let rep = &s.vibration[0];
     println!("{}", rep.summary());
@@ -498,7 +568,11 @@ fn welch_case(overlay: &str, name: &str, gyro: bool, psd: PsdTable) {
     let y: Vec<[f64; 3]> = v
         .iter()
         .map(|x| {
-            let q = if gyro { x.inc.dtheta_b_rad } else { x.inc.dv_b_mps } / dt;
+            let q = if gyro {
+                x.inc.dtheta_b_rad
+            } else {
+                x.inc.dv_b_mps
+            } / dt;
             [q.x, q.y, q.z]
         })
         .collect();
@@ -534,7 +608,15 @@ fn welch_angular_rate_matches_breakpoints() {
     let psd = PsdTable::from_breakpoints(&bp, "bp").unwrap();
     let rows: Vec<String> = bp
         .iter()
-        .map(|r| format!("[{}]", r.iter().map(|x| format!("{x:e}")).collect::<Vec<_>>().join(", ")))
+        .map(|r| {
+            format!(
+                "[{}]",
+                r.iter()
+                    .map(|x| format!("{x:e}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })
         .collect();
     welch_case(
         &format!("gyro_psd_breakpoints = [{}]", rows.join(", ")),
