@@ -1,6 +1,6 @@
 """Reproduce the Song–Lee Table 1 comparison: 90 min due east at Mach 1, 500 Hz IMU,
-3 samples per update, exact increments (spec §7.2). Prints the final position errors
-beside the paper's and optionally plots them (matplotlib, optional).
+3 samples per update, exact increments (docs/validation.md §"Song–Lee Table 1"). Prints the
+final position errors beside the paper's and optionally plots them (matplotlib, optional).
 
     python python/examples/songlee_table1.py [--plot table1.png]
 """

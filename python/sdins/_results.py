@@ -125,7 +125,7 @@ class Navigation:
 
 
 class Errors:
-    """Navigation errors against the truth (docs/conventions.md, mechanization.md §1.4):
+    """Navigation errors against the truth (docs/conventions.md §"Errors"):
     ``t_s`` (m,); ``pos_err_ned_m`` (m, 3) δN = δL(R_M+h), δE = δλ(R_N+h)cos L,
     δD = −δh [m]; ``vel_err_ned_mps`` (m, 3) v_alg − v_true [m/s]; ``att_err_rad``
     (m, 3) ε with C_alg C_trueᵀ = I + [ε×] [rad]; ``height_err_m`` (m,);

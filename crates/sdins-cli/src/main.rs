@@ -7,6 +7,7 @@
 #![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 
 mod cmd;
+mod csv_out;
 #[allow(dead_code)]
 mod error;
 mod output;
@@ -51,7 +52,7 @@ enum Command {
     /// Monte Carlo: N seeded runs with the scenario's IMU errors, per-epoch statistics.
     Montecarlo(cmd::montecarlo::Args),
     /// INS/GNSS Kalman filter on a scenario: errors with ±3σ, innovations, bias estimates.
-    Fuse(cmd::fuse::Args),
+    Fuse(Box<cmd::fuse::Args>),
     /// Merge Monte Carlo shard states exactly into the statistics of the whole job.
     Merge(cmd::merge::Args),
 }
@@ -82,7 +83,7 @@ fn main() -> ExitCode {
         Command::Align(a) => cmd::align::run(a),
         Command::Montecarlo(a) => cmd::montecarlo::run(a),
         Command::Merge(a) => cmd::merge::run(a),
-        Command::Fuse(a) => cmd::fuse::run(a),
+        Command::Fuse(a) => cmd::fuse::run(*a),
     };
     // a run's outputs all or none: swap the staged files in only if the command succeeded
     let result = output::finish(result);

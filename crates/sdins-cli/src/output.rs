@@ -68,7 +68,11 @@ impl AtomicFile {
         })
     }
 
-    /// The buffered writer.
+    /// The file's final path (for messages).
+    pub fn dest(&self) -> &Path {
+        &self.dest
+    }
+    /// The buffered writer of the temporary file.
     pub fn writer(&mut self) -> &mut BufWriter<File> {
         // The writer is only taken by `commit`, which consumes self.
         match self.writer.as_mut() {

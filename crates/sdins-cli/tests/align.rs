@@ -195,5 +195,6 @@ fn align_refuses_a_moving_scenario() {
         "--json",
     ]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("\"method\": \"i0\""));
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["method"], "i0");
 }

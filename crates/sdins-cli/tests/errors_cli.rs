@@ -51,8 +51,8 @@ fn errors_json_is_the_library_report() {
         out.trim_end(),
         serde_json::to_string_pretty(&lib.report).unwrap()
     );
-    // epochs 0.5, 1, 2 h; the east gyro bias gives the spec §6 T9 closed form ≈ −2013 m N
-    // at 2 h (with the accelerometer's share): a finite, nonzero number
+    // epochs 0.5, 1, 2 h; the east gyro bias gives the docs/validation.md §"error propagation" T9
+    // closed form ≈ −2013 m N at 2 h (with the accelerometer's share): a finite, nonzero number
     let ep = cli["epochs"].as_array().unwrap();
     assert_eq!(ep.len(), 3);
     assert!(ep[2]["nonlinear"].is_null());

@@ -1,15 +1,17 @@
 //! Coning (attitude) and sculling (velocity) compensation over N sensor samples
-//! (mechanization.md §3.1–§3.2 and §4.1–§4.2).
+//! (docs/theory/coning-sculling.md §"Coning and sculling"; docs/theory/coning-sculling.md
+//! §"Coefficient sets").
 //!
 //! For a coefficient set `k_ij` the rotation vector over the update interval is
-//! `Δφ = Σ Δθ_j + Σ_{i<j} k_ij Δθ_i × Δθ_j` (§3.1), and by the Ignagni duality the
-//! sculling term is `ΔV_scul = Σ_{i<j} k_ij (Δθ_i × Δv_j + Δv_i × Δθ_j)` (§4.2; for
+//! `Δφ = Σ Δθ_j + Σ_{i<j} k_ij Δθ_i × Δθ_j` (docs/theory/coning-sculling.md
+//! §"Coning and sculling"), and by the Ignagni duality the sculling term is
+//! `ΔV_scul = Σ_{i<j} k_ij (Δθ_i × Δv_j + Δv_i × Δθ_j)` (§"Coefficient sets"; for
 //! `three_poly` this is exactly S1 eq. (27)).
 
 use crate::math::Vec3;
 
 /// One sensor sample: body-frame integrals of the raw gyro and accelerometer outputs
-/// over the sample interval (mechanization.md §1.3).
+/// over the sample interval (docs/conventions.md §"IMU increments").
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Increment {
     /// Δθ = ∫ ω_ib^b dt \[rad\]
@@ -28,7 +30,7 @@ impl Increment {
     }
 }
 
-/// Coning/sculling coefficient set (mechanization.md §3.2 table).
+/// Coning/sculling coefficient set (docs/theory/coning-sculling.md §"Coefficient sets" table).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum ConingSet {
@@ -85,7 +87,8 @@ impl ConingSet {
         ConingSet::FourOpt,
     ];
 
-    /// The spec's name (`none`, `1prev`, `two`, `three_poly`, `three_opt`, `four_poly`, `four_opt`).
+    /// The canonical name (`none`, `1prev`, `two`, `three_poly`, `three_opt`, `four_poly`,
+    /// `four_opt`).
     pub const fn name(self) -> &'static str {
         match self {
             ConingSet::None => "none",
@@ -98,7 +101,7 @@ impl ConingSet {
         }
     }
 
-    /// Parse a spec name, or the aliases `polynomial` / `optimal` for the N-sample set
+    /// Parse a canonical name, or the aliases `polynomial` / `optimal` for the N-sample set
     /// (`samples` = N; for N = 2 both aliases are `two`, for N = 1 `polynomial` is `none`
     /// and `optimal` is `1prev`).
     pub fn parse(name: &str, samples: usize) -> Option<ConingSet> {
@@ -182,8 +185,9 @@ pub struct Compensated {
     pub dv_scul_b_mps: Vec3,
 }
 
-/// Combine the samples of one update with the coefficient set (§3.1 and §4.2).
-/// `prev` is the previous update's summed increment (used by `1prev` only).
+/// Combine the samples of one update with the coefficient set (docs/theory/coning-sculling.md
+/// §"Coning and sculling"). `prev` is the previous update's summed increment (used by `1prev`
+/// only).
 #[inline]
 pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Compensated {
     if let (ConingSet::ThreePoly | ConingSet::ThreeOpt, [s1, s2, s3]) = (set, samples) {
@@ -297,8 +301,8 @@ mod tests {
 
     #[test]
     fn constant_rates_give_zero_sculling_and_coning() {
-        // §7.4 item 5: for constant ω and f the sculling term is exactly zero (catches the
-        // (30)-OCR coefficients, which would give (11/120)ΔT² f×ω).
+        // Unit check: for constant ω and f the sculling term is exactly zero (catches the (30)-OCR
+        // coefficients, which would give (11/120)ΔT² f×ω).
         let inc = Increment::new(Vec3::new(1e-4, -2e-4, 3e-4), Vec3::new(0.01, 0.02, -0.0196));
         for set in ConingSet::ALL {
             let n = set.samples().max(1);
@@ -319,7 +323,8 @@ mod tests {
 
     #[test]
     fn coefficient_sums_match_spec() {
-        // Classical coning constrains S_d = Σ_{j−i=d} k_ij (§3.1–§3.2).
+        // Classical coning constrains S_d = Σ_{j−i=d} k_ij (docs/theory/coning-sculling.md
+        // §"Coefficient sets").
         let sums = |set: ConingSet| {
             let mut s = [0.0; 3];
             for &(i, j, k) in set.coefficients() {

@@ -1,5 +1,5 @@
-//! Earth model (mechanization.md §2): ellipsoid radii, normal gravity, earth rate,
-//! transport rate, geodetic ↔ ECEF and `C_e^n`.
+//! Earth model (docs/theory/mechanizations.md §"Earth model"): ellipsoid radii, normal gravity,
+//! earth rate, transport rate, geodetic ↔ ECEF and `C_e^n`.
 //!
 //! The model is a value ([`EarthModel`]) so that the WGS-84 default, the PSINS constant
 //! set (for PSINS data) and a flat, non-rotating model (for flat-NED fixtures) can be
@@ -179,8 +179,8 @@ impl EarthModel {
         )
     }
 
-    /// WGS-84 (mechanization.md §2): a = 6378137, f = 1/298.257223563,
-    /// Ω = 7.292115e-5 rad/s, Somigliana gravity with the TR8350.2 height series.
+    /// WGS-84 (docs/theory/mechanizations.md §"Earth model"): a = 6378137, f = 1/298.257223563, Ω =
+    /// 7.292115e-5 rad/s, Somigliana gravity with the TR8350.2 height series.
     pub const WGS84: EarthModel = EarthModel {
         a_m: 6_378_137.0,
         f: 1.0 / 298.257_223_563,
@@ -318,7 +318,7 @@ impl EarthModel {
     }
 
     /// Geodetic (lat, lon, h) of an ECEF position, by the fixed iteration of
-    /// mechanization.md §2 (10 iterations from `L = atan2(z, p(1 − e²))`).
+    /// docs/theory/mechanizations.md §"Earth model" (10 iterations from `L = atan2(z, p(1 − e²))`).
     /// Near the poles (p below 1 mm) the height is taken from |z|.
     pub fn geodetic_from_ecef(&self, r_e: &Vec3) -> (f64, f64, f64) {
         let lon = libm::atan2(r_e.y, r_e.x);
@@ -344,7 +344,7 @@ impl EarthModel {
         (lat, lon, h)
     }
 
-    /// `C_e^n(L, λ)`, ECEF to NED (mechanization.md §2).
+    /// `C_e^n(L, λ)`, ECEF to NED (docs/theory/mechanizations.md §"Earth model").
     pub fn c_e_n(lat_rad: f64, lon_rad: f64) -> Mat3 {
         let (sl, cl) = (libm::sin(lat_rad), libm::cos(lat_rad));
         let (so, co) = (libm::sin(lon_rad), libm::cos(lon_rad));
@@ -405,7 +405,8 @@ mod tests {
 
     #[test]
     fn wgs84_gravity_published_values() {
-        // TR8350.2: γ_e = 9.7803253359, γ_p = 9.8321849378 m/s²; spec §7.1 value at 37.5°.
+        // TR8350.2: γ_e = 9.7803253359, γ_p = 9.8321849378 m/s²; docs/validation.md
+        // §"stationary 90 min" value at 37.5°.
         let e = EarthModel::WGS84;
         assert!(rel(e.gravity(0.0, 0.0), 9.780_325_335_9) < 1e-9);
         assert!(rel(e.gravity(90.0 * D2R, 0.0), 9.832_184_937_8) < 1e-9);
@@ -424,7 +425,7 @@ mod tests {
     fn ecef_round_trip_all_heights() {
         // ECEF → geodetic → ECEF. The f64 floor is the quantisation of the latitude itself
         // (one ulp of a latitude near 1 rad is 2.2e-16 rad = 1.4e-9 m on the ground) plus the
-        // rounding of r (ulp of 6.4e6 m = 9.3e-10 m): the spec's 1e-9 m holds only where the
+        // rounding of r (ulp of 6.4e6 m = 9.3e-10 m): a flat 1e-9 m bound holds only where the
         // latitude ulp is small, so the bound is that floor, evaluated per point.
         let e = EarthModel::WGS84;
         for &lat in &[-89.9, -60.0, -1.0, 0.0, 37.5, 80.0, 89.99] {

@@ -1,5 +1,5 @@
-//! Spec alignment_and_errors.md §6 T3 (observability ranks, null space) and T8
-//! (Algorithm B, noise-free linear).
+//! docs/theory/alignment.md §"Observability at one heading" T3 (observability ranks, null space)
+//! and T8 (Algorithm B, noise-free linear).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{SMatrix, SVector};
@@ -33,7 +33,8 @@ fn t3_single_heading_ranks_and_null_space() {
     let o2 = analyze(&f, &h_horizontal(), &scale12(), 1e-9);
     assert_eq!(o3.rank, 9);
     assert_eq!(o2.rank, 7);
-    // spec §2.4: σ9/σ1 = 6.8e-2, σ10/σ1 ≈ 3e-17; T3: gap > 1e10
+    // docs/theory/alignment.md §"Observability at one heading": σ9/σ1 = 6.8e-2, σ10/σ1 ≈ 3e-17; T3:
+    // gap > 1e10
     assert!(o3.gap() > 1e10, "gap {}", o3.gap());
     assert!(
         (o3.sigma_rel[8] - 6.8e-2).abs() < 0.05e-2,

@@ -1,9 +1,11 @@
 //! Coning drift of every coefficient set against the closed-form classical coning truth
-//! (mechanization.md §3.3–§3.4).
+//! (docs/theory/coning-sculling.md §"Classical coning and sculling truth"; docs/validation.md
+//! §"coning drift of all 7 sets").
 //!
-//! Method (spec §3.4): ΔT = 6 ms, α = 0.1°, Ω = λ/ΔT, max(200, ⌈20·2π/λ⌉) updates from
-//! t0 = 0.123456789 s; per update e_b = 2 vec(Δq_true* ⊗ q(Δφ_alg)) (sign-fixed),
-//! ε_k = C(q_true(t_k)) e_b; drift = mean(ε_z)/ΔT. Prediction: −c_N sin²α cosα λ^p/ΔT.
+//! Method (docs/validation.md §"coning drift of all 7 sets"): ΔT = 6 ms, α = 0.1°, Ω = λ/ΔT,
+//! max(200, ⌈20·2π/λ⌉) updates from t0 = 0.123456789 s; per update e_b = 2 vec(Δq_true* ⊗
+//! q(Δφ_alg)) (sign-fixed), ε_k = C(q_true(t_k)) e_b; drift = mean(ε_z)/ΔT. Prediction: −c_N sin²α
+//! cosα λ^p/ΔT.
 #![allow(clippy::unwrap_used)]
 use sdins_core::coning::{compensate, ConingSet, Increment};
 use sdins_core::math::{Quat, Vec3};
@@ -15,7 +17,7 @@ fn q_cone(alpha: f64, omega: f64, t: f64) -> Quat {
     Quat::new(c, s * (omega * t).cos(), s * (omega * t).sin(), 0.0)
 }
 
-/// Δθ over \[t1, t2\] in the cancellation-free product form of the spec's closed form.
+/// Δθ over \[t1, t2\] in the cancellation-free product form of the classical coning closed form.
 fn dtheta(alpha: f64, omega: f64, t1: f64, h: f64) -> Vec3 {
     let (m, d) = (omega * (t1 + 0.5 * h), 0.5 * omega * h);
     Vec3::new(
@@ -76,7 +78,7 @@ fn predicted(set: ConingSet, lambda: f64, alpha: f64) -> f64 {
 
 const ALPHA: f64 = 0.1 * std::f64::consts::PI / 180.0;
 
-/// Spec §3.4 "meas" columns (λ = 0.4, λ = 0.8).
+/// Reference "meas" columns of docs/validation.md §"coning drift of all 7 sets" (λ = 0.4, λ = 0.8).
 const MEAS: [(ConingSet, f64, f64); 7] = [
     (ConingSet::None, -2.686e-6, -2.098e-5),
     (ConingSet::OnePrev, -8.501e-8, -2.569e-6),
@@ -93,17 +95,17 @@ fn drift_matches_spec_table_and_prediction() {
         let d08 = drift_z(set, 0.8, ALPHA);
         let rel08 = (d08 - m08).abs() / m08.abs();
         eprintln!(
-            "{:>10}: λ=0.8 {d08:+.4e} (spec {m08:+.4e}, {:+.2}%)",
+            "{:>10}: λ=0.8 {d08:+.4e} (ref {m08:+.4e}, {:+.2}%)",
             set.name(),
             100.0 * (d08 / m08 - 1.0)
         );
         assert!(rel08 <= 0.03, "{} λ=0.8: {d08:e} vs {m08:e}", set.name());
         if set == ConingSet::FourOpt {
-            continue; // at roundoff below λ = 0.8 (spec §3.4)
+            continue; // at roundoff below λ = 0.8 (docs/validation.md §"coning drift of all 7 sets")
         }
         let d04 = drift_z(set, 0.4, ALPHA);
         eprintln!(
-            "{:>10}: λ=0.4 {d04:+.4e} (spec {m04:+.4e}, {:+.2}%)",
+            "{:>10}: λ=0.4 {d04:+.4e} (ref {m04:+.4e}, {:+.2}%)",
             set.name(),
             100.0 * (d04 / m04 - 1.0)
         );

@@ -1,10 +1,12 @@
 //! Sculling bias of the coefficient sets against the classical sculling truth
-//! (mechanization.md §4.3): angular oscillation θ0 sin Ωt about body x in phase with a
-//! specific force A0 sin Ωt along body y, no gravity, non-rotating reference frame.
+//! (docs/theory/coning-sculling.md §"Classical coning and sculling truth"): angular oscillation θ0
+//! sin Ωt about body x in phase with a specific force A0 sin Ωt along body y, no gravity,
+//! non-rotating reference frame.
 //!
 //! The true velocity change over each update is the integral of (C_b^r f^b), evaluated
 //! here by composite 8-point Gauss–Legendre quadrature (an independent oracle to the
-//! spec's Bessel series; its error is below 1e-20 m/s per update at these frequencies).
+//! Bessel series of docs/theory/coning-sculling.md; its error is below 1e-20 m/s per update at
+//! these frequencies).
 #![allow(clippy::unwrap_used)]
 use sdins_core::coning::{compensate, ConingSet, Increment};
 use sdins_core::math::{Mat3, Vec3};
@@ -76,7 +78,7 @@ fn bias_z(set: ConingSet, lambda: f64) -> f64 {
     sum / updates as f64
 }
 
-/// Spec §4.3 "meas" columns (λ = 0.4, λ = 0.8) \[m/s²\].
+/// Reference "meas" columns of docs/validation.md §"sculling bias" (λ = 0.4, λ = 0.8) \[m/s²\].
 const MEAS: [(ConingSet, f64, f64, i32); 4] = [
     (ConingSet::Two, -4.632e-9, -7.306e-8, 4),
     (ConingSet::ThreePoly, 6.820e-10, 1.055e-8, 4),
@@ -88,7 +90,7 @@ const MEAS: [(ConingSet, f64, f64, i32); 4] = [
 fn sculling_bias_matches_spec_table() {
     for (set, m04, m08, _) in MEAS {
         let b08 = bias_z(set, 0.8);
-        eprintln!("{:>10}: λ=0.8 {b08:+.4e} (spec {m08:+.4e})", set.name());
+        eprintln!("{:>10}: λ=0.8 {b08:+.4e} (ref {m08:+.4e})", set.name());
         assert!(
             (b08 - m08).abs() <= 0.05 * m08.abs(),
             "{} λ=0.8: {b08:e} vs {m08:e}",
@@ -98,7 +100,7 @@ fn sculling_bias_matches_spec_table() {
             continue;
         }
         let b04 = bias_z(set, 0.4);
-        eprintln!("{:>10}: λ=0.4 {b04:+.4e} (spec {m04:+.4e})", set.name());
+        eprintln!("{:>10}: λ=0.4 {b04:+.4e} (ref {m04:+.4e})", set.name());
         assert!(
             (b04 - m04).abs() <= 0.05 * m04.abs(),
             "{} λ=0.4: {b04:e} vs {m04:e}",
@@ -109,7 +111,8 @@ fn sculling_bias_matches_spec_table() {
 
 #[test]
 fn sculling_bias_order() {
-    // bias ∝ λ^{p−1}: λ⁴ for two and three_poly, λ⁶ for three_opt (spec §4.3).
+    // bias ∝ λ^{p−1}: λ⁴ for two and three_poly, λ⁶ for three_opt (docs/theory/coning-sculling.md
+    // §"Classical coning and sculling truth").
     for (set, _, _, order) in MEAS.iter().copied().take(3) {
         let b3 = bias_z(set, 0.3).abs();
         let b4 = bias_z(set, 0.4).abs();

@@ -62,7 +62,7 @@ impl States {
     }
 }
 
-/// Error columns (pipeline.rs `NavError`, mechanization.md §1.4).
+/// Error columns (pipeline.rs `NavError`, docs/conventions.md §"Errors").
 #[derive(Default)]
 struct Errors {
     t_s: Vec<f64>,

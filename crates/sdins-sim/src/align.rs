@@ -1,12 +1,11 @@
 //! Alignment experiments: exact static / turntable truth, sensor corruption,
 //! and runners for coarse, fine, multi-heading (Algorithms A and B) alignment on top of
-//! [`sdins_core::align`]. See spec `alignment_and_errors.md` §1–§3 and §6.
+//! [`sdins_core::align`]. See docs/theory/alignment.md and docs/validation.md.
 //!
 //! Multi-heading sequences are built from the existing segment types: a stationary
 //! vehicle is turned on the spot with a `turn` segment at zero speed (a rotation about
-//! the local vertical; `profile = "constant"` gives the spec's constant 10 °/s, and
-//! `profile = "smooth"` also works at zero speed), see [`multiheading_trajectory`]; no
-//! new segment type is needed.
+//! the local vertical; `profile = "constant"` gives a constant 10 °/s, and `profile = "smooth"`
+//! also works at zero speed), see [`multiheading_trajectory`]; no new segment type is needed.
 
 use crate::cancel::{CancelToken, Cancelled, POLL_EVERY_SAMPLES};
 use crate::imu_error::{ImuErrorModel, ImuErrorModelError, ImuErrorState};
@@ -112,8 +111,8 @@ pub fn corrupt(
 /// Stationary sequence at relative headings `headings_deg` (first must be 0) from the
 /// start attitude `euler0`: `static_each_s` seconds at each heading, rotations between
 /// them at the constant rate `rate_dps` (on-the-spot turns about the local vertical,
-/// spec §3.2 step 3). Returns the trajectory and the start time and duration of each
-/// static phase.
+/// docs/theory/alignment.md §"Multi-heading alignment" step 3). Returns the trajectory and the
+/// start time and duration of each static phase.
 pub fn multiheading_trajectory(
     euler0: Euler,
     headings_deg: &[f64],
@@ -313,9 +312,10 @@ pub struct MultiHeadingResult {
     pub gyro_bias_sigma_b: Vec3,
 }
 
-/// Algorithm A (spec §3.2): 2-step coarse alignment over the first `coarse_s` seconds,
-/// then one continuous closed-loop filter with body-frame bias states over the whole
-/// record (zero-velocity updates through rotations too). `on_update` as in [`run_fine`].
+/// Algorithm A (docs/theory/alignment.md §"Multi-heading alignment"): 2-step coarse alignment over
+/// the first `coarse_s` seconds, then one continuous closed-loop filter with body-frame bias states
+/// over the whole record (zero-velocity updates through rotations too). `on_update` as in
+/// [`run_fine`].
 pub fn algorithm_a<F: FnMut(usize, &FineAlign)>(
     incs: &[Increment],
     dt_s: f64,
@@ -338,11 +338,11 @@ pub fn algorithm_a<F: FnMut(usize, &FineAlign)>(
     })
 }
 
-/// Algorithm B (spec §3.3): 2-step coarse alignment over the first `coarse_s` seconds,
-/// then the INS runs **open loop** (no corrections) over the whole record; at each static
-/// phase `(t_start, duration)` a feed-forward 12-state NED filter is restarted and its
-/// pseudo estimate `p_k = T x̂` (covariance `T P Tᵀ`) at the end of the phase is stacked
-/// into the least-squares problem for `θ = [φ(t_0), b_a, b_g]`. The final attitude is the
+/// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment"): 2-step coarse alignment over
+/// the first `coarse_s` seconds, then the INS runs **open loop** (no corrections) over the whole
+/// record; at each static phase `(t_start, duration)` a feed-forward 12-state NED filter is
+/// restarted and its pseudo estimate `p_k = T x̂` (covariance `T P Tᵀ`) at the end of the phase is
+/// stacked into the least-squares problem for `θ = [φ(t_0), b_a, b_g]`. The final attitude is the
 /// INS attitude corrected by `φ(t_end) = Φ φ(t_0) + Γ b_g`.
 pub fn algorithm_b(
     incs: &[Increment],
@@ -413,7 +413,7 @@ pub fn algorithm_b(
     })
 }
 
-/// Reference P0 (spec §2.3) as a convenience re-export.
+/// Reference P0 (docs/theory/alignment.md §"Fine alignment") as a convenience re-export.
 pub fn p0_reference() -> Mat12 {
     sdins_core::align::model::p0_reference()
 }

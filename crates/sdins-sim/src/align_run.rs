@@ -1,4 +1,5 @@
-//! The `align` procedure as one library call (spec `alignment_and_errors.md` §1–§3,
+//! The `align` procedure as one library call (docs/theory/alignment.md §"Coarse alignment";
+//! docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md §"Multi-heading alignment",
 //! docs/alignment_i0.md): load the input (a scenario's exact truth corrupted with one run
 //! of its error model, or an IMU file), pick the window, run the chosen method (coarse
 //! 1-step / 2-step, inertial-frame i0, 12-state Kalman fine alignment started from i0 or
@@ -39,15 +40,16 @@ pub const STATIONARY_SPEED_MPS: f64 = 0.5;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum AlignMethod {
-    /// 1-step analytic (TRIAD-type), polar-orthonormalised (spec §1.1)
+    /// 1-step analytic (TRIAD-type), polar-orthonormalised (docs/theory/alignment.md
+    /// §"Coarse alignment")
     Coarse1,
-    /// 2-step: levelling + gyrocompassing (spec §1.2)
+    /// 2-step: levelling + gyrocompassing (docs/theory/alignment.md §"Coarse alignment")
     Coarse2,
     /// inertial-frame coarse alignment (docs/alignment_i0.md), attitude at window end
     I0,
-    /// 12-state zero-velocity Kalman fine alignment (spec §2)
+    /// 12-state zero-velocity Kalman fine alignment (docs/theory/alignment.md §"Fine alignment")
     Fine,
-    /// multi-heading (spec §3.2 Algorithm A, §3.3 Algorithm B)
+    /// multi-heading (docs/theory/alignment.md §"Multi-heading alignment": Algorithm A or B)
     Multiheading,
 }
 
@@ -72,11 +74,12 @@ impl AlignMethod {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum MultiheadingAlg {
-    /// Algorithm A (spec §3.2): one closed-loop filter, body-frame bias states
+    /// Algorithm A (docs/theory/alignment.md §"Multi-heading alignment"): one closed-loop filter,
+    /// body-frame bias states
     #[default]
     A,
-    /// Algorithm B (spec §3.3): pseudo-error least squares over the static phases
-    /// (scenarios only)
+    /// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment"): pseudo-error least
+    /// squares over the static phases (scenarios only)
     B,
 }
 
@@ -435,8 +438,8 @@ pub fn check_options(o: &AlignOptions) -> Result<(), AlignRunError> {
     Ok(())
 }
 
-/// The filter configuration [`align`] uses: the reference configuration (spec §2.3) at
-/// the input's site with the options' (else the input's) VRW/ARW and σ_z.
+/// The filter configuration [`align`] uses: the reference configuration (docs/theory/alignment.md
+/// §"Fine alignment") at the input's site with the options' (else the input's) VRW/ARW and σ_z.
 pub fn filter_config(inp: &AlignInput, o: &AlignOptions) -> FineConfig {
     let mut cfg = reference_config(
         inp.site,
@@ -449,10 +452,11 @@ pub fn filter_config(inp: &AlignInput, o: &AlignOptions) -> FineConfig {
     cfg
 }
 
-/// Run one alignment of `inp` (spec §1–§3, docs/alignment_i0.md). The window is
-/// `n_w = round(window_s / dt)` samples from the start; coarse methods use `[0, n_w)`
-/// (attitude at t = 0 for coarse, at sample `n_w − 1` for i0), the filters the whole
-/// record (first `duration_s` seconds). Stationary-only methods refuse a scenario whose
+/// Run one alignment of `inp` (docs/theory/alignment.md §"Coarse alignment";
+/// docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md §"Multi-heading alignment",
+/// docs/alignment_i0.md). The window is `n_w = round(window_s / dt)` samples from the start; coarse
+/// methods use `[0, n_w)` (attitude at t = 0 for coarse, at sample `n_w − 1` for i0), the filters
+/// the whole record (first `duration_s` seconds). Stationary-only methods refuse a scenario whose
 /// truth speed exceeds [`STATIONARY_SPEED_MPS`] in the samples they use.
 pub fn align(
     inp: &AlignInput,

@@ -1,10 +1,11 @@
 //! The `errors` procedure as one library call: stationary free-inertial error propagation
-//! for a set of NED sensor biases (spec `alignment_and_errors.md` §4.3,
+//! for a set of NED sensor biases (docs/theory/error-analysis.md §"Full stationary closed form",
 //! docs/theory/error-analysis.md): the closed form, the 15-state linear model's
 //! deterministic error and 1σ covariance envelope, a nonlinear free-inertial run, and the
 //! per-source error budget, at the standard epochs. The CLI (`sdins errors`) and Python
 //! (`sdins.errors`) only parse, call [`errors`] and format. The Schuler-share table
-//! (spec §4.4) is [`crate::error_analysis::schuler_share::schuler_share_table_p2`].
+//! (docs/theory/error-analysis.md §"The Schuler share") is
+//! [`crate::error_analysis::schuler_share::schuler_share_table_p2`].
 
 use crate::cancel::CancelToken;
 use crate::error_analysis::grades::{grade_by_name, Grade, GRADES};
@@ -283,11 +284,11 @@ pub fn errors(o: &ErrorsOptions, token: &CancelToken) -> Result<ErrorsOutcome, E
 }
 
 /// The nonlinear column: a full nonlinear free-inertial run
-/// ([`NonlinearRun`], spec §6 T9 set-up): stationary, body = NED at `lat_rad` (so the NED
-/// biases are the body biases, injected as a custom `ImuErrorModel` with fixed
-/// `gyro_bias_dph`/`accel_bias_ug`), spherical earth with the closed form's constants
-/// (R0, g, Ω), 20 Hz IMU, `songlee-complete` with N = 2, vertical channel held; run once
-/// to the last epoch and read at every epoch of `hours`.
+/// ([`NonlinearRun`], docs/validation.md §"error propagation" T9 set-up): stationary, body = NED at
+/// `lat_rad` (so the NED biases are the body biases, injected as a custom `ImuErrorModel` with
+/// fixed `gyro_bias_dph`/`accel_bias_ug`), spherical earth with the closed form's constants (R0, g,
+/// Ω), 20 Hz IMU, `songlee-complete` with N = 2, vertical channel held; run once to the last epoch
+/// and read at every epoch of `hours`.
 pub fn nonlinear_column(
     lat_rad: f64,
     params: &SchulerParams,
@@ -412,8 +413,8 @@ mod tests {
         }
     }
 
-    /// The nonlinear column follows the closed form (east gyro 0.01 °/h, 2 h: spec §6 T9
-    /// INS −2011 m, closed form −2013 m; tolerance 1 % of the peak + 50 m).
+    /// The nonlinear column follows the closed form (east gyro 0.01 °/h, 2 h: docs/validation.md
+    /// §"error propagation" T9 INS −2011 m, closed form −2013 m; tolerance 1 % of the peak + 50 m).
     #[test]
     #[allow(clippy::unwrap_used)]
     fn nonlinear_column_matches_closed_form() {

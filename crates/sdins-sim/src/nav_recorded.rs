@@ -4,7 +4,7 @@
 //! Time base: the state before the first sample is at `t0 = t_first − δt`; update k
 //! (k = 1, 2, …) ends at `t0 + k N δt`. A reference row is compared with the state of the
 //! update whose end time it matches within 0.1 δt (the errors of pipeline.rs,
-//! mechanization.md §1.4).
+//! docs/conventions.md §"Errors").
 
 use crate::cancel::{CancelToken, Cancelled};
 use crate::imu_file::ImuData;

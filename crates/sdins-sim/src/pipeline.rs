@@ -14,7 +14,7 @@ use sdins_core::math::Vec3;
 use sdins_core::nav::{AlgorithmSpec, AnyMechanization, Mechanization, NavState};
 use std::time::Instant;
 
-/// Navigation errors at one epoch (mechanization.md §1.4).
+/// Navigation errors at one epoch (docs/conventions.md §"Errors").
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct NavError {
     /// time \[s\]
@@ -62,7 +62,7 @@ fn arr(v: &Vec3) -> [f64; 3] {
     [v.x, v.y, v.z]
 }
 
-/// Errors of a navigation state against the truth (spec §1.4).
+/// Errors of a navigation state against the truth (docs/conventions.md §"Errors").
 ///
 /// Evaluated without intermediate Euler angles: each Euler-angle difference is one
 /// `atan2` of the cross and dot products of the two angles' (sin, cos) pairs, which is
@@ -466,7 +466,7 @@ mod tests {
         assert_eq!(r, Err(PipelineError::Cancelled(Cancelled)));
     }
 
-    /// The textbook evaluation of spec §1.4 that `nav_error` must reproduce.
+    /// The textbook evaluation of docs/conventions.md §"Errors" that `nav_error` must reproduce.
     fn reference(earth: &EarthModel, nav: &NavState, truth: &TruthSample) -> NavError {
         let r = earth.radii(truth.lat_rad);
         let dlat = nav.lat_rad - truth.lat_rad;

@@ -1499,14 +1499,14 @@ pub struct Builtin {
     pub toml: &'static str,
 }
 
-/// The built-in scenarios (every paper case of mechanization.md §7 and the alignment
+/// The built-in scenarios (every paper case of docs/validation.md and the alignment
 /// reference case).
 pub const BUILTINS: &[Builtin] = &[
-    Builtin { name: "stationary", summary: "A0: stationary 90 min at 37.5N 127E (spec §7.1)", toml: include_str!("../scenarios/stationary.toml") },
-    Builtin { name: "mach1-east", summary: "A1: Mach 1 due east, 90 min (Song-Lee Table 1, spec §7.2)", toml: include_str!("../scenarios/mach1-east.toml") },
-    Builtin { name: "turn-90dps", summary: "A2: 90 deg/s turn from east to south at Mach 1 (spec §7.3)", toml: include_str!("../scenarios/turn-90dps.toml") },
-    Builtin { name: "dq-paper", summary: "B: stationary, accelerate, S-turn with 1 Hz coning (dual-quaternion paper, spec §7.5)", toml: include_str!("../scenarios/dq-paper.toml") },
-    Builtin { name: "alignment", summary: "stationary alignment reference: roll/pitch/yaw 2/-3/40 deg at 37.5N (alignment spec §6)", toml: include_str!("../scenarios/alignment.toml") },
+    Builtin { name: "stationary", summary: "A0: stationary 90 min at 37.5N 127E", toml: include_str!("../scenarios/stationary.toml") },
+    Builtin { name: "mach1-east", summary: "A1: Mach 1 due east, 90 min (Song-Lee Table 1)", toml: include_str!("../scenarios/mach1-east.toml") },
+    Builtin { name: "turn-90dps", summary: "A2: 90 deg/s turn from east to south at Mach 1", toml: include_str!("../scenarios/turn-90dps.toml") },
+    Builtin { name: "dq-paper", summary: "B: stationary, accelerate, S-turn with 1 Hz coning (dual-quaternion paper)", toml: include_str!("../scenarios/dq-paper.toml") },
+    Builtin { name: "alignment", summary: "stationary alignment reference: roll/pitch/yaw 2/-3/40 deg at 37.5N", toml: include_str!("../scenarios/alignment.toml") },
     Builtin { name: "moored-ship", summary: "disturbed base: moored ship at 40N, roll/pitch sway ±5 deg, 0.5 m heave, 0.2 m surge, marine grade", toml: include_str!("../scenarios/moored-ship.toml") },
     Builtin { name: "rocking-car", summary: "disturbed base: parked car rocking ±0.8/0.5 deg at 1.373/1.827 Hz with 1 cm heave, aviation grade", toml: include_str!("../scenarios/rocking-car.toml") },
 ];

@@ -1,5 +1,6 @@
 //! Analytic trajectories: piecewise motion segments plus attitude/linear overlays,
-//! evaluated exactly (value and derivative) at any time (mechanization.md §7.0).
+//! evaluated exactly (value and derivative) at any time (docs/theory/mechanizations.md
+//! §"Truth generation").
 //!
 //! The nominal vehicle moves with horizontal speed `s` along heading `ψ` (= yaw) and
 //! down velocity `v_D`: `v^n = [s cosψ, s sinψ, v_D]`. Roll and pitch stay at their start
@@ -34,12 +35,13 @@ pub enum Motion {
     },
     /// level turn through an angle with a smooth (raised-cosine) rate:
     /// `ψ = ψ0 + A(x − sin(2πx)/(2π))`, `ψ̇ = (A/T)(1 − cos 2πx)`, `x = τ/T`
-    /// (spec §7.3; peak rate 2A/T at mid-turn)
+    /// (docs/scenarios.md §"profile"; peak rate 2A/T at mid-turn)
     TurnSmooth {
         /// total heading change A \[rad\]
         angle_rad: f64,
     },
-    /// S-turn: `ψ̇ = a sin(2πτ/T)`, `ψ = ψ0 + a(T/2π)(1 − cos(2πτ/T))` (spec §7.5)
+    /// S-turn: `ψ̇ = a sin(2πτ/T)`, `ψ = ψ0 + a(T/2π)(1 − cos(2πτ/T))` (docs/scenarios.md
+    /// §"profile")
     STurn {
         /// peak yaw rate a \[rad/s\]
         amplitude_rps: f64,
@@ -131,7 +133,7 @@ impl Axis {
         }
     }
     /// Place z-axis-form components `(a, b, c)` (cone about z) for a cone about this axis
-    /// (cyclic permutation, spec §3.3).
+    /// (cyclic permutation, docs/theory/coning-sculling.md §"Classical coning and sculling truth").
     fn place(self, a: f64, b: f64, c: f64) -> Vec3 {
         match self {
             Axis::Z => Vec3::new(a, b, c),
@@ -145,7 +147,8 @@ impl Axis {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum OverlayKind {
     /// classical coning about a body axis, relative form `C_c = C(q_c(0)* ⊗ q_c(τ))`
-    /// (spec §3.3, §7.5)
+    /// (docs/theory/coning-sculling.md §"Classical coning and sculling truth"; docs/scenarios.md
+    /// §"profile")
     Coning {
         /// cone axis
         axis: Axis,
@@ -155,7 +158,8 @@ pub enum OverlayKind {
         omega_rps: f64,
     },
     /// classical sculling: rotation θ0 sin Ωτ about body x, in phase with a specific-force
-    /// oscillation A0 sin Ωτ along the nominal body y (spec §4.3)
+    /// oscillation A0 sin Ωτ along the nominal body y (docs/theory/coning-sculling.md
+    /// §"Classical coning and sculling truth")
     Sculling {
         /// angular amplitude θ0 \[rad\]
         angle_amp_rad: f64,
@@ -623,7 +627,8 @@ impl Trajectory {
     }
 
     /// Whether the kinematics are constant with v_N = v_D = 0 (no overlays, only static or
-    /// cruise segments): then the truth has the closed form of spec §7.0 (A0, A1).
+    /// cruise segments): then the truth has the closed form of docs/theory/mechanizations.md
+    /// §"Truth generation" (A0, A1).
     pub fn is_constant_parallel(&self) -> bool {
         self.track.is_none()
             && self.overlays.is_empty()
@@ -717,7 +722,7 @@ impl Trajectory {
     }
 
     /// Exact kinematics at time `t`, with the analytic branch selected by `t_sel`
-    /// (the substep midpoint of the integrator, spec §7.0).
+    /// (the substep midpoint of the integrator, docs/theory/mechanizations.md §"Truth generation").
     pub fn kinematics(&self, t: f64, t_sel: f64) -> Kinematics {
         self.kinematics_split(t, 0.0, t_sel)
     }
@@ -785,7 +790,7 @@ impl Trajectory {
                 // roll and pitch and the heading's sin/cos from above
                 let [sr, cr, sp, cp] = self.consts.roll_pitch;
                 let c_nom = sdins_core::math::c_b_n_from_sin_cos((sr, cr), (sp, cp), (sh, ch));
-                // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (spec §1.2)
+                // ω_nb^b from Euler rates with φ̇ = θ̇ = 0 (docs/conventions.md §"Euler angles")
                 let w_nom = Vec3::new(
                     -n.heading_dot * sp,
                     n.heading_dot * cp * sr,
@@ -795,7 +800,8 @@ impl Trajectory {
             }
         };
 
-        // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (spec §7.0)
+        // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (docs/theory/mechanizations.md
+        // §"Truth generation")
         let mut c_c = Mat3::identity();
         let mut w_c = Vec3::zeros();
         for (j, (ov, kc)) in self.overlays.iter().zip(&self.consts.overlay).enumerate() {

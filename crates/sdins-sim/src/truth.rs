@@ -1,5 +1,5 @@
 //! Exact truth: trajectory state and IMU increments per sensor sample
-//! (mechanization.md §7.0).
+//! (docs/theory/mechanizations.md §"Truth generation").
 //!
 //! * Constant-state cases (static, or cruise along a parallel): closed form
 //!   `Δθ = C_n^b (ω_ie + ω_en) δt`, `Δv = C_n^b ((2ω_ie + ω_en) × v − g) δt`,
@@ -13,7 +13,8 @@
 //!   `[L, l, h, ∫ω_ib^b, ∫f^b]` with Gauss–Legendre collocation: one 3-node panel per
 //!   sample up to 16 substeps, else 4-node panels, `⌈substeps/32⌉` per sample (split
 //!   further at segment and overlay boundaries inside a sample, so that no panel straddles
-//!   a kink); see [`TruthScheme::Gauss`] for the error bound. The classical RK4 of the spec, with `substeps` steps per sample and
+//!   a kink); see [`TruthScheme::Gauss`] for the error bound. The classical RK4
+//!   (docs/theory/mechanizations.md §"Truth generation"), with `substeps` steps per sample and
 //!   the analytic branch selected by the substep midpoint, is kept as the independent
 //!   reference ([`TruthGenerator::reference_rk4`], [`TruthScheme::Rk4`]).
 
@@ -82,8 +83,9 @@ pub struct TruthConfig {
     pub lon0_rad: f64,
     /// start height \[m\]
     pub h0_m: f64,
-    /// integration resolution: RK4 substeps per sample for [`TruthScheme::Rk4`] (16 in the
-    /// spec; the refinement test compares with 32); [`TruthScheme::Gauss`] uses one
+    /// integration resolution: RK4 substeps per sample for [`TruthScheme::Rk4`] (at least 16,
+    /// docs/theory/mechanizations.md §"Truth generation"; the refinement test compares with 32);
+    /// [`TruthScheme::Gauss`] uses one
     /// 3-node panel per sample up to 16, else `⌈substeps/32⌉` 4-node panels
     pub substeps: usize,
 }
@@ -134,7 +136,8 @@ pub enum TruthScheme {
     Gauss,
     /// Classical RK4 on `[L − L0, l − l0, h, ∫ω_ib^b, ∫f^b]` with `substeps` steps per
     /// sample, the integrals reset at every sample boundary and the analytic branch
-    /// selected by the substep midpoint (spec §7.0). The independent reference.
+    /// selected by the substep midpoint (docs/theory/mechanizations.md §"Truth generation"). The
+    /// independent reference.
     Rk4,
 }
 
@@ -487,7 +490,7 @@ impl<'a> TruthGenerator<'a> {
         self
     }
 
-    /// The classical RK4 of the spec with `substeps` steps per sample instead of the Gauss
+    /// The classical RK4 reference with `substeps` steps per sample instead of the Gauss
     /// scheme, and never the closed form: the independent reference for tests.
     pub fn reference_rk4(mut self) -> Self {
         self.closed = None;
@@ -895,7 +898,8 @@ impl Iterator for TruthGenerator<'_> {
     }
 }
 
-/// RK4 substeps per sample for a trajectory: at least 16 (spec §7.0), and enough that
+/// RK4 substeps per sample for a trajectory: at least 16 (docs/theory/mechanizations.md
+/// §"Truth generation"), and enough that
 /// the fastest periodic motion advances at most 2e-3 rad per substep. RK4 on a pure
 /// quadrature is Simpson's rule, whose error per sample is δt·h⁴·|ω⁗|/2880; for 1 Hz,
 /// 0.5° coning at 100 Hz this is 4.5e-17 rad with 16 substeps and 2.8e-18 rad with 32.

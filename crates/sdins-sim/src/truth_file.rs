@@ -226,6 +226,25 @@ pub const SDINS_TRUTH_COLUMNS: [&str; 10] = [
     "yaw_deg",
 ];
 
+/// The full header `sdins truth` writes: [`SDINS_TRUTH_COLUMNS`] and the attitude
+/// quaternion `q_b_n` (Hamilton, scalar first).
+pub const SDINS_TRUTH_HEADER: [&str; 14] = [
+    "t_s",
+    "lat_deg",
+    "lon_deg",
+    "h_m",
+    "v_n_mps",
+    "v_e_mps",
+    "v_d_mps",
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+];
+
 /// Parse the text of an sdins `truth.csv`; `path` names it in error messages.
 pub fn parse_sdins_truth(path: &Path, text: &str) -> Result<Vec<TruthSample>, TruthFileError> {
     let cols = SDINS_TRUTH_COLUMNS;

@@ -1,8 +1,8 @@
-//! Alignment acceptance tests, spec alignment_and_errors.md §6 (T1, T2, T4–T7) and the
-//! real-data check on PSINS `lasergyro.imu`.
+//! Alignment acceptance tests, docs/validation.md (T1, T2, T4–T7) and the real-data check on PSINS
+//! `lasergyro.imu`.
 //!
-//! Tolerances come from the spec (theory and its prototype); the Monte Carlo ones are
-//! `#[ignore]`d (run with `cargo test --release -- --ignored`).
+//! Tolerances come from the theory (docs/theory/alignment.md) and its reference prototype; the
+//! Monte Carlo ones are `#[ignore]`d (run with `cargo test --release -- --ignored`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{SMatrix, SVector};
@@ -103,7 +103,7 @@ fn t1_coarse_noise_free_matches_corrected_table() {
     .unwrap();
     let c = tr.c_b_n0;
     let (da, eps) = (c * ref_ba(), c * ref_bg());
-    // spec §6 REF: NED biases
+    // docs/theory/alignment.md §"Reference case": NED biases
     assert!((da / UG - Vec3::new(89.2243, -30.8676, 29.7693)).norm() < 1e-3);
     assert!((eps / DPH - Vec3::new(0.020261, -0.009774, 0.014797)).norm() < 1e-6);
     for (m, want_spec) in [
@@ -172,7 +172,8 @@ fn t1_coarse_randomized_against_table() {
 }
 
 /// T2: coarse-alignment noise, biases 0, T_c = 60 s, 200 runs: sample σ within ±15 % of
-/// spec §1.3 (σ_tilt 2.58 μrad, σ_yaw 1.298 mrad, 1-step σ(φ_E) 0.649 mrad).
+/// docs/theory/alignment.md §"Coarse alignment" (σ_tilt 2.58 μrad, σ_yaw 1.298 mrad, 1-step σ(φ_E)
+/// 0.649 mrad).
 #[test]
 fn t2_coarse_noise_sigma() {
     let tr = ref_truth();
@@ -276,7 +277,7 @@ fn t4_fine_noise_free() {
     );
     assert!(max_t <= 10.0 * URAD);
     assert!(max_h <= 20.0 * URAD);
-    // Spec T4 literally: the same noise-free data with Q from aviation noise. The tilt
+    // Reference case T4 literally: the same noise-free data with Q from aviation noise. The tilt
     // still meets 10 μrad; the heading drifts off Π x0 by up to ≈ 60 μrad (ARW in Q makes
     // the filter a fading-memory estimator of the weakly observable ε'_D, and Π x0 is the
     // limit of the exact Bayesian (Q = 0) filter only). That deviation is a quarter of the
@@ -401,11 +402,11 @@ const NEES_TIMES: [u64; 4] = [60, 300, 900, 1800];
 /// `ν ~ N(0, σ_z² I3)` (exactly the R of the filter); otherwise `ṽ = 0` (noise-free).
 ///
 /// Returns, per epoch of [`NEES_TIMES`], the run-mean of
-/// `[NEES of the 9 observable coordinates p = T9 e (spec §2.4), marginal NEES of δv
-/// (3 dof), marginal NEES of the 6 pseudo states φ', ε'_N, ε'_D, δa_D (6 dof)]`, with
-/// `e` = true error − estimate (estimate = 0 after the closed-loop reset; convention G,
-/// `φ = log(Ĉ Cᵀ)`; residual biases resolved with the true C) and the covariance
-/// `T9 P T9ᵀ`.
+/// `[NEES of the 9 observable coordinates p = T9 e (docs/theory/alignment.md
+/// §"Observability at one heading"), marginal NEES of δv (3 dof), marginal NEES of the 6 pseudo
+/// states φ', ε'_N, ε'_D, δa_D (6 dof)]`, with `e` = true error − estimate (estimate = 0 after the
+/// closed-loop reset; convention G, `φ = log(Ĉ Cᵀ)`; residual biases resolved with the true C) and
+/// the covariance `T9 P T9ᵀ`.
 fn nees_monte_carlo(runs: u64, sigma_z: f64, meas_noise: bool) -> Vec<[f64; 3]> {
     let tr = ref_truth();
     let s = ref_site();
@@ -498,8 +499,8 @@ fn nees_monte_carlo(runs: u64, sigma_z: f64, meas_noise: bool) -> Vec<[f64; 3]> 
 
 /// Filter consistency (NEES) with a statistically matched measurement: the simulated
 /// zero-velocity measurement carries exactly the noise the filter assumes,
-/// `ν ~ N(0, σ_z² I3)`, σ_z = 1 mm/s (spec §2.2). The mean pseudo-state NEES (9 dof)
-/// over 50 runs lies in its 95 % χ² band at 60, 300, 900 and 1800 s.
+/// `ν ~ N(0, σ_z² I3)`, σ_z = 1 mm/s (docs/theory/alignment.md §"Fine alignment"). The mean
+/// pseudo-state NEES (9 dof) over 50 runs lies in its 95 % χ² band at 60, 300, 900 and 1800 s.
 ///
 /// Why the simulated ν: in the simulation the IMU is exactly at rest, so the plain
 /// zero-velocity update `ṽ = 0` is noise-free, while the filter uses R = (1 mm/s)² — a
@@ -698,8 +699,9 @@ fn t6_multiheading_noise_free_algorithm_a() {
     assert!(phi.z.abs() > 1e-3);
 }
 
-/// Algorithm B (spec §3.3) on simulated signals, noise-free: same accuracy class as
-/// Algorithm A for 2 and 4 headings; single heading is rank-deficient.
+/// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment") on simulated signals,
+/// noise-free: same accuracy class as Algorithm A for 2 and 4 headings; single heading is
+/// rank-deficient.
 #[test]
 fn algorithm_b_noise_free_signals() {
     for (h, tr, ph) in mh_cases() {
@@ -804,7 +806,7 @@ fn lasergyro_real_data_alignment() {
         let c1 = coarse_window(w, dt, 0, win, &site, CoarseMethod::OneStep).unwrap();
         let c0 = coarse_window(w, dt, 0, 6000, &site, CoarseMethod::TwoStep).unwrap();
         let mut cfg = reference_config(site, 20.0 * UG, 0.002 * DPSH);
-        cfg.sigma_z_mps = 0.01; // parked vehicle: sway (spec §2.2)
+        cfg.sigma_z_mps = 0.01; // parked vehicle: sway (docs/theory/alignment.md §"Fine alignment")
         let fa = run_fine(w, dt, cfg, &c0, |_, _| {}, &CancelToken::new()).unwrap();
         let e = [
             sdins_core::math::euler_from_c_b_n(&c2),

@@ -1,7 +1,6 @@
-//! Error propagation against nonlinear simulation: spec
-//! `alignment_and_errors.md` §6 T9 (24 h free-running INS vs the §4.3 closed form), the
-//! linear model vs the nonlinear error over 1800 s, and the covariance propagation vs
-//! Monte Carlo σ.
+//! Error propagation against nonlinear simulation: docs/validation.md §"error propagation" T9 (24 h
+//! free-running INS vs the stationary closed form), the linear model vs the nonlinear error over
+//! 1800 s, and the covariance propagation vs Monte Carlo σ.
 //!
 //! The long cases are `#[ignore]` (run with `cargo test --release -- --ignored`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -28,7 +27,8 @@ struct T9Case {
     gyro_dph: [f64; 3],
     accel_ug: [f64; 3],
     phi0: [f64; 3],
-    /// (channel, hour, spec INS value \[m\]) — spec §6 T9 table, INS column
+    /// (channel, hour, reference INS value \[m\]) — docs/validation.md §"error propagation" T9
+    /// table, INS column
     spec_points: &'static [(usize, f64, f64)],
 }
 
@@ -98,10 +98,10 @@ fn t9_cases() -> Vec<T9Case> {
     ]
 }
 
-/// Spec §6 T9: 24 h nonlinear free-inertial INS (vertical held, L = 37.5°, body = NED,
-/// spherical earth R0 = 6371 km, g = 9.79949) vs the §4.3 closed form:
-/// max |INS − closed| ≤ 1 % of the peak + 50 m, per horizontal channel, over 0–24 h; and
-/// the INS values at the spec's table epochs within the same tolerance.
+/// docs/validation.md §"error propagation" T9: 24 h nonlinear free-inertial INS (vertical held,
+/// L = 37.5°, body = NED, spherical earth R0 = 6371 km, g = 9.79949) vs the stationary closed
+/// form: max |INS − closed| ≤ 1 % of the peak + 50 m, per horizontal channel, over 0–24 h; and
+/// the INS values at the reference table's epochs within the same tolerance.
 ///
 /// IMU 20 Hz, N = 2 (10 Hz updates), `songlee-complete`: with constant rates the
 /// algorithm error is negligible (the stationary run's own error is < 1 mm), and 1.7 M
@@ -155,12 +155,12 @@ fn t9_free_inertial_24h_matches_closed_form() {
                 .unwrap();
             let cf = closed.eval(e.t_s).dp_n[ch];
             println!(
-                "    ch {ch} at {h:>4} h: INS {:>9.1} m, closed {:>9.1} m, spec INS {v:>8.0} m",
+                "    ch {ch} at {h:>4} h: INS {:>9.1} m, closed {:>9.1} m, ref INS {v:>8.0} m",
                 e.pos_err_ned_m[ch], cf
             );
             assert!(
                 (e.pos_err_ned_m[ch] - v).abs() <= tol,
-                "{}: {h} h ch {ch}: {} vs spec {v}",
+                "{}: {h} h ch {ch}: {} vs ref {v}",
                 c.name,
                 e.pos_err_ned_m[ch]
             );
@@ -313,9 +313,9 @@ const REF_BIASES: &str =
     "[imu.errors]\ngyro_bias_dph = [0.01, -0.02, 0.015]\naccel_bias_ug = [50.0, -80.0, 30.0]";
 
 /// Linear error model vs the nonlinear difference over 1800 s within 12 % (relative to
-/// the channel's peak), for the spec REF biases in body axes: stationary at the REF
-/// attitude (roll 2°, pitch −3°, yaw 40°) and the Mach-1 cruise (100 Hz IMU, N = 2: the
-/// bias-driven error does not depend on the IMU rate, and the ideal run is subtracted).
+/// the channel's peak), for the REF biases (docs/theory/alignment.md §"Reference case") in
+/// body axes: stationary at the REF attitude (roll 2°, pitch −3°, yaw 40°) and the Mach-1 cruise (100 Hz IMU,
+/// N = 2: the bias-driven error does not depend on the IMU rate, and the ideal run is subtracted).
 #[test]
 fn linear_model_matches_nonlinear_difference_1800s() {
     let alignment = scenario_with("alignment", 100.0, 2, REF_BIASES);

@@ -1,6 +1,6 @@
 //! End-to-end acceptance of the mechanizations against the exact truth
-//! (mechanization.md §7). Reference values are the spec's signed numbers; tolerances are
-//! the spec's (±5 % / ±10 % / bars). The 90-minute runs are release-mode `#[ignore]` tests.
+//! (docs/validation.md). Reference values are the signed numbers of the papers' cases as
+//! reconstructed there; tolerances ±5 % / ±10 % / bars. The 90-minute runs are release-mode `#[ignore]` tests.
 #![allow(clippy::unwrap_used)]
 mod common;
 use common::*;
@@ -98,7 +98,8 @@ fn dual_quaternion_paper_case_spec_7_5() {
         false,
     );
     let [c, dq, sav, conv_phi] = [&got[0][0], &got[1][0], &got[2][0], &got[3][0]];
-    // Conventional row (spec §7.5 was computed with ½Δθ×Δv rotation compensation): ±10 %
+    // Conventional row (the reference values of docs/validation.md §"dual-quaternion paper case"
+    // were computed with ½Δθ×Δv rotation compensation): ±10 %
     let row = |e: &NavError| -> Vec<f64> {
         vec![
             e.pos_err_ned_m[0],

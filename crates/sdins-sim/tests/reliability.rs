@@ -139,8 +139,8 @@ fn antimeridian_east_and_west() {
 }
 
 /// 72 h stationary at 100 Hz, N = 4, vertical held, 0.01 °/h x-gyro bias (north, level):
-/// the horizontal errors follow the closed form of the error-analysis spec (§4.3) and the
-/// attitude matrix stays orthonormal to 1e-14.
+/// the horizontal errors follow the closed form of the (docs/theory/error-analysis.md
+/// §"Full stationary closed form") and the attitude matrix stays orthonormal to 1e-14.
 #[test]
 #[ignore = "72 h at 100 Hz: run in release with --ignored (about a minute)"]
 fn stationary_72h_vertical_hold_matches_closed_form() {
@@ -206,8 +206,8 @@ proptest! {
     // fixed seed: the same cases on every run
     #![proptest_config(ProptestConfig { cases: 32, rng_seed: proptest::test_runner::RngSeed::Fixed(0x9_5d1), ..ProptestConfig::default() })]
 
-    /// A stationary vehicle stays put (mechanization.md §7.1 scaled from 5400 s to 60 s).
-    /// With ideal sensors the SL/SLC residual is roundoff: an attitude residual grows
+    /// A stationary vehicle stays put (docs/validation.md §"stationary 90 min" scaled from 5400 s
+    /// to 60 s). With ideal sensors the SL/SLC residual is roundoff: an attitude residual grows
     /// linearly, a velocity residual linearly, a position residual at most quadratically
     /// (t ≪ Schuler period, t ≪ τ = 570 s of the vertical channel: cosh(60/570) − 1 = 0.6 %),
     /// so the 90-min bounds become att ≤ 1e-10·(60/5400), vel ≤ 1e-5·(60/5400),

@@ -42,7 +42,8 @@ fn stationary_increments_closed_form() {
 
 #[test]
 fn mach1_rk4_reproduces_closed_form() {
-    // spec §7.0: with the turn disabled the general generator reproduces the A1 closed-form
+    // docs/theory/mechanizations.md §"Truth generation": with the turn disabled the general
+    // generator reproduces the A1 closed-form
     // increments (5e-23 rad, 3.5e-18 m/s in the reference prototype) and position.
     let scn = Scenario::load("mach1-east").unwrap();
     let c = cfg(&scn, 16);
@@ -62,7 +63,7 @@ fn mach1_rk4_reproduces_closed_form() {
     assert!(dth <= 1e-21, "{dth:e}");
     assert!(dv <= 1e-17, "{dv:e}");
     assert!(dpos <= 1e-15, "{dpos:e}");
-    // the closed-form increments themselves (spec §7.2 truth values)
+    // the closed-form increments themselves (docs/validation.md §"Song–Lee Table 1" truth values)
     let first = TruthGenerator::new(&scn.trajectory, c).next().unwrap();
     let w = first.inc.dtheta_b_rad / c.dt_s;
     let f = first.inc.dv_b_mps / c.dt_s;
@@ -110,7 +111,8 @@ fn refinement_turn_and_sturn() {
 
 #[test]
 fn classical_coning_increments_closed_form() {
-    // Cone about body z (spec §3.3) on a flat, non-rotating earth: the generator's Δθ equals
+    // Cone about body z (docs/theory/coning-sculling.md §"Classical coning and sculling truth") on
+    // a flat, non-rotating earth: the generator's Δθ equals
     // [sinα(cosΩt2 − cosΩt1), sinα(sinΩt2 − sinΩt1), −Ω(1−cosα)(t2−t1)] to 1e-14 relative.
     let (alpha, omega) = (1.0 * D2R, 2.0 * std::f64::consts::PI * 1.0);
     let tr = Trajectory::new(
@@ -242,7 +244,8 @@ fn scenario_reference_lists_every_accepted_key() {
 
 #[test]
 fn mach1_truth_satisfies_navigation_equations() {
-    // Numerically differentiated truth against the increments (A1, spec §7.2): the
+    // Numerically differentiated truth against the increments (A1, docs/validation.md
+    // §"Song–Lee Table 1"): the
     // longitude advances at v_E/((R_N+h)cosL) (central difference of the truth), latitude
     // and height stay put, and the increments close the velocity equation
     // v̇ = C_b^n f + g − (2ω_ie + ω_en)×v = 0 to roundoff on every sample.
@@ -254,7 +257,7 @@ fn mach1_truth_satisfies_navigation_equations() {
     let lon_rate = 340.29 / ((r.r_n_m + c.h0_m) * c.lat0_rad.cos());
     assert!(
         (lon_rate - 6.716597206969401e-5).abs() < 1e-19,
-        "spec §7.2 dl/dt"
+        "A1 closed-form dl/dt"
     );
     for k in [500, 1000, 1500] {
         // central difference over ±1 s: the truth longitude is an absolute angle near

@@ -1,6 +1,6 @@
-//! `sdins align`: initial alignment of a stationary IMU (spec `alignment_and_errors.md`
-//! §1–§3): coarse 1-step / 2-step, 12-state Kalman fine alignment, multi-heading
-//! (Algorithm A, or B for scenarios), and the observability rank tables.
+//! `sdins align`: initial alignment of a stationary IMU (docs/theory/alignment.md): coarse 1-step /
+//! 2-step, 12-state Kalman fine alignment, multi-heading (Algorithm A, or B for scenarios), and the
+//! observability rank tables.
 //!
 //! Input is an IMU file (`--imu`) or a scenario (built-in name or file; its IMU error
 //! model applies with run index `--run`). Outputs in `--out` (if given):
@@ -35,26 +35,28 @@ use std::path::PathBuf;
 /// Alignment method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
-    /// 1-step analytic (TRIAD-type), polar-orthonormalised (spec §1.1)
+    /// 1-step analytic (TRIAD-type), polar-orthonormalised (docs/theory/alignment.md
+    /// §"Coarse alignment")
     Coarse1,
-    /// 2-step: levelling + gyrocompassing (spec §1.2)
+    /// 2-step: levelling + gyrocompassing (docs/theory/alignment.md §"Coarse alignment")
     Coarse2,
     /// inertial-frame coarse alignment, robust to sway, rocking, heave and surge
     /// (docs/alignment_i0.md); the attitude at the end of the window
     I0,
-    /// 12-state zero-velocity Kalman fine alignment (spec §2)
+    /// 12-state zero-velocity Kalman fine alignment (docs/theory/alignment.md §"Fine alignment")
     Fine,
-    /// multi-heading: one filter with body-frame bias states across rotations (spec §3.2)
+    /// multi-heading: one filter with body-frame bias states across rotations
+    /// (docs/theory/alignment.md §"Multi-heading alignment")
     Multiheading,
 }
 
 /// Multi-heading algorithm.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Alg {
-    /// Algorithm A (spec §3.2), recommended
+    /// Algorithm A (docs/theory/alignment.md §"Multi-heading alignment"), recommended
     A,
-    /// Algorithm B (spec §3.3, pseudo-error least squares; scenarios only: needs the
-    /// static phases)
+    /// Algorithm B (docs/theory/alignment.md §"Multi-heading alignment", pseudo-error least
+    /// squares; scenarios only: needs the static phases)
     B,
 }
 
@@ -125,7 +127,8 @@ pub struct Args {
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
-    /// print the observability rank tables (spec §2.4, §3.1) and exit
+    /// print the observability rank tables (docs/theory/alignment.md
+    /// §"Observability at one heading") and exit
     #[arg(long)]
     pub observability: bool,
 }
@@ -194,15 +197,37 @@ fn load(args: &Args) -> Result<AlignInput, CliError> {
     }
 }
 
-/// The per-update history as `align_history.csv` text and plot rows.
-fn history(res: &AlignOutcome) -> (String, Vec<HistRow>) {
-    let mut hist = String::from(
-        "t_s,roll_deg,pitch_deg,yaw_deg,sig_phi_n_urad,sig_phi_e_urad,sig_phi_d_urad,\
-         ba_x_ug,ba_y_ug,ba_z_ug,sig_ba_x_ug,sig_ba_y_ug,sig_ba_z_ug,\
-         bg_x_dph,bg_y_dph,bg_z_dph,sig_bg_x_dph,sig_bg_y_dph,sig_bg_z_dph,\
-         phi_n_urad,phi_e_urad,phi_d_urad\n",
-    );
+/// Header of `align_history.csv`.
+const HISTORY_HEADER: [&str; 22] = [
+    "t_s",
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "sig_phi_n_urad",
+    "sig_phi_e_urad",
+    "sig_phi_d_urad",
+    "ba_x_ug",
+    "ba_y_ug",
+    "ba_z_ug",
+    "sig_ba_x_ug",
+    "sig_ba_y_ug",
+    "sig_ba_z_ug",
+    "bg_x_dph",
+    "bg_y_dph",
+    "bg_z_dph",
+    "sig_bg_x_dph",
+    "sig_bg_y_dph",
+    "sig_bg_z_dph",
+    "phi_n_urad",
+    "phi_e_urad",
+    "phi_d_urad",
+];
+
+/// The per-update history as `align_history.csv` text and plot rows (the true attitude
+/// error φ only when the truth is known: empty cells otherwise).
+fn history(res: &AlignOutcome) -> Result<(String, Vec<HistRow>), CliError> {
     let mut rows = Vec::with_capacity(res.history.len());
+    let mut records = Vec::with_capacity(res.history.len());
     for h in &res.history {
         let e = h.euler;
         let sa = h.attitude_sigma / 1e-6;
@@ -211,21 +236,17 @@ fn history(res: &AlignOutcome) -> (String, Vec<HistRow>) {
         let bg = h.gyro_bias_b / DPH;
         let sbg = h.gyro_bias_sigma_b / DPH;
         let phi = h.phi_true.map(|p| p / 1e-6);
-        let _ = write!(
-            hist,
-            "{:.3},{:.9},{:.9},{:.9},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
-            h.t_s,
-            e.roll_rad.to_degrees(),
-            e.pitch_rad.to_degrees(),
-            e.yaw_rad.to_degrees(),
-            sa.x, sa.y, sa.z, ba.x, ba.y, ba.z, sba.x, sba.y, sba.z, bg.x, bg.y, bg.z, sbg.x, sbg.y, sbg.z
-        );
-        match phi {
-            Some(p) => {
-                let _ = writeln!(hist, ",{:.4},{:.4},{:.4}", p.x, p.y, p.z);
-            }
-            None => hist.push_str(",,,\n"),
+        let mut rec: Vec<Option<f64>> = vec![
+            Some(h.t_s),
+            Some(e.roll_rad.to_degrees()),
+            Some(e.pitch_rad.to_degrees()),
+            Some(e.yaw_rad.to_degrees()),
+        ];
+        for v in [sa, ba, sba, bg, sbg] {
+            rec.extend(v.iter().map(|x| Some(*x)));
         }
+        rec.extend((0..3).map(|i| phi.map(|p| p[i])));
+        records.push(rec);
         let a = |v: Vec3| [v.x, v.y, v.z];
         rows.push(HistRow {
             t_s: h.t_s,
@@ -237,7 +258,7 @@ fn history(res: &AlignOutcome) -> (String, Vec<HistRow>) {
             sig_bg_dph: a(sbg),
         });
     }
-    (hist, rows)
+    Ok((crate::csv_out::table(&HISTORY_HEADER, records)?, rows))
 }
 
 /// Run the command.
@@ -258,14 +279,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let (Some(sz), false) = (res.sigma_z_used_mps, args.json) {
         println!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
     }
-    let (hist, rows) = history(&res);
+    let (hist, rows) = history(&res)?;
     let dt = inp.dt_s;
     let t_end = res.samples as f64 * dt;
     let phi = res.phi_true;
     let e = res.euler;
     if let Some(dir) = &args.out {
         crate::output::claim(dir)?;
-        write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi))?;
+        write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi)?)?;
         let mut svgs = None;
         if res.has_history {
             write_string(&dir.join("align_history.csv"), &hist)?;
@@ -499,83 +520,79 @@ fn write_align_toml(
     crate::report::write_run_toml(dir, t)
 }
 
-fn v3(v: &Vec3, unit: f64) -> String {
-    format!("[{}, {}, {}]", v.x / unit, v.y / unit, v.z / unit)
+fn v3(v: &Vec3, unit: f64) -> serde_json::Value {
+    serde_json::json!([v.x / unit, v.y / unit, v.z / unit])
 }
 
 fn result_json(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>, tb: Option<(Vec3, Vec3)>) -> String {
-    let mut s = format!(
-        "{{\"method\": \"{}\", \"roll_deg\": {}, \"pitch_deg\": {}, \"yaw_deg\": {}",
-        r.method,
-        e.roll_rad.to_degrees(),
-        e.pitch_rad.to_degrees(),
-        e.yaw_rad.to_degrees()
-    );
+    let mut m = serde_json::Map::new();
+    m.insert("method".into(), r.method.to_string().into());
+    m.insert("roll_deg".into(), e.roll_rad.to_degrees().into());
+    m.insert("pitch_deg".into(), e.pitch_rad.to_degrees().into());
+    m.insert("yaw_deg".into(), e.yaw_rad.to_degrees().into());
     if let Some((b, sd)) = r.accel_bias {
-        let _ = write!(
-            s,
-            ", \"accel_bias_ug\": {}, \"accel_bias_sigma_ug\": {}",
-            v3(&b, UG),
-            v3(&sd, UG)
-        );
+        m.insert("accel_bias_ug".into(), v3(&b, UG));
+        m.insert("accel_bias_sigma_ug".into(), v3(&sd, UG));
     }
     if let Some((b, sd)) = r.gyro_bias {
-        let _ = write!(
-            s,
-            ", \"gyro_bias_dph\": {}, \"gyro_bias_sigma_dph\": {}",
-            v3(&b, DPH),
-            v3(&sd, DPH)
-        );
+        m.insert("gyro_bias_dph".into(), v3(&b, DPH));
+        m.insert("gyro_bias_sigma_dph".into(), v3(&sd, DPH));
     }
     if let Some(a) = r.attitude_sigma {
-        let _ = write!(s, ", \"attitude_sigma_urad\": {}", v3(&a, 1e-6));
+        m.insert("attitude_sigma_urad".into(), v3(&a, 1e-6));
     }
     if let Some(p) = phi {
-        let _ = write!(s, ", \"phi_urad\": {}", v3(&p, 1e-6));
+        m.insert("phi_urad".into(), v3(&p, 1e-6));
     }
     if let Some((ba, bg)) = tb {
-        let _ = write!(
-            s,
-            ", \"true_accel_bias_ug\": {}, \"true_gyro_bias_dph\": {}",
-            v3(&ba, UG),
-            v3(&bg, DPH)
-        );
+        m.insert("true_accel_bias_ug".into(), v3(&ba, UG));
+        m.insert("true_gyro_bias_dph".into(), v3(&bg, DPH));
     }
-    s.push('}');
-    s
+    serde_json::Value::Object(m).to_string()
 }
 
-fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> String {
-    let mut s = String::from(
-        "method,roll_deg,pitch_deg,yaw_deg,ba_x_ug,ba_y_ug,ba_z_ug,sig_ba_x_ug,sig_ba_y_ug,sig_ba_z_ug,\
-         bg_x_dph,bg_y_dph,bg_z_dph,sig_bg_x_dph,sig_bg_y_dph,sig_bg_z_dph,phi_n_urad,phi_e_urad,phi_d_urad\n",
-    );
-    let _ = write!(
-        s,
-        "{},{:.9},{:.9},{:.9}",
-        r.method,
-        e.roll_rad.to_degrees(),
-        e.pitch_rad.to_degrees(),
-        e.yaw_rad.to_degrees()
-    );
-    let mut cells = |v: Option<Vec3>, unit: f64| match v {
-        Some(v) => {
-            let _ = write!(s, ",{},{},{}", v.x / unit, v.y / unit, v.z / unit);
-        }
-        None => s.push_str(",,,"),
-    };
-    cells(r.accel_bias.map(|b| b.0), UG);
-    cells(r.accel_bias.map(|b| b.1), UG);
-    cells(r.gyro_bias.map(|b| b.0), DPH);
-    cells(r.gyro_bias.map(|b| b.1), DPH);
-    cells(phi, 1e-6);
-    s.push('\n');
-    s
+fn result_csv(r: &AlignOutcome, e: &Euler, phi: Option<Vec3>) -> Result<String, CliError> {
+    const HEADER: [&str; 19] = [
+        "method",
+        "roll_deg",
+        "pitch_deg",
+        "yaw_deg",
+        "ba_x_ug",
+        "ba_y_ug",
+        "ba_z_ug",
+        "sig_ba_x_ug",
+        "sig_ba_y_ug",
+        "sig_ba_z_ug",
+        "bg_x_dph",
+        "bg_y_dph",
+        "bg_z_dph",
+        "sig_bg_x_dph",
+        "sig_bg_y_dph",
+        "sig_bg_z_dph",
+        "phi_n_urad",
+        "phi_e_urad",
+        "phi_d_urad",
+    ];
+    let mut cells: Vec<Option<f64>> = vec![
+        Some(e.roll_rad.to_degrees()),
+        Some(e.pitch_rad.to_degrees()),
+        Some(e.yaw_rad.to_degrees()),
+    ];
+    for (v, unit) in [
+        (r.accel_bias.map(|b| b.0), UG),
+        (r.accel_bias.map(|b| b.1), UG),
+        (r.gyro_bias.map(|b| b.0), DPH),
+        (r.gyro_bias.map(|b| b.1), DPH),
+        (phi, 1e-6),
+    ] {
+        cells.extend((0..3).map(|i| v.map(|v| v[i] / unit)));
+    }
+    crate::csv_out::table(&HEADER, [(r.method.to_string(), cells)])
 }
 
-/// The observability rank tables of spec §2.4 (single heading, NED bias states; pseudo
-/// 9-state model) and §3.1 (stripped observability matrix, body-frame bias states,
-/// attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
+/// The observability rank tables of docs/theory/alignment.md §"Observability at one heading"
+/// (single heading, NED bias states; pseudo 9-state model) and of the multi-heading case
+/// (stripped observability matrix, body-frame bias states, attitude roll 2°, pitch −3°, base heading 40°), at latitude `lat_deg`.
 pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     if !(lat_deg.is_finite() && lat_deg.abs() <= 80.0) {
         return Err(CliError::bad(format!(
@@ -643,7 +660,7 @@ pub fn observability_tables(lat_deg: f64) -> Result<String, CliError> {
     }
     let _ = writeln!(
         s,
-        "\nUnobservable directions, 1 heading (spec §2.4): n1 = φ_N + (−tan L) φ_D + (−g) δa_E; \
+        "\nUnobservable directions, 1 heading (docs/theory/alignment.md): n1 = φ_N + (−tan L) φ_D + (−g) δa_E; \
          n2 = φ_D + (−Ω cos L) ε_E; n3 = φ_E + g δa_N + Ω sin L ε_N + Ω cos L ε_D"
     );
     Ok(s)

@@ -2,16 +2,17 @@
 //! histories that `align_history.csv` holds, drawn as
 //!
 //! * `align_attitude.svg/.png`: one panel per NED axis, the attitude error
-//!   `φ = log(Ĉ Cᵀ)` (convention G, spec §0.2) against the truth (scenarios) in μrad,
-//!   with the filter's `±3σ = ±3 √P_φφ` as a shaded band in the same color. Without a
-//!   truth (IMU files) only the `±3σ` band is drawn.
+//!   `φ = log(Ĉ Cᵀ)` (convention G, docs/conventions.md §"Errors") against the truth (scenarios) in
+//!   μrad, with the filter's `±3σ = ±3 √P_φφ` as a shaded band in the same color. Without a truth
+//!   (IMU files) only the `±3σ` band is drawn.
 //! * `align_bias.svg/.png`: accelerometer (μg) and gyro (°/h) bias estimates in body
 //!   axes, `b̂ ± 3σ` shaded in the same color, and the true bias (scenarios) dashed.
-//!   σ is the body-frame 1σ of the bias state (spec §2.1 NED states rotated with `Ĉᵀ P Ĉ`, or the body states of §3.2).
+//!   σ is the body-frame 1σ of the bias state (docs/theory/alignment.md §"Fine alignment" NED
+//!   states rotated with `Ĉᵀ P Ĉ`, or the body-frame states of Algorithm A).
 //!
 //! The y range is fitted to the last 90 % of the record (the first Kalman cycles carry
-//! the P0 bounds of spec §2.3, up to 30 mrad in heading, which would flatten the
-//! converged part); values outside it are clipped to the frame. Drawn by
+//! the P0 bounds of docs/theory/alignment.md §"Fine alignment", up to 30 mrad in heading, which
+//! would flatten the converged part); values outside it are clipped to the frame. Drawn by
 //! [`crate::plot::Figure`] (legend above the panels, tick labels for their range).
 
 use crate::error::CliError;

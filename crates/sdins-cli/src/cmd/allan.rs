@@ -68,7 +68,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     crate::output::claim(&args.out)?;
     let report = analyse(&data.increments, data.dt_s);
-    write_string(&args.out.join("allan.csv"), &csv(&report))?;
+    write_string(&args.out.join("allan.csv"), &csv(&report)?)?;
     let svg = plot_svg(&report)?;
     write_string(&args.out.join("allan.svg"), &svg)?;
     plot_png(&report, &args.out.join("allan.png"))?;
@@ -209,19 +209,26 @@ pub fn json(r: &AllanReport) -> String {
 }
 
 /// `allan.csv`: τ and the six deviations (gyro °/h, accelerometer μg).
-pub fn csv(r: &AllanReport) -> String {
-    let mut s =
-        String::from("tau_s,gyro_x_dph,gyro_y_dph,gyro_z_dph,accel_x_ug,accel_y_ug,accel_z_ug\n");
+pub fn csv(r: &AllanReport) -> Result<String, CliError> {
+    const HEADER: [&str; 7] = [
+        "tau_s",
+        "gyro_x_dph",
+        "gyro_y_dph",
+        "gyro_z_dph",
+        "accel_x_ug",
+        "accel_y_ug",
+        "accel_z_ug",
+    ];
     let n = r.curves.iter().map(|c| c.tau_s.len()).min().unwrap_or(0);
-    for i in 0..n {
-        let _ = write!(s, "{}", r.curves[0].tau_s[i]);
+    let rows = (0..n).map(|i| {
+        let mut rec = vec![r.curves[0].tau_s[i]];
         for (ch, c) in r.curves.iter().enumerate() {
             let unit = if ch < 3 { DPH } else { UG };
-            let _ = write!(s, ",{}", c.adev[i] / unit);
+            rec.push(c.adev[i] / unit);
         }
-        s.push('\n');
-    }
-    s
+        rec
+    });
+    crate::csv_out::table(&HEADER, rows)
 }
 
 const SIZE: (u32, u32) = (1400, 600);

@@ -1,5 +1,6 @@
 //! `sdins demo`: the papers' headline comparisons on built-in scenarios, with the
-//! papers'/spec's numbers printed beside ours, and one self-contained HTML report.
+//! papers' reference numbers (docs/validation.md) printed beside ours, and one self-contained HTML
+//! report.
 
 use super::run::{
     error_figure, execute_full, print_table, summary_rows, Args as RunArgs, Outcome, SUMMARY_HEADER,
@@ -63,7 +64,7 @@ fn section(
     r.para(&o.scn.description);
     r.table(&SUMMARY_HEADER, &summary_rows(&o.sums));
     if !paper_rows.is_empty() {
-        r.para("The papers' (reconstructed) and the specification's numbers for comparison:");
+        r.para("The papers' numbers (reconstructed, docs/validation.md) for comparison:");
         r.table(paper_header, paper_rows);
     }
     r.para(note);
@@ -129,7 +130,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 sl.final_err.vel_err_ned_mps,
             ))
             .min(ratio(sav.final_err.att_err_rad, sl.final_err.att_err_rad));
-        ratio_text = format!("Smallest Savage/Song-Lee ratio over all nine components: {q:.1} (the paper claims > 50). East and down agree with the paper within 2 %; the north error does not: the paper prints 0.01 m, we and the specification's independent reconstruction get 0.044 m. The paper states neither its latitude, constants nor exact evaluation time, and the north error of this due-east flight is the small residue of a Schuler oscillation, the component most sensitive to them; we report the difference rather than claim a reproduction.");
+        ratio_text = format!("Smallest Savage/Song-Lee ratio over all nine components: {q:.1} (the paper claims > 50). East and down agree with the paper within 2 %; the north error does not: the paper prints 0.01 m, we and an independent reconstruction get 0.044 m. The paper states neither its latitude, constants nor exact evaluation time, and the north error of this due-east flight is the small residue of a Schuler oscillation, the component most sensitive to them; we report the difference rather than claim a reproduction.");
         println!("  {ratio_text}");
     }
     let t1_header = [
@@ -146,7 +147,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "7.1, 0.5, 5.5",
         ]),
         v(&[
-            "Savage, spec reference",
+            "Savage, paper reference",
             "3.065, −47.58, −566.7",
             "3.476, −52.88, −991.6",
             "7.451, 0.482, −5.718",
@@ -158,19 +159,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "0.1, 0.01, 0.08",
         ]),
         v(&[
-            "Song–Lee, spec reference",
+            "Song–Lee, paper reference",
             "0.0438, −0.681, −8.109",
             "0.0497, −0.757, −14.19",
             "0.107, 0.0069, −0.082",
         ]),
         v(&[
-            "Song–Lee complete, spec bars",
+            "Song–Lee complete, reference bars",
             "≤ 1e−2 (horizontal), ≤ 0.2 (D)",
             "≤ 1e−2, ≤ 0.3 (D)",
             "≤ 2e−3",
         ]),
         v(&[
-            "dual quaternion, spec bars",
+            "dual quaternion, reference bars",
             "≤ 0.5 (horizontal), ≤ 5 (D)",
             "",
             "≤ 0.05",
@@ -245,7 +246,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     println!("attitude error |ε| at the end of the turn (t = 8 s):");
     for row in &att_rows {
         println!(
-            "  {:<42} {:>10}  spec {:>20}  S1 {}",
+            "  {:<42} {:>10}  ref {:>20}  S1 {}",
             row[0], row[1], row[2], row[3]
         );
     }
@@ -253,7 +254,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &mut r,
         "2. 90°/s turn from east to south at Mach 1",
         &a2,
-        &["attitude option", "|ε| at 8 s [μrad] (sdins)", "spec", "S1"],
+        &["attitude option", "|ε| at 8 s [μrad] (sdins)", "reference", "S1"],
         &att_rows,
         "The transport-matrix attitude (S1 eq. 6) keeps the attitude error at the end of the turn near 1e-3 μrad; the (5)-method reproduces S1's 0.3 μrad. Position errors during the turn are the trapezoid rule's transient (ΔT²/12)(a(t) − a(t0)), which vanishes when the turn ends.",
     )?;
@@ -265,7 +266,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut timing = String::new();
     if let (Some(sav), Some(dq)) = (find(&b, "savage"), find(&b, "dualquat")) {
         timing = format!(
-            "Execution time dual quaternion / Savage: {:.2} here (S2: 2.7 in MATLAB; spec prototype 2.2).",
+            "Execution time dual quaternion / Savage: {:.2} here (S2: 2.7 in MATLAB; reference prototype 2.2).",
             dq.wall_s / sav.wall_s.max(1e-12)
         );
         println!("  {timing}");
@@ -309,7 +310,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     println!("height and down-velocity errors at 420 s (S2: DQ better in height and v_D):");
     for row in &b_rows {
         println!(
-            "  {:<26} h {:>11} (spec {:>26})  vD {:>11} (spec {})",
+            "  {:<26} h {:>11} (ref {:>26})  vD {:>11} (ref {})",
             row[0], row[1], row[2], row[3], row[4]
         );
     }
@@ -317,7 +318,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &mut r,
         "3. The dual-quaternion paper's case (accuracy and execution time, its Figures 1–4)",
         &b,
-        &["algorithm", "height error [m] (sdins)", "spec", "v_D error [m/s] (sdins)", "spec"],
+        &["algorithm", "height error [m] (sdins)", "reference", "v_D error [m/s] (sdins)", "reference"],
         &b_rows,
         &format!("S2 found the dual-quaternion algorithm better in north/down velocity and height: reproduced. {timing}"),
     )?;
@@ -332,13 +333,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     }
     r.heading("4. Initial alignment");
-    r.para("Built-in scenario `alignment` (37.5°N, roll/pitch/yaw 2/−3/40°, aviation-grade IMU, run 0): attitude error φ (convention G, NED) of coarse 1-step and 2-step alignment over the first 60 s and of the 12-state fine Kalman alignment after 300 s and 1800 s. Tilt is limited by the accelerometer biases and heading by the east gyro bias, as the spec's error table predicts; `sdins align` gives the biases and the ±3σ plots.");
+    r.para("Built-in scenario `alignment` (37.5°N, roll/pitch/yaw 2/−3/40°, aviation-grade IMU, run 0): attitude error φ (convention G, NED) of coarse 1-step and 2-step alignment over the first 60 s and of the 12-state fine Kalman alignment after 300 s and 1800 s. Tilt is limited by the accelerometer biases and heading by the east gyro bias, as the first-order error table (docs/theory/alignment.md) predicts; `sdins align` gives the biases and the ±3σ plots.");
     r.table(
         &["method", "φ N [μrad]", "φ E [μrad]", "φ D [μrad]", "note"],
         &align_rows,
     );
 
-    // 5. Schuler share (spec §4.4)
+    // 5. Schuler share (docs/theory/error-analysis.md §"The Schuler share")
     println!(
         "\n== 5. Schuler share of the position error by sensor grade ([P2] Table 1, docs/theory/error-analysis.md) =="
     );

@@ -1,9 +1,10 @@
 //! `sdins errors`: analytic INS error propagation.
 //!
-//! Prints the full stationary closed form (spec `alignment_and_errors.md` §4.3) for a
-//! set of NED sensor biases, next to the 15-state linear model's deterministic error and
-//! 1σ covariance envelope, at a few epochs; or, with `--schuler-share`, the
-//! reconstruction of \[P2\] Table 1 (spec §4.4).
+//! Prints the full stationary closed form (docs/theory/error-analysis.md
+//! §"Full stationary closed form") for a set of NED sensor biases, next to the 15-state linear
+//! model's deterministic error and 1σ covariance envelope, at a few epochs; or, with
+//! `--schuler-share`, the reconstruction of \[P2\] Table 1 (docs/theory/error-analysis.md
+//! §"The Schuler share").
 //!
 //! Examples:
 //! ```text

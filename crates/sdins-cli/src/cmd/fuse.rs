@@ -3,6 +3,7 @@
 //! writes.
 
 use super::fuse_report::{ErrRow, FuseReportData, Thin};
+use crate::csv_out::{innovation_row, CsvOut, INNOVATION_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
@@ -11,7 +12,6 @@ use sdins_core::nav::AlgorithmSpec;
 use sdins_sim::cancel::CancelToken;
 use sdins_sim::fuse::{fuse_scenario, FuseError, FuseEvent, FuseOptions};
 use sdins_sim::scenario::Scenario;
-use std::io::Write;
 use std::path::PathBuf;
 
 /// Arguments of `sdins fuse`.
@@ -105,24 +105,46 @@ pub struct Args {
     pub json: bool,
 }
 
-const ERR_HEADER: &str = "t_s,err_n_m,err_e_m,err_d_m,sigma_n_m,sigma_e_m,sigma_d_m,err_vn_mps,err_ve_mps,err_vd_mps,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,err_att_n_rad,err_att_e_rad,err_att_d_rad,sigma_att_n_rad,sigma_att_e_rad,sigma_att_d_rad";
+const ERR_HEADER: [&str; 19] = [
+    "t_s",
+    "err_n_m",
+    "err_e_m",
+    "err_d_m",
+    "sigma_n_m",
+    "sigma_e_m",
+    "sigma_d_m",
+    "err_vn_mps",
+    "err_ve_mps",
+    "err_vd_mps",
+    "sigma_vn_mps",
+    "sigma_ve_mps",
+    "sigma_vd_mps",
+    "err_att_n_rad",
+    "err_att_e_rad",
+    "err_att_d_rad",
+    "sigma_att_n_rad",
+    "sigma_att_e_rad",
+    "sigma_att_d_rad",
+];
 
 /// One row of nav.csv / smoothed.csv: errors against the truth with σ.
-fn epoch_row(e: &sdins_sim::fuse::FuseEpoch) -> String {
-    let mut line = format!("{}", e.t_s);
-    for (i0, vals) in [
+fn epoch_row(e: &sdins_sim::fuse::FuseEpoch) -> [f64; 19] {
+    let mut row = [0.0; 19];
+    row[0] = e.t_s;
+    for (b, (i0, vals)) in [
         (I_POS, e.nav.pos_err_ned_m),
         (I_VEL, e.nav.vel_err_ned_mps),
         (I_ATT, e.nav.att_err_rad),
-    ] {
-        for v in vals {
-            line.push_str(&format!(",{v:e}"));
-        }
+    ]
+    .into_iter()
+    .enumerate()
+    {
         for i in 0..3 {
-            line.push_str(&format!(",{:e}", e.sigma(i0 + i)));
+            row[1 + 6 * b + i] = vals[i];
+            row[4 + 6 * b + i] = e.sigma(i0 + i);
         }
     }
-    line
+    row
 }
 
 fn err_row(e: &sdins_sim::fuse::FuseEpoch) -> ErrRow {
@@ -232,7 +254,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     crate::output::check_size(
         "nav.csv (and smoothed.csv)",
         scn.duration_s() * args.cov_rate_hz + 2.0,
-        250.0,
+        380.0,
         "lower --cov-rate-hz or shorten the scenario",
     )?;
     crate::output::claim(&out)?;
@@ -243,20 +265,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         None
     };
-    let io = |name: &str, e: std::io::Error| CliError::Io {
-        path: out.join(name),
-        source: e,
+    let mut smo_csv = match smo.as_mut() {
+        Some(f) => Some(CsvOut::new(f, &ERR_HEADER)?),
+        None => None,
     };
-    if let Some(f) = smo.as_mut() {
-        writeln!(f.writer(), "{ERR_HEADER}").map_err(|e| io("smoothed.csv", e))?;
-    }
-    writeln!(nav.writer(), "{ERR_HEADER}").map_err(|e| io("nav.csv", e))?;
-    writeln!(
-        inn.writer(),
-        "t_s,kind,dof,nis,accepted,forced,nu_1,nu_2,nu_3,nu_4,nu_5,nu_6"
-    )
-    .map_err(|e| io("innovations.csv", e))?;
-    let mut werr: Option<std::io::Error> = None;
+    let mut nav_csv = CsvOut::new(&mut nav, &ERR_HEADER)?;
+    let mut inn_csv = CsvOut::new(&mut inn, &INNOVATION_HEADER)?;
+    let mut werr: Option<CliError> = None;
     let mut sq = [0.0_f64; 9];
     let mut n_ep = 0.0_f64;
     let cancel = CancelToken::new();
@@ -285,28 +300,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     }
                 }
                 n_ep += 1.0;
-                writeln!(nav.writer(), "{line}")
+                nav_csv.row(&line)
             }
-            FuseEvent::Smoothed(e) => match smo.as_mut() {
-                Some(f) => writeln!(f.writer(), "{}", epoch_row(e)),
+            FuseEvent::Smoothed(e) => match smo_csv.as_mut() {
+                Some(f) => f.row(&epoch_row(e)),
                 None => Ok(()),
             },
-            FuseEvent::Update(u) => {
-                let kind = match u.kind {
-                    MeasKind::Gnss => "gnss",
-                    MeasKind::Zupt => "zupt",
-                    MeasKind::Nhc => "nhc",
-                    _ => "other",
-                };
-                let mut line = format!(
-                    "{},{kind},{},{:.6},{},{}",
-                    u.t_s, u.dof, u.nis, u.accepted, u.forced
-                );
-                for v in u.innovation {
-                    line.push_str(&format!(",{v:e}"));
-                }
-                writeln!(inn.writer(), "{line}")
-            }
+            FuseEvent::Update(u) => inn_csv.row(&innovation_row(u.t_s, u)),
             _ => Ok(()),
         };
         if let Err(e) = r {
@@ -314,13 +314,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     });
     if let Some(e) = werr {
-        return Err(io("nav.csv", e));
+        return Err(e);
     }
     let s = match res {
         Ok(s) => s,
         Err(FuseError::Cancelled(_)) => return Err(CliError::Interrupted),
         Err(e) => return Err(CliError::bad(e.to_string())),
     };
+    nav_csv.finish()?;
+    inn_csv.finish()?;
+    smo_csv.map(CsvOut::finish).transpose()?;
     nav.commit()?;
     inn.commit()?;
     if let Some(f) = smo {

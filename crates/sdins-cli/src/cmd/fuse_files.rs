@@ -4,6 +4,7 @@
 
 use super::fuse::Args;
 use super::fuse_report::{ErrRow, FuseReportData, Thin};
+use crate::csv_out::{innovation_row, nav_row, CsvOut, INNOVATION_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
@@ -13,7 +14,6 @@ use sdins_sim::fuse_files::{fuse_files, FilesError, FilesInput, InitSource, Sens
 use sdins_sim::fuse_records::{RecordEvent, RecordOptions, RecordPoint, COMPARISON_AXES};
 use sdins_sim::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
 use sdins_sim::imu_file::ImuFormat;
-use std::io::Write;
 use std::path::PathBuf;
 
 fn triple(name: &str, s: &str) -> Result<[f64; 3], CliError> {
@@ -34,29 +34,14 @@ fn triple(name: &str, s: &str) -> Result<[f64; 3], CliError> {
     Ok(out)
 }
 
-fn point_row(p: &RecordPoint) -> String {
-    let s = &p.state;
-    let e = s.euler();
-    let mut line = format!(
-        "{},{:.12},{:.12},{:.4},{:.5},{:.5},{:.5},{:.6},{:.6},{:.6}",
-        p.t_s,
-        s.lat_rad.to_degrees(),
-        s.lon_rad.to_degrees(),
-        s.h_m,
-        s.v_n_mps.x,
-        s.v_n_mps.y,
-        s.v_n_mps.z,
-        e.roll_rad.to_degrees(),
-        e.pitch_rad.to_degrees(),
-        e.yaw_rad.to_degrees()
-    );
-    for v in &p.sigma_nav[0..6] {
-        line.push_str(&format!(",{v:.4e}"));
+fn point_row(p: &RecordPoint) -> [f64; 19] {
+    let mut row = [0.0; 19];
+    row[..10].copy_from_slice(&nav_row(p.t_s, &p.state));
+    row[10..16].copy_from_slice(&p.sigma_nav[0..6]);
+    for (r, v) in row[16..].iter_mut().zip(&p.sigma_euler_rad) {
+        *r = v.to_degrees();
     }
-    for v in &p.sigma_euler_rad {
-        line.push_str(&format!(",{:.4e}", v.to_degrees()));
-    }
-    line
+    row
 }
 
 fn err_row(p: &RecordPoint, e: &[f64; 9]) -> ErrRow {
@@ -88,7 +73,28 @@ fn err_row(p: &RecordPoint, e: &[f64; 9]) -> ErrRow {
     )
 }
 
-const NAV_HEADER: &str = "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg,sigma_n_m,sigma_e_m,sigma_d_m,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg";
+/// Header of nav.csv / smoothed.csv on recorded data: [`crate::csv_out::NAV_HEADER`] and σ.
+const POINT_HEADER: [&str; 19] = [
+    "t_s",
+    "lat_deg",
+    "lon_deg",
+    "h_m",
+    "v_n_mps",
+    "v_e_mps",
+    "v_d_mps",
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "sigma_n_m",
+    "sigma_e_m",
+    "sigma_d_m",
+    "sigma_vn_mps",
+    "sigma_ve_mps",
+    "sigma_vd_mps",
+    "sigma_roll_deg",
+    "sigma_pitch_deg",
+    "sigma_yaw_deg",
+];
 
 /// Run `sdins fuse` on files.
 pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
@@ -191,14 +197,10 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
     crate::output::check_size(
         "nav.csv (and smoothed.csv)",
         imu_bytes / 40.0 / samples as f64 + 1.0,
-        200.0,
+        380.0,
         "split the IMU file or raise --samples",
     )?;
     crate::output::claim(&out)?;
-    let io = |name: &str, e: std::io::Error| CliError::Io {
-        path: out.join(name),
-        source: e,
-    };
     let mut nav = AtomicFile::create(&out.join("nav.csv"))?;
     let mut inn = AtomicFile::create(&out.join("innovations.csv"))?;
     let mut smo = if args.smooth {
@@ -206,16 +208,13 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
     } else {
         None
     };
-    writeln!(nav.writer(), "{NAV_HEADER}").map_err(|e| io("nav.csv", e))?;
-    if let Some(f) = smo.as_mut() {
-        writeln!(f.writer(), "{NAV_HEADER}").map_err(|e| io("smoothed.csv", e))?;
-    }
-    writeln!(
-        inn.writer(),
-        "t_s,kind,dof,nis,accepted,forced,nu_1,nu_2,nu_3,nu_4,nu_5,nu_6"
-    )
-    .map_err(|e| io("innovations.csv", e))?;
-    let mut werr: Option<(&'static str, std::io::Error)> = None;
+    let mut nav_csv = CsvOut::new(&mut nav, &POINT_HEADER)?;
+    let mut smo_csv = match smo.as_mut() {
+        Some(f) => Some(CsvOut::new(f, &POINT_HEADER)?),
+        None => None,
+    };
+    let mut inn_csv = CsvOut::new(&mut inn, &INNOVATION_HEADER)?;
+    let mut werr: Option<CliError> = None;
     let mut last_fwd: Option<RecordPoint> = None;
     let mut t_start = None;
     let mut fwd_rows = Thin::<ErrRow>::new();
@@ -233,36 +232,18 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
             RecordEvent::Forward(p) => {
                 t_start.get_or_insert(p.t_s);
                 last_fwd = Some(*p);
-                writeln!(nav.writer(), "{}", point_row(p)).map_err(|e| ("nav.csv", e))
+                nav_csv.row(&point_row(p))
             }
-            RecordEvent::Smoothed(p) => match smo.as_mut() {
-                Some(f) => {
-                    writeln!(f.writer(), "{}", point_row(p)).map_err(|e| ("smoothed.csv", e))
-                }
+            RecordEvent::Smoothed(p) => match smo_csv.as_mut() {
+                Some(f) => f.row(&point_row(p)),
                 None => Ok(()),
             },
             RecordEvent::Update(u) => {
-                let kind = match u.kind {
-                    MeasKind::Gnss => "gnss",
-                    MeasKind::Zupt => "zupt",
-                    MeasKind::Nhc => "nhc",
-                    _ => "other",
-                };
-                let mut line = format!(
-                    "{},{kind},{},{:.6},{},{}",
-                    t_start.unwrap_or(0.0) + u.t_s,
-                    u.dof,
-                    u.nis,
-                    u.accepted,
-                    u.forced
-                );
-                for v in u.innovation {
-                    line.push_str(&format!(",{v:e}"));
-                }
+                let t = t_start.unwrap_or(0.0) + u.t_s;
                 if u.kind == MeasKind::Gnss {
-                    gnss_rows.push((t_start.unwrap_or(0.0) + u.t_s, u.nis, u.dof, u.accepted));
+                    gnss_rows.push((t, u.nis, u.dof, u.accepted));
                 }
-                writeln!(inn.writer(), "{line}").map_err(|e| ("innovations.csv", e))
+                inn_csv.row(&innovation_row(t, u))
             }
             _ => Ok(()),
         };
@@ -270,14 +251,17 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
             werr.get_or_insert(e);
         }
     });
-    if let Some((name, e)) = werr {
-        return Err(io(name, e));
+    if let Some(e) = werr {
+        return Err(e);
     }
     let r = match res {
         Ok(r) => r,
         Err(FilesError::Fuse(FuseError::Cancelled(_))) => return Err(CliError::Interrupted),
         Err(e) => return Err(CliError::bad(e.to_string())),
     };
+    nav_csv.finish()?;
+    inn_csv.finish()?;
+    smo_csv.map(CsvOut::finish).transpose()?;
     nav.commit()?;
     inn.commit()?;
     if let Some(f) = smo {

@@ -1,15 +1,29 @@
 //! `sdins nav`: run one navigation algorithm over a recorded IMU file.
 
+use crate::csv_out::{nav_row, CsvOut, NAV_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_sim::imu_file::{read_imu_file, ImuFormat};
 use sdins_sim::nav_recorded;
 use sdins_sim::run_setup::{self, algorithms, earth_by_name, AlgoChoice};
 use sdins_sim::truth_file::read_truth;
-use std::io::Write;
 use std::path::PathBuf;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
+
+/// Header of `err_<algo>.csv` (errors against the truth file).
+const ERR_HEADER: [&str; 10] = [
+    "t_s",
+    "pos_err_n_m",
+    "pos_err_e_m",
+    "pos_err_d_m",
+    "vel_err_n_mps",
+    "vel_err_e_mps",
+    "vel_err_d_mps",
+    "att_err_n_rad",
+    "att_err_e_rad",
+    "att_err_d_rad",
+];
 
 /// Arguments of `sdins nav`.
 #[derive(clap::Args, Debug)]
@@ -123,15 +137,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )?;
     crate::output::claim(&out)?;
     let mut nav_file = AtomicFile::create(&out.join(format!("nav_{}.csv", spec.kind.name())))?;
-    let io = |source| CliError::Io {
-        path: out.clone(),
-        source,
-    };
-    writeln!(
-        nav_file.writer(),
-        "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg"
-    )
-    .map_err(io)?;
+    let mut nav_csv = CsvOut::new(&mut nav_file, &NAV_HEADER)?;
     let mut write_err = None;
     let mut final_state = None;
     // what was used, so that nobody has to guess a default
@@ -159,51 +165,25 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &crate::progress::token(),
         |t, st| {
             final_state = Some((t, *st));
-            let e = st.euler();
-            if let Err(err) = writeln!(
-                nav_file.writer(),
-                "{},{},{},{},{},{},{},{},{},{}",
-                t,
-                st.lat_rad / D2R,
-                st.lon_rad / D2R,
-                st.h_m,
-                st.v_n_mps.x,
-                st.v_n_mps.y,
-                st.v_n_mps.z,
-                e.roll_rad / D2R,
-                e.pitch_rad / D2R,
-                e.yaw_rad / D2R
-            ) {
+            if let Err(err) = nav_csv.row(&nav_row(t, st)) {
                 write_err.get_or_insert(err);
             }
         },
     )?;
     let (wall, errs) = (rec.wall_s, rec.errors);
     if let Some(e) = write_err {
-        return Err(io(e));
+        return Err(e);
     }
+    nav_csv.finish()?;
     nav_file.commit()?;
     if truth.is_some() {
         let mut ef = AtomicFile::create(&out.join(format!("err_{}.csv", spec.kind.name())))?;
-        writeln!(ef.writer(), "t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,vel_err_n_mps,vel_err_e_mps,vel_err_d_mps,att_err_n_rad,att_err_e_rad,att_err_d_rad").map_err(io)?;
+        let mut ec = CsvOut::new(&mut ef, &ERR_HEADER)?;
         for e in &errs {
             let (p, v, a) = (e.pos_err_ned_m, e.vel_err_ned_mps, e.att_err_rad);
-            writeln!(
-                ef.writer(),
-                "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-                e.t_s,
-                p[0],
-                p[1],
-                p[2],
-                v[0],
-                v[1],
-                v[2],
-                a[0],
-                a[1],
-                a[2]
-            )
-            .map_err(io)?;
+            ec.row(&[e.t_s, p[0], p[1], p[2], v[0], v[1], v[2], a[0], a[1], a[2]])?;
         }
+        ec.finish()?;
         ef.commit()?;
     }
     let last = errs.last();

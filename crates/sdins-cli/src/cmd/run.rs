@@ -1,5 +1,6 @@
 //! `sdins run`: truth → IMU → navigation → errors for algorithms side by side.
 
+use crate::csv_out::{nav_row, CsvOut, NAV_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use crate::plot::PlotScale;
@@ -8,7 +9,6 @@ use sdins_core::nav::{AlgorithmSpec, NavState};
 use sdins_sim::pipeline::{run_cancellable as run_pipeline, NavError, RunOptions, RunSummary};
 use sdins_sim::run_setup::{self, AlgoChoice};
 use sdins_sim::scenario::Scenario;
-use std::io::Write;
 use std::path::PathBuf;
 
 /// Arguments of `sdins run`.
@@ -108,6 +108,27 @@ pub const PLOT_COLUMNS: usize = 2000;
 /// per-axis errors in display units (attitude μrad, velocity m/s,
 /// position m), as absolute values when the plot scale is logarithmic.
 const ERR_CHANNELS: usize = 13;
+
+/// The comment line of `err_<algo>.csv`: the error definitions.
+const ERR_COMMENT: &str = "attitude error eps: C_alg C_true^T = I + [eps x] (NED, rad); position error dN = dLat(R_M+h), dE = dLon(R_N+h)cosL, dD = -(h_alg - h_true)";
+
+/// Header of `err_<algo>.csv`.
+const ERR_HEADER: [&str; 14] = [
+    "t_s",
+    "pos_err_n_m",
+    "pos_err_e_m",
+    "pos_err_d_m",
+    "vel_err_n_mps",
+    "vel_err_e_mps",
+    "vel_err_d_mps",
+    "att_err_n_rad",
+    "att_err_e_rad",
+    "att_err_d_rad",
+    "height_err_m",
+    "roll_err_rad",
+    "pitch_err_rad",
+    "yaw_err_rad",
+];
 
 /// Full-rate (every navigation update) figure data of a run, decimated online with
 /// min/max per column ([`crate::plot::MinMaxColumns`]) so that short manoeuvres show.
@@ -226,24 +247,21 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let mut nav_files = Vec::new();
     let mut err_files = Vec::new();
     for a in &algos {
-        let mut nf = AtomicFile::create(&out.join(format!("nav_{}.csv", a.kind.name())))?;
-        let mut ef = AtomicFile::create(&out.join(format!("err_{}.csv", a.kind.name())))?;
-        writeln!(
-            nf.writer(),
-            "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg"
-        )
-        .map_err(|source| CliError::Io {
-            path: out.clone(),
-            source,
-        })?;
-        writeln!(
-            ef.writer(),
-            "# attitude error eps: C_alg C_true^T = I + [eps x] (NED, rad); position error dN = dLat(R_M+h), dE = dLon(R_N+h)cosL, dD = -(h_alg - h_true)\nt_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,vel_err_n_mps,vel_err_e_mps,vel_err_d_mps,att_err_n_rad,att_err_e_rad,att_err_d_rad,height_err_m,roll_err_rad,pitch_err_rad,yaw_err_rad"
-        )
-        .map_err(|source| CliError::Io { path: out.clone(), source })?;
-        nav_files.push(nf);
-        err_files.push(ef);
+        nav_files.push(AtomicFile::create(
+            &out.join(format!("nav_{}.csv", a.kind.name())),
+        )?);
+        err_files.push(AtomicFile::create(
+            &out.join(format!("err_{}.csv", a.kind.name())),
+        )?);
     }
+    let mut nav_csv = nav_files
+        .iter_mut()
+        .map(|f| CsvOut::new(f, &NAV_HEADER))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut err_csv = err_files
+        .iter_mut()
+        .map(|f| CsvOut::with_comments(f, &[ERR_COMMENT], &ERR_HEADER))
+        .collect::<Result<Vec<_>, _>>()?;
     let total = (t_end_s / dt_u).round() as u64; // for the progress bar
     let mut bar = Progress::new(total, "navigate", args.quiet);
     let mut io_error = None;
@@ -253,9 +271,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let earth = scn.nav.earth.model();
     let mut updates = vec![0_u64; algos.len()];
     let mut pending: Vec<Option<(NavState, NavError)>> = vec![None; algos.len()];
-    let d = 180.0 / std::f64::consts::PI;
     // one CSV row of each file and one point of the epoch series
-    let mut write_epoch = |i: usize, st: &NavState, e: &NavError| -> std::io::Result<()> {
+    let mut write_epoch = |i: usize, st: &NavState, e: &NavError| -> Result<(), CliError> {
         let (p, v, a, u) = (
             e.pos_err_ned_m,
             e.vel_err_ned_mps,
@@ -264,24 +281,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         );
         let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
         series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
-        let eu = st.euler();
-        writeln!(
-            nav_files[i].writer(),
-            "{},{},{},{},{},{},{},{},{},{}",
-            e.t_s,
-            st.lat_rad * d,
-            st.lon_rad * d,
-            st.h_m,
-            st.v_n_mps.x,
-            st.v_n_mps.y,
-            st.v_n_mps.z,
-            eu.roll_rad * d,
-            eu.pitch_rad * d,
-            eu.yaw_rad * d
-        )?;
-        writeln!(
-            err_files[i].writer(),
-            "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+        nav_csv[i].row(&nav_row(e.t_s, st))?;
+        err_csv[i].row(&[
             e.t_s,
             p[0],
             p[1],
@@ -295,8 +296,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
             e.height_err_m,
             u[0],
             u[1],
-            u[2]
-        )
+            u[2],
+        ])
     };
     // the figures take every update; the CSV files and the series every `every`
     let opts = RunOptions {
@@ -347,10 +348,13 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
             }
         }
     }
-    if let Some(source) = io_error {
-        return Err(CliError::Io { path: out, source });
+    if let Some(e) = io_error {
+        return Err(e);
     }
     let summaries = summaries?;
+    for c in nav_csv.into_iter().chain(err_csv) {
+        c.finish()?;
+    }
     for f in nav_files.into_iter().chain(err_files) {
         f.commit()?;
     }

@@ -1,12 +1,13 @@
 //! `sdins truth`: write the exact truth trajectory and IMU increments, streaming.
 
+use crate::csv_out::CsvOut;
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use crate::progress::Progress;
-use sdins_core::math::{euler_from_c_b_n, Quat};
+use sdins_core::math::{euler_from_c_b_n, Mat3, Quat, Vec3};
 use sdins_sim::scenario::Scenario;
 use sdins_sim::truth::{TruthConfig, TruthGenerator};
-use std::io::Write;
+use sdins_sim::truth_file::SDINS_TRUTH_HEADER as TRUTH_HEADER;
 use std::path::PathBuf;
 
 /// Arguments of `sdins truth`.
@@ -67,48 +68,53 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )?;
     let mut truth = AtomicFile::create(&out.join("truth.csv"))?;
     let mut imu = AtomicFile::create(&out.join("imu.csv"))?;
-    writeln!(truth.writer(), "t_s,lat_deg,lon_deg,h_m,v_n_mps,v_e_mps,v_d_mps,roll_deg,pitch_deg,yaw_deg,q_w,q_x,q_y,q_z")
-        .map_err(|e| io_err(&out, "truth.csv", e))?;
-    writeln!(
-        imu.writer(),
-        "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps"
-    )
-    .map_err(|e| io_err(&out, "imu.csv", e))?;
-    let e0 = euler_from_c_b_n(&init.c_b_n);
-    let q0 = Quat::from_dcm(&init.c_b_n);
+    let mut truth_csv = CsvOut::new(&mut truth, &TRUTH_HEADER)?;
+    let mut imu_csv = CsvOut::new(&mut imu, &sdins_sim::imu_file::SDINS_INCREMENT_HEADER)?;
     let d = 180.0 / std::f64::consts::PI;
-    writeln!(
-        truth.writer(),
-        "0,{:.15},{:.15},{:.6},{:.12},{:.12},{:.12},{:.12},{:.12},{:.12},{:.17},{:.17},{:.17},{:.17}",
-        init.lat_rad * d, init.lon_rad * d, init.h_m, init.v_n_mps.x, init.v_n_mps.y, init.v_n_mps.z,
-        e0.roll_rad * d, e0.pitch_rad * d, e0.yaw_rad * d, q0.w, q0.x, q0.y, q0.z
-    )
-    .map_err(|e| io_err(&out, "truth.csv", e))?;
+    let truth_row = |t_s: f64, lat: f64, lon: f64, h: f64, v: &Vec3, c: &Mat3| {
+        let e = euler_from_c_b_n(c);
+        let q = Quat::from_dcm(c);
+        [
+            t_s,
+            lat * d,
+            lon * d,
+            h,
+            v.x,
+            v.y,
+            v.z,
+            e.roll_rad * d,
+            e.pitch_rad * d,
+            e.yaw_rad * d,
+            q.w,
+            q.x,
+            q.y,
+            q.z,
+        ]
+    };
+    truth_csv.row(&truth_row(
+        0.0,
+        init.lat_rad,
+        init.lon_rad,
+        init.h_m,
+        &init.v_n_mps,
+        &init.c_b_n,
+    ))?;
     let mut bar = Progress::new(total, "truth", args.quiet);
     for (k, s) in gen.enumerate() {
         let i = &s.inc;
-        writeln!(
-            imu.writer(),
-            "{},{:e},{:e},{:e},{:e},{:e},{:e}",
+        imu_csv.row(&[
             s.t_s,
             i.dtheta_b_rad.x,
             i.dtheta_b_rad.y,
             i.dtheta_b_rad.z,
             i.dv_b_mps.x,
             i.dv_b_mps.y,
-            i.dv_b_mps.z
-        )
-        .map_err(|e| io_err(&out, "imu.csv", e))?;
+            i.dv_b_mps.z,
+        ])?;
         if (k as u64 + 1).is_multiple_of(args.every) {
-            let e = euler_from_c_b_n(&s.c_b_n);
-            let q = Quat::from_dcm(&s.c_b_n);
-            writeln!(
-                truth.writer(),
-                "{},{:.15},{:.15},{:.6},{:.12},{:.12},{:.12},{:.12},{:.12},{:.12},{:.17},{:.17},{:.17},{:.17}",
-                s.t_s, s.lat_rad * d, s.lon_rad * d, s.h_m, s.v_n_mps.x, s.v_n_mps.y, s.v_n_mps.z,
-                e.roll_rad * d, e.pitch_rad * d, e.yaw_rad * d, q.w, q.x, q.y, q.z
-            )
-            .map_err(|e| io_err(&out, "truth.csv", e))?;
+            truth_csv.row(&truth_row(
+                s.t_s, s.lat_rad, s.lon_rad, s.h_m, &s.v_n_mps, &s.c_b_n,
+            ))?;
         }
         if k % 65536 == 0 {
             bar.set(k as u64);
@@ -117,6 +123,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             }
         }
     }
+    truth_csv.finish()?;
+    imu_csv.finish()?;
     bar.finish();
     truth.commit()?;
     imu.commit()?;
@@ -129,11 +137,4 @@ pub fn run(args: Args) -> Result<(), CliError> {
         scn.duration_s()
     );
     Ok(())
-}
-
-fn io_err(dir: &std::path::Path, name: &str, source: std::io::Error) -> CliError {
-    CliError::Io {
-        path: dir.join(name),
-        source,
-    }
 }

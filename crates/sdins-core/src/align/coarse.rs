@@ -1,8 +1,8 @@
-//! Coarse (analytic) alignment of a stationary IMU (spec §1).
+//! Coarse (analytic) alignment of a stationary IMU (docs/theory/alignment.md §"Coarse alignment").
 //!
-//! Inputs are the sensor outputs averaged over a static window (spec §1: T_c ≥ 30 s):
-//! `f̄^b = Σ Δv / T`, `ω̄^b = Σ Δθ / T` ([`StaticMean`]). At rest `f^n = [0, 0, −g]` and
-//! `ω^n = ω_ie^n = Ω [cos L, 0, −sin L]`.
+//! Inputs are the sensor outputs averaged over a static window (docs/theory/alignment.md
+//! §"Coarse alignment": T_c ≥ 30 s): `f̄^b = Σ Δv / T`, `ω̄^b = Σ Δθ / T` ([`StaticMean`]). At rest
+//! `f^n = [0, 0, −g]` and `ω^n = ω_ie^n = Ω [cos L, 0, −sin L]`.
 
 use super::{AlignError, Site};
 use crate::coning::Increment;
@@ -50,9 +50,10 @@ impl StaticMean {
 /// Coarse-alignment method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CoarseMethod {
-    /// 1-step analytic (TRIAD-type) alignment, polar-orthonormalised (spec §1.1)
+    /// 1-step analytic (TRIAD-type) alignment, polar-orthonormalised (docs/theory/alignment.md
+    /// §"Coarse alignment")
     OneStep,
-    /// 2-step: levelling, then gyrocompassing (spec §1.2)
+    /// 2-step: levelling, then gyrocompassing (docs/theory/alignment.md §"Coarse alignment")
     TwoStep,
 }
 
@@ -67,7 +68,8 @@ fn check(f_b: &Vec3, w_b: &Vec3, site: &Site) -> Result<(), AlignError> {
     Ok(())
 }
 
-/// 1-step analytic alignment (spec §1.1), closed form without matrix inversion:
+/// 1-step analytic alignment (docs/theory/alignment.md §"Coarse alignment"), closed form without
+/// matrix inversion:
 ///
 /// ```text
 /// d_b = −f̄^b / g
@@ -76,9 +78,9 @@ fn check(f_b: &Vec3, w_b: &Vec3, site: &Site) -> Result<(), AlignError> {
 /// C_n^b(raw) = [n_b  e_b  d_b],   C_b^n(raw) = C_n^b(raw)ᵀ
 /// ```
 ///
-/// followed by the **symmetric (polar) orthonormalisation** `Ĉ = U Vᵀ` (spec §1.1:
-/// only then does the §1.3 error table hold; `C_n^b` and `M_n M_b^{-1}` share the
-/// polar factor).
+/// followed by the **symmetric (polar) orthonormalisation** `Ĉ = U Vᵀ` (docs/theory/alignment.md
+/// §"Coarse alignment": only then does the error table of docs/theory/alignment.md
+/// §"Coarse alignment" hold; `C_n^b` and `M_n M_b^{-1}` share the polar factor).
 pub fn one_step(f_b: &Vec3, w_b: &Vec3, site: &Site) -> Result<Mat3, AlignError> {
     check(f_b, w_b, site)?;
     let g = site.g_mps2;
@@ -93,7 +95,7 @@ pub fn one_step(f_b: &Vec3, w_b: &Vec3, site: &Site) -> Result<Mat3, AlignError>
     Ok(orthonormalize(&c_n_b.transpose()))
 }
 
-/// 2-step alignment (spec §1.2): levelling
+/// 2-step alignment (docs/theory/alignment.md §"Coarse alignment"): levelling
 /// `roll = atan2(−f̄_y, −f̄_z)`, `pitch = atan2(f̄_x, √(f̄_y² + f̄_z²))`, then
 /// gyrocompassing in the levelled frame `ω^L = Ry(pitch) Rx(roll) ω̄^b`:
 /// `yaw = atan2(−ω^L_y, ω^L_x)`; `Ĉ_b^n = Rz(yaw) Ry(pitch) Rx(roll)`.
@@ -120,9 +122,9 @@ pub fn align(method: CoarseMethod, mean: &StaticMean, site: &Site) -> Result<Mat
     }
 }
 
-/// First-order coarse-alignment error, the **corrected** table of spec §1.3
-/// (convention G; `da_n = C_b^n b_a`, `eps_n = C_b^n b_g` NED-resolved biases at the
-/// true attitude):
+/// First-order coarse-alignment error, the **corrected** table of docs/theory/alignment.md
+/// §"Coarse alignment" (convention G; `da_n = C_b^n b_a`, `eps_n = C_b^n b_g` NED-resolved biases
+/// at the true attitude):
 ///
 /// | axis | 1-step | 2-step |
 /// |---|---|---|
@@ -142,8 +144,8 @@ pub fn error_table(method: CoarseMethod, da_n: &Vec3, eps_n: &Vec3, site: &Site)
     Vec3::new(phi_n, phi_e, phi_d)
 }
 
-/// Noise-limited 1σ of a T_c-second average (spec §1.3), `vrw` \[m/s/√s\], `arw` \[rad/√s\]:
-/// returns `(σ_tilt, σ_yaw, σ_φE(1-step))` with
+/// Noise-limited 1σ of a T_c-second average (docs/theory/alignment.md §"Coarse alignment"), `vrw`
+/// \[m/s/√s\], `arw` \[rad/√s\]: returns `(σ_tilt, σ_yaw, σ_φE(1-step))` with
 /// `σ_tilt = VRW/(g√T_c)`, `σ_yaw = √((ARW/(Ω cos L))²/T_c + (tan L σ_tilt)²)`,
 /// `σ_φE,1 = ½ √(VRW²(1 + tan²L)/g² + ARW²/(Ω cos L)²)/√T_c`.
 pub fn noise_sigma(vrw: f64, arw: f64, t_c: f64, site: &Site) -> (f64, f64, f64) {
@@ -187,7 +189,8 @@ mod tests {
         }
     }
 
-    /// Spec §6 T1 single-bias sanity checks at body = NED, g = 9.80.
+    /// docs/validation.md §"coarse alignment (1-/2-step)" T1 single-bias sanity checks at body =
+    /// NED, g = 9.80.
     #[test]
     fn single_bias_table_values() {
         let s = Site {

@@ -1,8 +1,9 @@
-//! 12-state stationary Kalman fine alignment (spec §2, and §3.2 Algorithm A with
-//! body-frame bias states).
+//! 12-state stationary Kalman fine alignment (docs/theory/alignment.md §"Fine alignment";
+//! docs/theory/alignment.md §"Multi-heading alignment" Algorithm A with body-frame bias states).
 //!
 //! The filter runs its own stationary attitude/velocity propagation at the IMU rate
-//! (spec §2.3 "navigation in alignment mode"; position fixed), per sample `j` of period δt:
+//! (docs/theory/alignment.md §"Fine alignment", alignment mode; position fixed), per
+//! sample `j` of period δt:
 //!
 //! ```text
 //! Δθ' = Δθ_j − b̂_g δt,   Δv' = Δv_j − b̂_a δt
@@ -11,20 +12,23 @@
 //! ```
 //!
 //! The `½ Δθ' × Δv'` term (body-rotation compensation) keeps the velocity exact to first
-//! order while the IMU turns (multi-heading rotations at 10 °/s, spec §3.2: "a first-order
-//! increment update is exact enough"); the `−½ (ω_ie^n δt) × Ĉ Δv'` term is the matching
-//! navigation-frame rotation over the sample. At rest the two cancel exactly (without the
-//! second one the first leaves a spurious `½ ω_ie^n × f^n δt` ≈ 0.3 μg east at 100 Hz). Every `kf_dt_s` seconds the
-//! filter predicts with `F(Ĉ)` (re-evaluated each cycle, spec §2.3), updates with the
-//! zero-velocity measurement `z = v̂ − 0` (spec §2.2) and, in closed loop, resets:
+//! order while the IMU turns (multi-heading rotations at 10 °/s, docs/theory/alignment.md
+//! §"Multi-heading alignment": a first-order increment update is exact enough); the
+//! `−½ (ω_ie^n δt) × Ĉ Δv'` term is the matching navigation-frame rotation over the sample. At rest
+//! the two cancel exactly (without the second one the first leaves a spurious `½ ω_ie^n × f^n δt` ≈
+//! 0.3 μg east at 100 Hz). Every `kf_dt_s` seconds the filter predicts with `F(Ĉ)` (re-evaluated
+//! each cycle, docs/theory/alignment.md §"Fine alignment"), updates with the zero-velocity
+//! measurement `z = v̂ − 0` (docs/theory/alignment.md §"Fine alignment") and, in
+//! closed loop, resets:
 //!
 //! ```text
 //! v̂ ← v̂ − δv̂,   Ĉ ← exp(−[φ̂×]) Ĉ,
 //! b̂_a ← b̂_a + Ĉᵀ δâ,  b̂_g ← b̂_g + Ĉᵀ ε̂   (NED states; body states: add directly),  x̂ ← 0
 //! ```
 //!
-//! In feed-forward mode (used by Algorithm B, spec §3.3) nothing is reset and the INS
-//! runs open loop; [`FineAlign::restart`] re-initialises the filter at each position.
+//! In feed-forward mode (used by Algorithm B, docs/theory/alignment.md §"Multi-heading alignment")
+//! nothing is reset and the INS runs open loop; [`FineAlign::restart`] re-initialises the filter at
+//! each position.
 
 use super::kf::Kf;
 use super::model::{discretize, f_matrix, h_zupt, q_continuous, BiasFrame, Mat12, Vec12};
@@ -33,7 +37,7 @@ use crate::coning::Increment;
 use crate::math::{dcm_from_rotvec, orthonormalize, Mat3, Vec3};
 use nalgebra::SMatrix;
 
-/// Fine-alignment settings (spec §2.1–§2.3).
+/// Fine-alignment settings (docs/theory/alignment.md §"Fine alignment").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FineConfig {
     /// latitude, gravity, earth rate
@@ -42,7 +46,8 @@ pub struct FineConfig {
     pub bias_frame: BiasFrame,
     /// Kalman-filter interval Δt \[s\] (spec: 0.1–1 s; reference 1 s)
     pub kf_dt_s: f64,
-    /// zero-velocity measurement σ_z \[m/s\] (spec §2.2: 1 mm/s on a benign pad)
+    /// zero-velocity measurement σ_z \[m/s\] (docs/theory/alignment.md §"Fine alignment": 1 mm/s on
+    /// a benign pad)
     pub sigma_z_mps: f64,
     /// VRW \[m/s/√s\]
     pub vrw: f64,
@@ -54,7 +59,8 @@ pub struct FineConfig {
     pub q_bg: f64,
     /// initial covariance P0 (bias blocks in the frame of `bias_frame`)
     pub p0: Mat12,
-    /// closed-loop reset after each update (spec §2.3); `false` = feed-forward
+    /// closed-loop reset after each update (docs/theory/alignment.md §"Fine alignment"); `false` =
+    /// feed-forward
     pub closed_loop: bool,
 }
 
@@ -92,17 +98,18 @@ impl FineAlign {
 
     /// Process one IMU sample of period `dt_s`. Returns `true` if a Kalman cycle
     /// (predict, update, reset) ran at the end of this sample. The measurement is the
-    /// zero-velocity update `z = v̂ − 0` (spec §2.2); see [`Self::step_with_velocity`].
+    /// zero-velocity update `z = v̂ − 0` (docs/theory/alignment.md §"Fine alignment"); see
+    /// [`Self::step_with_velocity`].
     pub fn step(&mut self, inc: &Increment, dt_s: f64) -> bool {
         self.step_with_velocity(inc, dt_s, &Vec3::zeros())
     }
 
     /// As [`Self::step`], with a measured reference velocity `ṽ^n` \[m/s\] (NED) used if a
     /// Kalman cycle runs at the end of this sample: `z = v̂ − ṽ = H x + ν` with
-    /// `ν = −(ṽ − v_true)` assumed `N(0, σ_z² I3)` (spec §2.2). For a vehicle at rest
-    /// `ṽ = 0 + ν`; passing `ṽ = 0` is the plain zero-velocity update, whose actual
-    /// noise is whatever the true (sway, vibration) velocity is. A simulation that wants
-    /// a statistically matched filter passes `ṽ ~ N(0, σ_z² I3)` drawn per KF cycle.
+    /// `ν = −(ṽ − v_true)` assumed `N(0, σ_z² I3)` (docs/theory/alignment.md §"Fine alignment").
+    /// For a vehicle at rest `ṽ = 0 + ν`; passing `ṽ = 0` is the plain zero-velocity update, whose
+    /// actual noise is whatever the true (sway, vibration) velocity is. A simulation that wants a
+    /// statistically matched filter passes `ṽ ~ N(0, σ_z² I3)` drawn per KF cycle.
     pub fn step_with_velocity(&mut self, inc: &Increment, dt_s: f64, v_meas_n: &Vec3) -> bool {
         let w = self.cfg.site.omega_ie_n();
         let dth = inc.dtheta_b_rad - self.bg_b * dt_s;
@@ -128,7 +135,8 @@ impl FineAlign {
         let (phi, qd) = discretize(&f, &self.qc, dt);
         self.kf.predict(&phi, &qd);
         let r = SMatrix::<f64, 3, 3>::identity() * (self.cfg.sigma_z_mps * self.cfg.sigma_z_mps);
-        // z = v̂ − ṽ (spec §2.2; ṽ = 0 for the plain zero-velocity update)
+        // z = v̂ − ṽ (docs/theory/alignment.md §"Fine alignment"; ṽ = 0 for the plain zero-velocity
+        // update)
         let _ = self.kf.update(&h_zupt(), &(self.v_n - v_meas_n), &r);
         self.updates += 1;
         if self.cfg.closed_loop {
@@ -136,7 +144,7 @@ impl FineAlign {
         }
     }
 
-    /// Closed-loop reset of spec §2.3.
+    /// Closed-loop reset of docs/theory/alignment.md §"Fine alignment".
     fn reset(&mut self) {
         let x = self.kf.x;
         let dv = x.fixed_rows::<3>(0).into_owned();
@@ -154,9 +162,9 @@ impl FineAlign {
         self.kf.x = Vec12::zeros();
     }
 
-    /// Restart the filter in feed-forward mode (Algorithm B, spec §3.3) at a new
-    /// position: `x̂ = [v̂, 0]`, `P = p0` with the velocity block set to `σ_z² I3`
-    /// (the INS velocity error is then known to the measurement accuracy).
+    /// Restart the filter in feed-forward mode (Algorithm B, docs/theory/alignment.md
+    /// §"Multi-heading alignment") at a new position: `x̂ = [v̂, 0]`, `P = p0` with the velocity
+    /// block set to `σ_z² I3` (the INS velocity error is then known to the measurement accuracy).
     pub fn restart(&mut self, p0: &Mat12) {
         let mut p = *p0;
         let mut x = Vec12::zeros();
@@ -242,8 +250,9 @@ impl FineAlign {
     }
 }
 
-/// Reference settings of spec §2.3/§6 T4 with NED bias states, closed loop, KF at 1 Hz,
-/// σ_z = 1 mm/s and P0 of spec §2.3; `vrw` \[m/s/√s\], `arw` \[rad/√s\].
+/// Reference settings of docs/theory/alignment.md §"Fine alignment"; docs/validation.md
+/// §"fine alignment" T4 with NED bias states, closed loop, KF at 1 Hz, σ_z = 1 mm/s and P0 of
+/// docs/theory/alignment.md §"Fine alignment"; `vrw` \[m/s/√s\], `arw` \[rad/√s\].
 pub fn reference_config(site: Site, vrw: f64, arw: f64) -> FineConfig {
     FineConfig {
         site,
@@ -273,8 +282,9 @@ mod tests {
     }
 
     /// `step` is `step_with_velocity` with ṽ = 0, and a reference velocity enters the
-    /// update only through the innovation `z = v̂ − ṽ` (spec §2.2): feeding ṽ equal to
-    /// an offset that is also added to the INS velocity leaves the estimate unchanged.
+    /// update only through the innovation `z = v̂ − ṽ` (docs/theory/alignment.md
+    /// §"Fine alignment"): feeding ṽ equal to an offset that is also added to the INS velocity
+    /// leaves the estimate unchanged.
     #[test]
     fn velocity_reference_enters_through_the_innovation() {
         let s = site();

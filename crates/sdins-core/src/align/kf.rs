@@ -1,6 +1,6 @@
-//! Kalman filter core for the alignment filters (spec §2.3): prediction with a given
-//! `(Φ, Q_d)` and the Joseph-form update; the covariance is re-symmetrised after every
-//! step so that it stays symmetric positive definite.
+//! Kalman filter core for the alignment filters (docs/theory/alignment.md §"Fine alignment"):
+//! prediction with a given `(Φ, Q_d)` and the Joseph-form update; the covariance is re-symmetrised
+//! after every step so that it stays symmetric positive definite.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -29,8 +29,8 @@ impl<const N: usize> Kf<N> {
         self.symmetrize();
     }
 
-    /// Measurement update with `z = H x + ν`, `ν ~ N(0, R)`, Joseph form (spec §2.3):
-    /// `K = P Hᵀ (H P Hᵀ + R)⁻¹`, `x̂ ← x̂ + K (z − H x̂)`,
+    /// Measurement update with `z = H x + ν`, `ν ~ N(0, R)`, Joseph form (docs/theory/alignment.md
+    /// §"Fine alignment"): `K = P Hᵀ (H P Hᵀ + R)⁻¹`, `x̂ ← x̂ + K (z − H x̂)`,
     /// `P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ`.
     /// Returns the innovation, or `None` (no update) if `H P Hᵀ + R` is singular.
     pub fn update<const M: usize>(

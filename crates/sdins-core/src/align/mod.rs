@@ -1,27 +1,31 @@
-//! Initial alignment of a stationary strapdown INS (spec `alignment_and_errors.md` §1–§3).
+//! Initial alignment of a stationary strapdown INS (docs/theory/alignment.md §"Coarse alignment";
+//! docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md
+//! §"Multi-heading alignment").
 //!
 //! One file per concept:
 //! * [`coarse`]: 1-step analytic (TRIAD-type, polar-orthonormalised) and 2-step
 //!   (levelling + gyrocompassing) coarse alignment from averaged static increments,
-//!   and the corrected first-order error table (spec §1.1–§1.3).
+//!   and the corrected first-order error table (docs/theory/alignment.md §"Coarse alignment").
 //! * [`model`]: the 12-state stationary error model `F`, its discretisation, the null
 //!   space `n1, n2, n3`, the pseudo (observable) coordinates and the finite-prior
-//!   residual projector `Π` (spec §2.1, §2.3, §2.4).
+//!   residual projector `Π` (docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md
+//!   §"Observability at one heading").
 //! * [`i0`]: inertial-frame coarse alignment on a disturbed (swaying, heaving) base
 //!   (gravity's apparent motion in the inertially frozen body frame, Wahba fit).
 //! * [`kf`]: the generic Kalman filter core (prediction, Joseph-form update).
 //! * [`fine`]: the 12-state zero-velocity Kalman fine alignment with its own stationary
-//!   attitude/velocity propagation, closed-loop reset or feed-forward (spec §2.2–§2.3,
-//!   §3.2 Algorithm A with body-frame bias states).
+//!   attitude/velocity propagation, closed-loop reset or feed-forward (docs/theory/alignment.md
+//!   §"Fine alignment", Algorithm A with body-frame bias states, §"Multi-heading alignment").
 //! * [`observability`]: numerical rank and unobservable directions of piece-wise
-//!   constant `(F_j, H)` (spec §2.4 procedure, §3.1 stripped observability matrix).
-//! * [`multiheading`]: Algorithm B of spec §3.3 (pseudo-error least squares) with the
-//!   exact attitude-error transition `Φ_k, Γ_k`.
+//!   constant `(F_j, H)` (docs/theory/alignment.md §"Observability at one heading": rank procedure,
+//!   stripped observability matrix).
+//! * [`multiheading`]: Algorithm B of docs/theory/alignment.md §"Multi-heading alignment"
+//!   (pseudo-error least squares) with the exact attitude-error transition `Φ_k, Γ_k`.
 //!
 //! Conventions: NED / FRD, `c_b_n`, attitude error convention G,
-//! `Ĉ_b^n = (I + [φ×]) C_b^n` (spec §0.2); use [`phi_tw_from_g`] for Titterton & Weston's
-//! ψ. Biases are "measured − true" (spec §0.3); estimator bias states are residuals
-//! (true − current estimate).
+//! `Ĉ_b^n = (I + [φ×]) C_b^n` (docs/conventions.md §"Errors"); use [`phi_tw_from_g`] for Titterton
+//! & Weston's ψ. Biases are "measured − true" (docs/theory/imu-errors.md §"IMU error model");
+//! estimator bias states are residuals (true − current estimate).
 //!
 //! Everything is `no_std` and allocation-free (fixed-size nalgebra matrices).
 
@@ -35,8 +39,8 @@ pub mod observability;
 
 use crate::math::Vec3;
 
-/// Converts a convention-G attitude error φ to Titterton & Weston's ψ (spec §0.2:
-/// `ψ_TW = −φ_G`).
+/// Converts a convention-G attitude error φ to Titterton & Weston's ψ (docs/conventions.md
+/// §"Errors": `ψ_TW = −φ_G`).
 #[inline]
 pub fn phi_tw_from_g(phi_g: &Vec3) -> Vec3 {
     -phi_g
@@ -46,7 +50,8 @@ pub fn phi_tw_from_g(phi_g: &Vec3) -> Vec3 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum AlignError {
-    /// |latitude| > 80°: the sec L terms diverge (spec §1.3 "Validity").
+    /// |latitude| > 80°: the sec L terms diverge (docs/theory/alignment.md §"Coarse alignment",
+    /// validity).
     LatitudeTooHigh,
     /// The averaged specific force or rate is zero / not finite, or a matrix is singular.
     Degenerate,
@@ -58,7 +63,7 @@ impl core::fmt::Display for AlignError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(match self {
             AlignError::LatitudeTooHigh => {
-                "latitude beyond ±80°: gyrocompassing is ill-conditioned (spec §1.3)"
+                "latitude beyond ±80°: gyrocompassing is ill-conditioned (docs/theory/alignment.md)"
             }
             AlignError::Degenerate => {
                 "degenerate input (zero or non-finite specific force or rate, singular matrix)"
@@ -69,7 +74,8 @@ impl core::fmt::Display for AlignError {
 }
 
 /// Site constants used by every alignment algorithm: latitude, gravity magnitude and
-/// earth rate (spec §0.4). The truth and the algorithm must use the same `g`.
+/// earth rate (docs/theory/error-analysis.md §"Constants and units"). The truth and the algorithm
+/// must use the same `g`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Site {
     /// geodetic latitude L \[rad\]
@@ -89,7 +95,7 @@ impl Site {
             omega_ie_rps: earth.omega_ie_rps,
         }
     }
-    /// `ω_ie^n = Ω [cos L, 0, −sin L]` (spec §0.4).
+    /// `ω_ie^n = Ω [cos L, 0, −sin L]` (docs/theory/error-analysis.md §"Constants and units").
     #[inline]
     pub fn omega_ie_n(&self) -> Vec3 {
         Vec3::new(

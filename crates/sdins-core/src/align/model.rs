@@ -1,8 +1,11 @@
-//! The 12-state stationary alignment error model (spec §2.1, §2.3, §2.4, §3.2).
+//! The 12-state stationary alignment error model (docs/theory/alignment.md §"Fine alignment";
+//! docs/theory/alignment.md §"Observability at one heading"; docs/theory/alignment.md
+//! §"Multi-heading alignment").
 //!
 //! State (convention G, residual biases):
 //! `x = [δv_N, δv_E, δv_D, φ_N, φ_E, φ_D, δa (3), ε (3)]`, with the bias states either
-//! NED-resolved (spec §2.1, \[P1\]) or body-frame (spec §3.2, needed across rotations).
+//! NED-resolved (docs/theory/alignment.md §"Fine alignment", \[P1\]) or body-frame
+//! (docs/theory/alignment.md §"Multi-heading alignment", needed across rotations).
 
 use super::Site;
 use crate::math::{skew, Mat3};
@@ -18,14 +21,17 @@ pub type Mat9 = SMatrix<f64, 9, 9>;
 /// Frame in which the bias states are kept.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BiasFrame {
-    /// NED-resolved `δa = C_b^n b_a`, `ε = C_b^n b_g` (spec §2.1; single heading only —
-    /// spec §3.2 shows it fails across rotations)
+    /// NED-resolved `δa = C_b^n b_a`, `ε = C_b^n b_g` (docs/theory/alignment.md §"Fine alignment";
+    /// single heading only — docs/theory/alignment.md §"Multi-heading alignment" shows it fails
+    /// across rotations)
     Ned,
-    /// body-frame residuals, bias blocks `Ĉ_b^n(t)` (spec §3.2 Algorithm A)
+    /// body-frame residuals, bias blocks `Ĉ_b^n(t)` (docs/theory/alignment.md
+    /// §"Multi-heading alignment" Algorithm A)
     Body,
 }
 
-/// Continuous system matrix F (spec §2.1, §3.2):
+/// Continuous system matrix F (docs/theory/alignment.md §"Fine alignment"; docs/theory/alignment.md
+/// §"Multi-heading alignment"):
 ///
 /// ```text
 /// δv̇ = g^n × φ − 2 ω_ie^n × δv + B δa
@@ -34,7 +40,8 @@ pub enum BiasFrame {
 /// ```
 ///
 /// `[g^n×]` is the F12 block `[[0, −g, 0], [g, 0, 0], [0, 0, 0]]` (equivalently `φ × f^n`
-/// with `f^n = −g^n`; spec §3.2 allows `f^n = Ĉ f̂`, which equals `−g^n` at rest).
+/// with `f^n = −g^n`; docs/theory/alignment.md §"Multi-heading alignment" allows `f^n = Ĉ f̂`,
+/// which equals `−g^n` at rest).
 pub fn f_matrix(site: &Site, frame: BiasFrame, c_b_n: &Mat3) -> Mat12 {
     let w = skew(&site.omega_ie_n());
     let gx = skew(&site.g_n());
@@ -51,14 +58,16 @@ pub fn f_matrix(site: &Site, frame: BiasFrame, c_b_n: &Mat3) -> Mat12 {
     f
 }
 
-/// Zero-velocity measurement matrix `H = [I3 0]` (spec §2.2), 3 rows.
+/// Zero-velocity measurement matrix `H = [I3 0]` (docs/theory/alignment.md §"Fine alignment"), 3
+/// rows.
 pub fn h_zupt() -> SMatrix<f64, 3, 12> {
     let mut h = SMatrix::<f64, 3, 12>::zeros();
     h.fixed_view_mut::<3, 3>(0, 0).copy_from(&Mat3::identity());
     h
 }
 
-/// Horizontal-only measurement `H = [I2 0]` (spec §2.2, loses rank: §2.4).
+/// Horizontal-only measurement `H = [I2 0]` (docs/theory/alignment.md §"Fine alignment"; it loses
+/// rank: §"Observability at one heading").
 pub fn h_horizontal() -> SMatrix<f64, 2, 12> {
     let mut h = SMatrix::<f64, 2, 12>::zeros();
     h[(0, 0)] = 1.0;
@@ -67,7 +76,8 @@ pub fn h_horizontal() -> SMatrix<f64, 2, 12> {
 }
 
 /// Continuous process-noise PSD `Q_c = diag(VRW² I3, ARW² I3, q_ba I3, q_bg I3)`
-/// (spec §2.1); `vrw` \[m/s/√s\], `arw` \[rad/√s\], `q_ba` \[(m/s²)²/s\], `q_bg` \[(rad/s)²/s\].
+/// (docs/theory/alignment.md §"Fine alignment"); `vrw` \[m/s/√s\], `arw` \[rad/√s\], `q_ba`
+/// \[(m/s²)²/s\], `q_bg` \[(rad/s)²/s\].
 pub fn q_continuous(vrw: f64, arw: f64, q_ba: f64, q_bg: f64) -> Mat12 {
     let mut d = Vec12::zeros();
     for i in 0..3 {
@@ -79,8 +89,8 @@ pub fn q_continuous(vrw: f64, arw: f64, q_ba: f64, q_bg: f64) -> Mat12 {
     Mat12::from_diagonal(&d)
 }
 
-/// Discretisation used for the acceptance numbers (spec §2.3, "allowed simplification"):
-/// `Φ = I + FΔt + (FΔt)²/2 + (FΔt)³/6`, `Q_d = ½(Φ Q_c Φᵀ + Q_c) Δt`.
+/// Discretisation used for the acceptance numbers (docs/theory/alignment.md §"Fine alignment",
+/// "allowed simplification"): `Φ = I + FΔt + (FΔt)²/2 + (FΔt)³/6`, `Q_d = ½(Φ Q_c Φᵀ + Q_c) Δt`.
 pub fn discretize(f: &Mat12, qc: &Mat12, dt: f64) -> (Mat12, Mat12) {
     let a = f * dt;
     let a2 = a * a;
@@ -90,7 +100,7 @@ pub fn discretize(f: &Mat12, qc: &Mat12, dt: f64) -> (Mat12, Mat12) {
 }
 
 /// The exact null space of the single-heading observability matrix with NED bias states
-/// (spec §2.4), as columns:
+/// (docs/theory/alignment.md §"Observability at one heading"), as columns:
 ///
 /// ```text
 /// n1: φ_N = 1, φ_D = −tan L, δa_E = −g
@@ -126,8 +136,8 @@ pub fn null_space_body(site: &Site, c_b_n: &Mat3) -> SMatrix<f64, 12, 3> {
     n
 }
 
-/// Pseudo (observable) coordinates `p = T x` of spec §2.4 (NED bias states),
-/// `p = [φ'_N, φ'_E, φ'_D, ε'_N, ε'_D, δa_D]`:
+/// Pseudo (observable) coordinates `p = T x` of docs/theory/alignment.md
+/// §"Observability at one heading" (NED bias states), `p = [φ'_N, φ'_E, φ'_D, ε'_N, ε'_D, δa_D]`:
 ///
 /// ```text
 /// φ'_N = φ_N + δa_E/g          φ'_E = φ_E − δa_N/g
@@ -152,7 +162,8 @@ pub fn pseudo_transform(site: &Site) -> SMatrix<f64, 6, 12> {
     t
 }
 
-/// The 9 observable coordinates `[δv (3), p (6)]` (spec §2.4 pseudo 9-state vector).
+/// The 9 observable coordinates `[δv (3), p (6)]` (docs/theory/alignment.md
+/// §"Observability at one heading" pseudo 9-state vector).
 pub fn pseudo9_transform(site: &Site) -> SMatrix<f64, 9, 12> {
     let mut t = SMatrix::<f64, 9, 12>::zeros();
     t.fixed_view_mut::<3, 3>(0, 0).copy_from(&Mat3::identity());
@@ -161,7 +172,8 @@ pub fn pseudo9_transform(site: &Site) -> SMatrix<f64, 9, 12> {
     t
 }
 
-/// Pseudo 9-state model of spec §2.4, state `[δv (3), φ'_N, φ'_E, φ'_D, δa_D, ε'_N, ε'_D]`:
+/// Pseudo 9-state model of docs/theory/alignment.md §"Observability at one heading", state
+/// `[δv (3), φ'_N, φ'_E, φ'_D, δa_D, ε'_N, ε'_D]`:
 ///
 /// ```text
 /// δv̇_N = 2Ω_D δv_E − g φ'_E             φ̇'_N = Ω_D φ'_E + ε'_N
@@ -187,9 +199,9 @@ pub fn f_pseudo9(site: &Site) -> Mat9 {
     f
 }
 
-/// Finite-prior asymptotic residual projector (spec §2.4):
-/// `Π = N (Nᵀ P0⁻¹ N)⁻¹ Nᵀ P0⁻¹`, so that the converged true error is `x_res = Π x0`.
-/// `None` if P0 or the 3×3 Gram matrix is singular.
+/// Finite-prior asymptotic residual projector (docs/theory/alignment.md
+/// §"Observability at one heading"): `Π = N (Nᵀ P0⁻¹ N)⁻¹ Nᵀ P0⁻¹`, so that the converged true
+/// error is `x_res = Π x0`. `None` if P0 or the 3×3 Gram matrix is singular.
 pub fn residual_projector(null: &SMatrix<f64, 12, 3>, p0: &Mat12) -> Option<Mat12> {
     let p0i = p0.try_inverse()?;
     let m = null.transpose() * p0i * null;
@@ -197,7 +209,7 @@ pub fn residual_projector(null: &SMatrix<f64, 12, 3>, p0: &Mat12) -> Option<Mat1
     Some(null * mi * null.transpose() * p0i)
 }
 
-/// Reference initial covariance of spec §2.3:
+/// Reference initial covariance of docs/theory/alignment.md §"Fine alignment":
 /// `P0 = diag((0.1 m/s)² I3, (1 mrad)², (1 mrad)², (10 mrad)², (100 μg)² I3, (0.02 °/h)² I3)`.
 pub fn p0_reference() -> Mat12 {
     let ug = 9.80665e-6;
@@ -232,7 +244,8 @@ mod tests {
         }
     }
 
-    /// Spec §2.4: every null vector is an equilibrium, F n = 0, and T n = 0.
+    /// docs/theory/alignment.md §"Observability at one heading": every null vector is an
+    /// equilibrium, F n = 0, and T n = 0.
     #[test]
     fn null_vectors_are_equilibria_and_pseudo_blind() {
         let s = site();

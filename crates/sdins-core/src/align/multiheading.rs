@@ -1,6 +1,6 @@
-//! Multi-heading alignment, Algorithm B of spec §3.3 (the \[P1\] "pseudo-error /
-//! multiple" method): per heading k a filter estimates the observable pseudo vector
-//! `p_k = [φ'_N, φ'_E, φ'_D, ε'_N, ε'_D, δa_D]` at time `t_k`; the unknowns
+//! Multi-heading alignment, Algorithm B of docs/theory/alignment.md §"Multi-heading alignment" (the
+//! \[P1\] "pseudo-error / multiple" method): per heading k a filter estimates the observable pseudo
+//! vector `p_k = [φ'_N, φ'_E, φ'_D, ε'_N, ε'_D, δa_D]` at time `t_k`; the unknowns
 //! `θ = [φ(t_0) (3), b_a^b (3), b_g^b (3)]` follow from stacking
 //!
 //! ```text
@@ -42,7 +42,7 @@ pub fn expm<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
 }
 
 /// Attitude-error transition since `t_0`: `φ(t) = Φ φ(t_0) + Γ b_g` for
-/// `φ̇ = −[ω_ie^n×] φ + C_b^n(t) b_g` (spec §3.3).
+/// `φ̇ = −[ω_ie^n×] φ + C_b^n(t) b_g` (docs/theory/alignment.md §"Multi-heading alignment").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AttitudeErrorTransition {
     /// Φ
@@ -76,8 +76,8 @@ impl AttitudeErrorTransition {
     }
 }
 
-/// `P_β(C_k)` of spec §3.3: pseudo vector from the body biases `[b_a; b_g]`, with
-/// `c_N, c_E, c_D` the rows of `C_k = C_b^n`:
+/// `P_β(C_k)` of docs/theory/alignment.md §"Multi-heading alignment": pseudo vector from the body
+/// biases `[b_a; b_g]`, with `c_N, c_E, c_D` the rows of `C_k = C_b^n`:
 ///
 /// ```text
 /// φ'_N: [ c_E/g ,              0            ]
@@ -127,7 +127,8 @@ pub fn theta_scale() -> SVector<f64, 9> {
     SVector::<f64, 9>::from_fn(|i, _| if i < 6 { 1e-3 } else { 1e-7 })
 }
 
-/// Weighted least-squares accumulator of Algorithm B (spec §3.3).
+/// Weighted least-squares accumulator of Algorithm B (docs/theory/alignment.md
+/// §"Multi-heading alignment").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AlgorithmB {
     site: Site,
@@ -188,7 +189,8 @@ impl AlgorithmB {
         true
     }
 
-    /// Rank of the stacked design (spec §6 T8: 6 for one heading, 9 for two or four).
+    /// Rank of the stacked design (docs/validation.md §"multi-heading" T8: 6 for one heading, 9 for
+    /// two or four).
     pub fn observability(&self, tol: f64) -> Observability<9> {
         from_accumulator(&self.rank_acc, tol)
     }

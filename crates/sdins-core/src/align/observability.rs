@@ -1,10 +1,12 @@
 //! Numerical observability analysis of piece-wise constant linear systems
-//! (spec §2.4 "Numerical rank procedure", §3.1 stripped observability matrix).
+//! (docs/theory/alignment.md §"Observability at one heading": numerical rank, stripped
+//! observability matrix).
 //!
 //! For segments `j = 1..J` with system matrices `F_j` and a common `H`, the stripped
 //! observability matrix is `SOM = [O_1; …; O_J]`, `O_j = [H; H F_j; …; H F_j^{N−1}]`
-//! (Goshen-Meskin & Bar-Itzhack; valid here because `null(O_j) ⊂ null(F_j)`, spec §3.1).
-//! Procedure (spec §2.4):
+//! (Goshen-Meskin & Bar-Itzhack; valid here because `null(O_j) ⊂ null(F_j)`,
+//! docs/theory/alignment.md §"Observability at one heading"). Procedure (docs/theory/alignment.md
+//! §"Observability at one heading"):
 //!
 //! 1. build the rows of O in f64;
 //! 2. scale the columns by `D` (`scale`), i.e. use `O D`;
@@ -173,8 +175,9 @@ pub fn add_segment<const N: usize, const M: usize>(
 }
 
 /// Rank and unobservable directions of the stripped observability matrix of the
-/// segments `fs` with measurement `h`, by the spec §2.4 procedure (column scaling
-/// `scale` = diag D, unit rows, `σ_i > tol σ_1`).
+/// segments `fs` with measurement `h`, by the docs/theory/alignment.md
+/// §"Observability at one heading" procedure (column scaling `scale` = diag D, unit rows,
+/// `σ_i > tol σ_1`).
 pub fn analyze<const N: usize, const M: usize>(
     fs: &[SMatrix<f64, N, N>],
     h: &SMatrix<f64, M, N>,
@@ -214,8 +217,9 @@ pub fn from_accumulator<const N: usize>(acc: &RowAccumulator<N>, tol: f64) -> Ob
     }
 }
 
-/// `‖O_s D⁻¹ x‖ / (‖O_s‖_F ‖D⁻¹ x‖)` for the scaled, row-normalised SOM `O_s` (spec §6 T3
-/// null-space check: < 1e-12 for a null vector).
+/// `‖O_s D⁻¹ x‖ / (‖O_s‖_F ‖D⁻¹ x‖)` for the scaled, row-normalised SOM `O_s`
+/// (docs/theory/alignment.md §"Observability at one heading" T3 null-space check: < 1e-12 for a
+/// null vector).
 pub fn null_residual<const N: usize, const M: usize>(
     fs: &[SMatrix<f64, N, N>],
     h: &SMatrix<f64, M, N>,
@@ -242,8 +246,8 @@ pub fn null_residual<const N: usize, const M: usize>(
     libm::sqrt(sum) / (libm::sqrt(rows as f64) * y.norm())
 }
 
-/// Column scaling of spec §2.4 for the 12-state model:
-/// `D = diag(1 m/s ×3, 1e-3 rad ×3, 1e-3 m/s² ×3, 1e-7 rad/s ×3)`.
+/// Column scaling of docs/theory/alignment.md §"Observability at one heading" for the 12-state
+/// model: `D = diag(1 m/s ×3, 1e-3 rad ×3, 1e-3 m/s² ×3, 1e-7 rad/s ×3)`.
 pub fn scale12() -> SVector<f64, 12> {
     SVector::<f64, 12>::from_fn(|i, _| match i / 3 {
         0 => 1.0,

@@ -1,5 +1,5 @@
 //! Euler angles, 3-2-1 sequence (yaw ψ, pitch θ, roll φ): `c_b_n = Rz(ψ) Ry(θ) Rx(φ)`
-//! (mechanization.md §1.2, alignment_and_errors.md §0.1).
+//! (docs/conventions.md §"Euler angles", §"Frames").
 
 use super::Mat3;
 

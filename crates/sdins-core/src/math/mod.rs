@@ -1,7 +1,7 @@
 //! Attitude mathematics: vectors, skew matrices, quaternions, DCMs, rotation vectors,
 //! Euler angles. Vectors and matrices are nalgebra's fixed-size `f64` types; the
 //! quaternion is our own small scalar-first type so that every operation order follows
-//! the spec literally (mechanization.md §1.2).
+//! the written formulas literally (docs/conventions.md §"Quaternions").
 
 mod euler;
 mod quat;
@@ -24,7 +24,7 @@ pub fn skew(a: &Vec3) -> Mat3 {
 
 /// Inverse of [`skew`] for the skew-symmetric part: `vee(M) = ½ (M − Mᵀ)` read as a vector.
 ///
-/// This is the attitude-error extraction of mechanization.md §1.4: `ε = ½ vee(M − Mᵀ)`.
+/// This is the attitude-error extraction of docs/conventions.md §"Errors": `ε = ½ vee(M − Mᵀ)`.
 #[inline]
 pub fn vee_antisym(m: &Mat3) -> Vec3 {
     Vec3::new(
@@ -53,7 +53,7 @@ pub fn orthonormalize(c: &Mat3) -> Mat3 {
     m
 }
 
-/// Attitude error vector of spec mechanization.md §1.4 / alignment §0.2 (convention G):
+/// Attitude error vector of docs/conventions.md §"Errors" (convention G):
 /// `c_est c_trueᵀ = I + [ε×] + O(ε²)`, `ε = ½ vee(M − Mᵀ)`, resolved in the navigation frame.
 #[inline]
 pub fn attitude_error(c_b_n_est: &Mat3, c_b_n_true: &Mat3) -> Vec3 {

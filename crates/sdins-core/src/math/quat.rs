@@ -1,4 +1,4 @@
-//! Hamilton, scalar-first quaternion (mechanization.md §1.2).
+//! Hamilton, scalar-first quaternion (docs/conventions.md §"Quaternions").
 
 use super::{Mat3, Vec3};
 
@@ -189,7 +189,7 @@ impl Quat {
     }
 
     /// Quaternion of a rotation vector (S1 eq. 2): `q(φ) = [cos(φ/2), (φ/|φ|) sin(φ/2)]`,
-    /// with the spec's series below |φ| = 1e-6 rad.
+    /// with the Taylor series below |φ| = 1e-6 rad.
     #[inline]
     pub fn from_rotvec(phi: &Vec3) -> Self {
         let a2 = phi.norm_squared();

@@ -3,7 +3,8 @@
 use super::{skew, Mat3, Quat, Vec3};
 
 /// DCM of a rotation vector: `C = I + (sin φ/φ)[φ×] + ((1 − cos φ)/φ²)[φ×]²`
-/// (series below |φ| = 1e-4 rad). To first order `C = I + [φ×]` (mechanization.md §1.2).
+/// (series below |φ| = 1e-4 rad). To first order `C = I + [φ×]` (docs/conventions.md
+/// §"Quaternions").
 pub fn dcm_from_rotvec(phi: &Vec3) -> Mat3 {
     let a2 = phi.norm_squared();
     let (s1, s2) = if a2 < 1e-8 {

@@ -1,4 +1,5 @@
-//! Wu's dual-quaternion SDINS (mechanization.md §6.2–§6.3; S2 eqs (1)–(13), W).
+//! Wu's dual-quaternion SDINS (docs/theory/mechanizations.md §"Dual quaternion"; S2 eqs (1)–(13),
+//! W).
 //!
 //! Three unit dual quaternions, all "from I to X":
 //! * T (thrust velocity): attitude B, translation `v_t^I = ∫ f^I`, twist `ω_ib^b + ε f^b`;
@@ -116,8 +117,8 @@ fn screw_dual(r: ZRot, d: &Quat, e_r: ZRot, e_d: &Quat) -> Quat {
     r.mul_left(e_d).add(&e_r.mul_right(d))
 }
 
-/// Dual part of the screw exponential (spec §6.1) for `σ = [0, 0, x]`:
-/// `[−½ s g, g σ' + s h σ]` with `s = σ·σ' = x σ'_z`.
+/// Dual part of the screw exponential (docs/theory/mechanizations.md §"Dual quaternion") for
+/// `σ = [0, 0, x]`: `[−½ s g, g σ' + s h σ]` with `s = σ·σ' = x σ'_z`.
 #[inline]
 fn dual_of_z_screw(x: f64, sigma_d: &Vec3, g: f64, h: f64) -> Quat {
     let s = x * sigma_d.z;
@@ -164,7 +165,7 @@ pub struct DualQuatNav {
 }
 
 impl DualQuatNav {
-    /// Initialise (spec §6.3 "Initialisation").
+    /// Initialise (docs/theory/mechanizations.md §"Dual quaternion").
     pub fn new(
         earth: EarthModel,
         dt_s: f64,
@@ -208,8 +209,9 @@ impl DualQuatNav {
 
     /// Gravitational (mass-attraction) acceleration in ECEF at the interval mid-point
     /// `r_mid = r_{k−1} + ½ΔT v^e_{k−1}`: `G^e = C_n^e g^n + ω_ie^e × (ω_ie^e × r^e)`
-    /// (spec §2, §6.3 step 2), with the mid-point's geodetic coordinates extrapolated
-    /// from the last update's.
+    /// (docs/theory/mechanizations.md §"Earth model"; docs/theory/mechanizations.md
+    /// §"Dual quaternion" step 2), with the mid-point's geodetic coordinates extrapolated from the
+    /// last update's.
     fn gravitation_mid(&self, r_mid: &Vec3, le0: &crate::earth::LocalEarth) -> Vec3 {
         let e = &self.earth;
         let g0 = &self.geo;

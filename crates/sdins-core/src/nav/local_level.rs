@@ -1,8 +1,9 @@
 //! Local-level (NED) mechanizations: Savage baseline (SAV), Song–Lee paper mode (SL)
-//! and Song–Lee complete (SLC) (mechanization.md §5).
+//! and Song–Lee complete (SLC) (docs/theory/mechanizations.md
+//! §"Song–Lee three-sample local-level algorithm").
 //!
-//! Computation order per update (S1 §IV, spec §5.4): velocity, then position, then
-//! attitude; every rate term is evaluated at t_{k−1}.
+//! Computation order per update (S1 §IV, docs/theory/mechanizations.md §"Order per update"):
+//! velocity, then position, then attitude; every rate term is evaluated at t_{k−1}.
 
 use super::{
     transport_matrix, transport_matrix_sc, wrap_pi, InitialState, Mechanization, NavState,
@@ -11,7 +12,7 @@ use crate::coning::{compensate, ConingSet, Increment};
 use crate::earth::{sin_cos_shift, EarthModel};
 use crate::math::{Mat3, Quat, Vec3};
 
-/// Velocity-update formula (spec §5.2).
+/// Velocity-update formula (docs/theory/mechanizations.md §"Velocity").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VelocityMode {
     /// `v_k = v_{k−1} + C(Δv + ½Δθ×Δv + ΔV_scul) + ΔT[g − (2ω_ie + ω_en)×v_{k−1}]`
@@ -23,7 +24,8 @@ pub enum VelocityMode {
     SongLeeComplete,
 }
 
-/// Attitude-update formula (spec §5.1, §5.4).
+/// Attitude-update formula (docs/theory/mechanizations.md §"Attitude by DCM separation";
+/// docs/theory/mechanizations.md §"Order per update").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AttitudeMode {
     /// S1 eq. (6)/(32): gyro-only quaternion `Q_k = Q_{k−1} ⊗ q(Δφ)`, `C_b^n = T(L, l, t) C(Q)`
@@ -34,14 +36,16 @@ pub enum AttitudeMode {
     Savage,
 }
 
-/// Which rotation vector the rotation compensation `½ x × Δv` uses (spec §4.1).
+/// Which rotation vector the rotation compensation `½ x × Δv` uses (docs/theory/coning-sculling.md
+/// §"Coning and sculling").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RotVector {
     /// `½ Δθ × Δv`, Savage's `α_m × υ_m` (the summed gyro increment)
     Theta,
     /// `½ Δφ × Δv`, S1 eq. (30) (the coning-compensated rotation vector). Differs from
-    /// `Theta` by O(ΔT³)·coning; under 1 Hz coning (spec §7.5) it is the more exact one
-    /// (closer to the dual-quaternion screw exponential, which contains it).
+    /// `Theta` by O(ΔT³)·coning; under 1 Hz coning (docs/validation.md
+    /// §"dual-quaternion paper case") it is the more exact one (closer to the dual-quaternion screw
+    /// exponential, which contains it).
     Phi,
 }
 
@@ -64,7 +68,8 @@ pub struct LocalLevelConfig {
     /// `½ΔT² Ȧ v`, i.e. first order globally; near the poles Ȧ is large (tanL grows with
     /// the northward motion) and this dominates. Used by `songlee-complete`.
     pub midpoint_rates: bool,
-    /// third-order rotation compensation `+ (1/6) Δφ×(Δφ×Δv)` (spec §4.1)
+    /// third-order rotation compensation `+ (1/6) Δφ×(Δφ×Δv)` (docs/theory/coning-sculling.md
+    /// §"Coning and sculling")
     pub rot3: bool,
     /// earth model (must equal the truth's)
     pub earth: EarthModel,
@@ -77,7 +82,8 @@ pub struct LocalLevelConfig {
 pub struct LocalLevel {
     cfg: LocalLevelConfig,
     dt_update_s: f64,
-    // position carried as offsets from the start (spec §5.3 roundoff recommendation)
+    // position carried as offsets from the start (docs/theory/mechanizations.md §"Position"
+    // roundoff recommendation)
     lat0_rad: f64,
     lon0_rad: f64,
     s_lat0: f64,
@@ -187,7 +193,8 @@ impl Mechanization for LocalLevel {
             }
         }
 
-        // 4. position, trapezoid with a latitude predictor (spec §5.3)
+        // 4. position, trapezoid with a latitude predictor (docs/theory/mechanizations.md
+        //    §"Position")
         let h_new = h - 0.5 * (v.z + v_new.z) * dt;
         let h_bar = 0.5 * (h + h_new);
         let vn_bar = 0.5 * (v.x + v_new.x);

@@ -3,8 +3,10 @@
 //!
 //! * [`LocalLevel`]: local-level NED mechanizations: the Savage baseline (`savage`), the
 //!   Song–Lee three-sample algorithm (`songlee`) and our complete version
-//!   (`songlee-complete`) (mechanization.md §5).
-//! * [`DualQuatNav`]: Wu's dual-quaternion mechanization (`dualquat`, §6).
+//!   (`songlee-complete`) (docs/theory/mechanizations.md
+//!   §"Song–Lee three-sample local-level algorithm").
+//! * [`DualQuatNav`]: Wu's dual-quaternion mechanization (`dualquat`, docs/theory/mechanizations.md
+//!   §"Dual quaternion").
 
 mod dual;
 mod dualquat;
@@ -63,7 +65,7 @@ pub struct InitialState {
     pub c_b_n: Mat3,
 }
 
-/// Vertical-channel mode (mechanization.md §2).
+/// Vertical-channel mode (docs/theory/mechanizations.md §"Earth model").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum VerticalMode {
     /// free inertial vertical channel (what the papers run)

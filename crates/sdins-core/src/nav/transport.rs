@@ -1,5 +1,5 @@
 //! The transport matrix `T(L, l, t) = C_{n0ⁱ}^{n(t)} = C_e^n(L, l + Ω_e t) C_e^n(L0, l0)ᵀ`
-//! (mechanization.md §5.1, S1 eq. (32), corrected).
+//! (docs/theory/mechanizations.md §"Attitude by DCM separation", S1 eq. (32), corrected).
 
 use crate::math::Mat3;
 
@@ -57,7 +57,7 @@ mod tests {
 
     #[test]
     fn derivative_is_minus_omega_in() {
-        // §7.4 item 2: Ṫ Tᵀ = −[(ω_ie + ω_en)×] for a vehicle moving over the ellipsoid.
+        // Unit check: Ṫ Tᵀ = −[(ω_ie + ω_en)×] for a vehicle moving over the ellipsoid.
         let e = EarthModel::WGS84;
         let (l0, lon0, h) = (0.6_f64, 2.0_f64, 0.0);
         let v = Vec3::new(150.0, 300.0, 0.0);

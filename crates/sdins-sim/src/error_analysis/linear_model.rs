@@ -7,7 +7,7 @@
 //! |---|---|---|
 //! | 0, 1, 2 | δL, δλ, δh (curvilinear position error, h up) | rad, rad, m |
 //! | 3, 4, 5 | δv^n (N, E, D) | m/s |
-//! | 6, 7, 8 | φ (N, E, D), **convention G**: `Ĉ_b^n = (I + [φ×]) C_b^n` (spec §0.2) | rad |
+//! | 6, 7, 8 | φ (N, E, D), **convention G**: `Ĉ_b^n = (I + [φ×]) C_b^n` (docs/conventions.md §"Errors") | rad |
 //! | 9, 10, 11 | accelerometer bias b_a, body frame (measured − true) | m/s² |
 //! | 12, 13, 14 | gyro bias b_g, body frame | rad/s |
 //!
@@ -79,7 +79,8 @@ pub enum LinearModelError {
 /// Earth used by the error model.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ModelEarth {
-    /// Spherical Earth of radius R0 with constant g (the Schuler-analysis model of §4.3).
+    /// Spherical Earth of radius R0 with constant g (the Schuler-analysis model of
+    /// docs/theory/error-analysis.md §"Full stationary closed form").
     Spherical(SchulerParams),
     /// An ellipsoidal earth model of `sdins-core`.
     Ellipsoid(EarthModel),
@@ -193,7 +194,8 @@ impl TrajectorySample {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum VerticalChannel {
     /// δh and δv_D held at zero (their F rows, Q and initial values are zeroed), as in the
-    /// spec §4.3 / §6 T9 reference runs. Default.
+    /// docs/theory/error-analysis.md §"Full stationary closed form"; docs/validation.md
+    /// §"error propagation" T9 reference runs. Default.
     #[default]
     Held,
     /// Free inertial vertical channel (unstable, `δḧ = (2g/r_eS) δh`).
@@ -555,7 +557,7 @@ mod tests {
         ]
     }
 
-    /// Run the 15-state model for 24 h at Δt = 10 s and compare with the §4.3 closed form.
+    /// Run the 15-state model for 24 h at Δt = 10 s and compare with the stationary closed form.
     /// The closed form neglects (i) the Coriolis coupling of the slow 24 h response
     /// (exact gain `1/(1 − r² ± 2 sin L r²)`, so ≤ (1 + 2 sin L) r² of the slow amplitude
     /// per circular component, two components) and (ii) the Foucault effects on the
@@ -609,14 +611,15 @@ mod tests {
             }
             println!("{:18} peak {:8.0} m  |lin-closed| unity {:6.1} m  k {:6.1} m  tol {:6.1} m  hdg {:.4} mrad", c.name, peak, worst[0], worst[1], tol, worst_hdg * 1e3);
             assert!(worst[0] <= tol, "{}: {} > {}", c.name, worst[0], tol);
-            // spec §4.3: heading prediction within 0.013 mrad
+            // docs/theory/error-analysis.md §"Full stationary closed form": heading prediction
+            // within 0.013 mrad
             assert!(worst_hdg <= 0.013e-3, "{}: heading {}", c.name, worst_hdg);
         }
     }
 
-    /// The linear model against the spec's *nonlinear INS* column of §6 T9. Tolerance:
-    /// printing (0.5 m) + discretization (< 0.1 m at Δt = 10 s) + the neglected
-    /// second-order terms, whose relative size is ~ the position angle δθ = δp/R0 ≤
+    /// The linear model against the *nonlinear INS* column of the T9 table (docs/validation.md
+    /// §"error propagation"). Tolerance: printing (0.5 m) + discretization (< 0.1 m at Δt = 10 s) +
+    /// the neglected second-order terms, whose relative size is ~ the position angle δθ = δp/R0 ≤
     /// peak/R0 (2.7e-3 for the 16.9 km case); 1e-3 · peak is used (observed: ≤ 8.3 m at
     /// 17 km, ≤ 4 m at 5.4 km, ≤ 0.8 m elsewhere).
     #[test]

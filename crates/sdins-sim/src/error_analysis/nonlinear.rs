@@ -1,12 +1,13 @@
 //! Nonlinear free-inertial reference runs for the error analysis: a stationary vehicle
-//! navigated by a full strapdown mechanization with injected sensor biases (spec §6 T9).
+//! navigated by a full strapdown mechanization with injected sensor biases (docs/validation.md
+//! §"error propagation" T9).
 //!
 //! The exact truth increments of a stationary scenario at latitude L are corrupted by an
 //! [`ImuErrorModel`] with fixed body-frame biases (`gyro_bias_dph`, `accel_bias_ug`,
-//! measured − true, spec §0.3) and navigated by one algorithm (default
-//! `songlee-complete`) with the vertical channel **held** to the truth (height and v_D
-//! replaced after every update, as in the closed form of §4.3). An initial attitude
-//! error φ0 (convention G) starts the navigation from `Ĉ_b^n = exp([φ0×]) C_b^n`.
+//! measured − true, docs/theory/imu-errors.md §"IMU error model") and navigated by one algorithm
+//! (default `songlee-complete`) with the vertical channel **held** to the truth (height and v_D
+//! replaced after every update, as in the stationary closed form). An initial attitude error φ0
+//! (convention G) starts the navigation from `Ĉ_b^n = exp([φ0×]) C_b^n`.
 //!
 //! Earth: by default a **spherical** earth of radius R0 with constant gravity g and
 //! Earth rate Ω, i.e. exactly the constants of the closed form ([`SchulerParams`]), so

@@ -1,4 +1,5 @@
-//! Schuler, Foucault and Earth-rate periods (spec §4.1, constants of §0.4).
+//! Schuler, Foucault and Earth-rate periods (docs/theory/error-analysis.md §"Periods", constants of
+//! its §"Constants and units").
 //!
 //! * Schuler: `ω_s = √(g/R0)`, `T_s = 2π √(R0/g)` = 84.41 min for R0 = 6371 km,
 //!   g = 9.80665 m/s². (The paper \[P2\] calls `√(g/R0)` "about 84.4 min"; that is the
@@ -9,7 +10,8 @@
 
 use core::f64::consts::TAU;
 
-/// Spherical-Earth constants of the Schuler analysis (spec §0.4).
+/// Spherical-Earth constants of the Schuler analysis (docs/theory/error-analysis.md
+/// §"Constants and units").
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct SchulerParams {
     /// Earth radius R0 \[m\]
@@ -21,16 +23,16 @@ pub struct SchulerParams {
 }
 
 impl SchulerParams {
-    /// The constants of the §4.2 formula tables and the §4.4 Schuler-share reconstruction:
-    /// R0 = 6 371 000 m, g = 9.80665 m/s², Ω = 7.292115e-5 rad/s.
+    /// The constants of the single-channel formula tables and the Schuler-share reconstruction: R0
+    /// = 6 371 000 m, g = 9.80665 m/s², Ω = 7.292115e-5 rad/s.
     pub const P2: SchulerParams = SchulerParams {
         r0_m: 6_371_000.0,
         g_mps2: 9.806_65,
         omega_ie_rps: 7.292_115e-5,
     };
 
-    /// The constants of the §6 T9 24 h comparisons: R0 = 6371 km with the local gravity of
-    /// the INS run, g(37.5°, 0) = 9.79949 m/s².
+    /// The constants of the T9 24 h comparisons (docs/validation.md §"error propagation"): R0 =
+    /// 6371 km with the local gravity of the INS run, g(37.5°, 0) = 9.79949 m/s².
     pub const T9: SchulerParams = SchulerParams {
         r0_m: 6_371_000.0,
         g_mps2: 9.799_49,
@@ -65,27 +67,28 @@ impl SchulerParams {
     }
 }
 
-/// Schuler angular frequency `ω_s = √(g/R0)` \[rad/s\] (spec §4.1).
+/// Schuler angular frequency `ω_s = √(g/R0)` \[rad/s\] (docs/theory/error-analysis.md §"Periods").
 pub fn schuler_frequency(g_mps2: f64, r0_m: f64) -> f64 {
     (g_mps2 / r0_m).sqrt()
 }
 
-/// Schuler period `T_s = 2π √(R0/g)` \[s\] (spec §4.1).
+/// Schuler period `T_s = 2π √(R0/g)` \[s\] (docs/theory/error-analysis.md §"Periods").
 pub fn schuler_period_s(g_mps2: f64, r0_m: f64) -> f64 {
     TAU / schuler_frequency(g_mps2, r0_m)
 }
 
-/// Foucault angular frequency `ω_F = Ω sin L` \[rad/s\] (spec §4.1).
+/// Foucault angular frequency `ω_F = Ω sin L` \[rad/s\] (docs/theory/error-analysis.md §"Periods").
 pub fn foucault_frequency(omega_ie_rps: f64, lat_rad: f64) -> f64 {
     omega_ie_rps * lat_rad.sin()
 }
 
-/// Foucault period `T_F = 2π/|Ω sin L|` \[s\] (spec §4.1); infinite on the equator.
+/// Foucault period `T_F = 2π/|Ω sin L|` \[s\] (docs/theory/error-analysis.md §"Periods"); infinite
+/// on the equator.
 pub fn foucault_period_s(omega_ie_rps: f64, lat_rad: f64) -> f64 {
     TAU / foucault_frequency(omega_ie_rps, lat_rad).abs()
 }
 
-/// Earth-rate ("24 h") period `2π/Ω` \[s\] (spec §4.1).
+/// Earth-rate ("24 h") period `2π/Ω` \[s\] (docs/theory/error-analysis.md §"Periods").
 pub fn earth_rate_period_s(omega_ie_rps: f64) -> f64 {
     TAU / omega_ie_rps
 }
@@ -98,9 +101,10 @@ mod tests {
     #[test]
     fn periods_match_spec_4_1() {
         let p = SchulerParams::P2;
-        // ω_s = 1.24067e-3 rad/s, T_s = 5064.4 s = 84.41 min (spec §0.4, rounded)
+        // ω_s = 1.24067e-3 rad/s, T_s = 5064.4 s = 84.41 min (docs/theory/error-analysis.md
+        // §"Constants and units", rounded)
         assert!((p.omega_s() - 1.240_67e-3).abs() < 0.000_005e-3);
-        // spec prints 5064.4 s; 2π√(6371000/9.80665) = 5064.33 s (spec rounding; 84.41 min holds)
+        // 5064.4 s is the rounded value; 2π√(6371000/9.80665) = 5064.33 s (84.41 min holds)
         assert!((p.schuler_period_s() - 5064.4).abs() < 0.1);
         assert!((p.schuler_period_s() / 60.0 - 84.41).abs() < 0.005);
         // T_F = 39.32 h at 37.5°, 33.85 h at 45°, 29.9 h at 53.1°

@@ -1,8 +1,8 @@
-//! "Schuler share" of the position error — the reconstruction of \[P2\] Table 1 (spec §4.4).
+//! "Schuler share" of the position error — the reconstruction of \[P2\] Table 1
+//! (docs/theory/error-analysis.md §"The Schuler share").
 //!
-//! \[P2\] does not define its ratio; the spec's best reconstruction (rms 0.40 percentage
-//! points over the paper's six numbers, one fitted parameter t*) is, with
-//! `δB_gE = δB_gD = δω` and `δB_aN = δa`:
+//! \[P2\] does not define its ratio; our best reconstruction (rms 0.40 percentage points over the
+//! paper's six numbers, one fitted parameter t*) is, with `δB_gE = δB_gD = δω` and `δB_aN = δa`:
 //!
 //! ```text
 //! share(t) = [ R0 δω |sin ω_s t|/ω_s + R0 Ω cos L δω (1 − cos ω_s t)/ω_s²
@@ -12,10 +12,12 @@
 //! evaluated at `t* = 6573 s` (≈ 1.30 T_s), L = 37.5°, R0 = 6371 km, g = 9.80665,
 //! v_E = 0. The numerator is the sum of the magnitudes of the Schuler-oscillatory parts
 //! of (1), (2), (3) (all of (3) counts as Schuler); the denominator the sum of the
-//! magnitudes of (1), (2), (3) (spec §4.2, [`super::short_term`]). The share is 0 at every
-//! multiple of T_s. This is a *plausible* reconstruction, not a proven one.
+//! magnitudes of (1), (2), (3) (docs/theory/error-analysis.md §"Single-channel formulas",
+//! [`super::short_term`]). The share is 0 at every multiple of T_s. This is a *plausible*
+//! reconstruction, not a proven one.
 //!
-//! [`schuler_share_full`] is the spec's requested variant on the full model of §4.3.
+//! [`schuler_share_full`] is the variant on the full model (docs/theory/error-analysis.md
+//! §"Full stationary closed form").
 
 use super::grades::{P2Box, GRADES};
 use super::periods::SchulerParams;
@@ -25,15 +27,16 @@ use super::{DEG_PER_HOUR, MICRO_G};
 use sdins_core::Vec3;
 use serde::Serialize;
 
-/// The fitted evaluation time of the reconstruction, t* = 6573 s (spec §4.4).
+/// The fitted evaluation time of the reconstruction, t* = 6573 s (docs/theory/error-analysis.md
+/// §"The Schuler share").
 pub const T_STAR_S: f64 = 6573.0;
 /// Latitude of the reconstruction, 37.5° \[rad\].
 pub const SHARE_LAT_RAD: f64 = 37.5 * core::f64::consts::PI / 180.0;
 
-/// Schuler share \[%\] of the spec §4.4 reconstruction for accelerometer bias `da`
-/// \[m/s²\] and gyro bias `dw` \[rad/s\] at time `t` \[s\]. Uses the single-channel formulas
-/// beyond their 2 h validity on purpose (that is the definition). Returns 0 where the
-/// denominator vanishes (t = 0 or zero biases).
+/// Schuler share \[%\] of the docs/theory/error-analysis.md §"The Schuler share" reconstruction for
+/// accelerometer bias `da` \[m/s²\] and gyro bias `dw` \[rad/s\] at time `t` \[s\]. Uses the
+/// single-channel formulas beyond their 2 h validity on purpose (that is the definition). Returns 0
+/// where the denominator vanishes (t = 0 or zero biases).
 pub fn schuler_share(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerParams) -> f64 {
     let ws = p.omega_s();
     let (s, c) = (ws * t).sin_cos();
@@ -51,10 +54,11 @@ pub fn schuler_share(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerParams) 
     }
 }
 
-/// Variant on the full stationary model (spec §4.3), defined here as
-/// `Σ_i ‖o_i'(t)‖ / Σ_i ‖δp_i(t)‖` over the three sources i = east gyro δω, down gyro δω,
-/// north accelerometer δa, each run alone through [`StationaryClosedForm`]; `o_i'` is the
-/// Foucault-rotated Schuler oscillation, norms are horizontal. \[%\]
+/// Variant on the full stationary model (docs/theory/error-analysis.md
+/// §"Full stationary closed form"), defined here as `Σ_i ‖o_i'(t)‖ / Σ_i ‖δp_i(t)‖` over the three
+/// sources i = east gyro δω, down gyro δω, north accelerometer δa, each run alone through
+/// [`StationaryClosedForm`]; `o_i'` is the Foucault-rotated Schuler oscillation, norms are
+/// horizontal. \[%\]
 pub fn schuler_share_full(da: f64, dw: f64, t: f64, lat_rad: f64, p: &SchulerParams) -> f64 {
     let sources = [
         StationaryErrors {
@@ -98,8 +102,8 @@ pub struct ShareRow {
     pub share_pct: f64,
 }
 
-/// The reconstruction of \[P2\] Table 1: every grade with a \[P2\] bias box (spec §4.5) ×
-/// the four corners of its box, evaluated with [`schuler_share`] at `t` (use
+/// The reconstruction of \[P2\] Table 1: every grade with a \[P2\] bias box (docs/imu-errors.md
+/// §"Grades") × the four corners of its box, evaluated with [`schuler_share`] at `t` (use
 /// [`T_STAR_S`]), latitude `lat_rad` (use [`SHARE_LAT_RAD`]) and `p` (use
 /// [`SchulerParams::P2`]).
 pub fn schuler_share_table(t: f64, lat_rad: f64, p: &SchulerParams) -> Vec<ShareRow> {
@@ -127,7 +131,8 @@ pub fn schuler_share_table(t: f64, lat_rad: f64, p: &SchulerParams) -> Vec<Share
     rows
 }
 
-/// [`schuler_share_table`] with the spec §4.4 settings (t*, 37.5°, P2 constants).
+/// [`schuler_share_table`] with the docs/theory/error-analysis.md §"The Schuler share" settings
+/// (t*, 37.5°, P2 constants).
 pub fn schuler_share_table_p2() -> Vec<ShareRow> {
     schuler_share_table(T_STAR_S, SHARE_LAT_RAD, &SchulerParams::P2)
 }
@@ -146,7 +151,8 @@ mod tests {
         )
     }
 
-    /// spec §6 T10: the 12 corner values of §4.4 at t* to ±0.05 percentage points.
+    /// docs/validation.md §"error propagation" T10: the 12 corner values of the reconstruction at
+    /// t* to ±0.05 percentage points.
     #[test]
     fn t10_values_at_t_star() {
         let want = [
@@ -175,7 +181,7 @@ mod tests {
             {
                 assert!((r.share_pct - v).abs() <= 0.05, "{r:?}");
             } else {
-                panic!("corner not in spec §4.4: {r:?}");
+                panic!("corner not in the Schuler-share reconstruction table: {r:?}");
             }
         }
     }
@@ -197,8 +203,8 @@ mod tests {
         }
     }
 
-    /// T10 and §4.4: share(30 μg, 0.0035 °/h) = 43.8 / 32.6 / 6.8 / 5.8 / 0.1 % at
-    /// 1 / 2 / 4 / 8 / 24 h (±0.1, one printed digit).
+    /// T10 and docs/theory/error-analysis.md §"The Schuler share": share(30 μg, 0.0035 °/h) = 43.8
+    /// / 32.6 / 6.8 / 5.8 / 0.1 % at 1 / 2 / 4 / 8 / 24 h (±0.1, one printed digit).
     #[test]
     fn t10_time_dependence() {
         for (h, v) in [
@@ -213,13 +219,14 @@ mod tests {
         }
     }
 
-    /// The full-model variant at t = T_s/4 (sin ω_s t = 1, cos ω_s t = 0): by §4.3 the only
-    /// oscillatory part left is the east gyro's `R0 δω/ω_s sin ω_s t` (the others ∝ cos ω_s t;
-    /// Foucault rotation keeps norms), so the numerator is `R0 δω/ω_s`; at 21 min the full
+    /// The full-model variant at t = T_s/4 (sin ω_s t = 1, cos ω_s t = 0): by the full closed form
+    /// the only oscillatory part left is the east gyro's `R0 δω/ω_s sin ω_s t` (the others ∝ cos
+    /// ω_s t; Foucault rotation keeps norms), so the numerator is `R0 δω/ω_s`; at 21 min the full
     /// model's magnitudes equal |(1)|, |(2)|, |(3)| to < 1 % (Earth-loop terms
-    /// O(Ωt) ≈ 0.1 rad enter at second order, spec §4.2 table: 1 % at 1 h), hence 2 %.
-    /// Note the variant does not reproduce Table 1: the reconstruction counts all of (3)
-    /// as Schuler, the full model only its oscillation `−δa/ω_s² cos ω_s t`.
+    /// O(Ωt) ≈ 0.1 rad enter at second order, docs/theory/error-analysis.md
+    /// §"Single-channel formulas" table: 1 % at 1 h), hence 2 %. Note the variant does not
+    /// reproduce Table 1: the reconstruction counts all of (3) as Schuler, the full model only its
+    /// oscillation `−δa/ω_s² cos ω_s t`.
     #[test]
     fn full_variant_at_quarter_period() {
         let p = SchulerParams::P2;

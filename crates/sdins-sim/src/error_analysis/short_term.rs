@@ -1,14 +1,15 @@
 //! Single-channel (short-term) position-error formulas: the corrected \[P2\] (1)–(3) and
-//! their companion terms (spec §4.2).
+//! their companion terms (docs/theory/error-analysis.md §"Single-channel formulas").
 //!
-//! The formulas ignore the Earth-rate (24 h) loop and the Foucault rotation; the spec
-//! measures 1 % error at 1 h, 4.7 % at 2 h and 21 % at 4 h against the full model
-//! (east gyro, 37.5°). **Validity policy (chosen here):** the checked entry point
+//! The formulas ignore the Earth-rate (24 h) loop and the Foucault rotation; against the full
+//! model (docs/theory/error-analysis.md §"Single-channel formulas") they are 1 % error at 1 h, 4.7
+//! % at 2 h and 21 % at 4 h off (east gyro, 37.5°). **Validity policy (chosen here):** the checked
+//! entry point
 //! [`position_error`] returns [`ShortTermError::BeyondValidity`] for `t >`
 //! [`VALIDITY_LIMIT_S`] (2 h), so no caller can silently use them for long times.
 //! The raw formulas (`eq1_*`, `eq2_*`, `eq3_*`, ...) are public *without* the check
-//! because the spec §4.4 Schuler-share reconstruction deliberately evaluates them at
-//! any t; their doc comments say so.
+//! because the Schuler-share reconstruction (docs/theory/error-analysis.md §"The Schuler share")
+//! deliberately evaluates them at any t; their doc comments say so.
 //!
 //! Units: R0 \[m\], t \[s\], ε \[rad/s\], δa \[m/s²\], results in metres. NED, convention G,
 //! bias = measured − true.
@@ -16,8 +17,8 @@
 use super::periods::SchulerParams;
 use sdins_core::Vec3;
 
-/// Validity limit of the single-channel formulas: 2 h (spec §4.2 "use (1)–(3) only for
-/// t ≲ 2 h").
+/// Validity limit of the single-channel formulas: 2 h (docs/theory/error-analysis.md
+/// §"Single-channel formulas": t ≲ 2 h).
 pub const VALIDITY_LIMIT_S: f64 = 7200.0;
 
 /// Error of the checked short-term formulas.
@@ -27,7 +28,7 @@ pub enum ShortTermError {
     /// The time is beyond the validity of the single-channel formulas.
     #[error(
         "t = {t_s} s is beyond the {limit_s} s validity of the single-channel formulas \
-         (spec §4.2); use the stationary closed form (§4.3)"
+         (docs/theory/error-analysis.md); use the stationary closed form"
     )]
     BeyondValidity {
         /// requested time \[s\]
@@ -58,7 +59,8 @@ pub fn eq2_down_gyro(eps_d: f64, lat_rad: f64, v_e_mps: f64, t: f64, p: &Schuler
 
 /// \[P2\] (3): north error from a north accelerometer bias,
 /// `δp_N = (1 − cos ω_s t)/ω_s² · δa_N = R0 (δa_N/g)(1 − cos ω_s t)`. The same formula gives
-/// the east error from δa_E (spec §4.2 companion term). No validity check.
+/// the east error from δa_E (docs/theory/error-analysis.md §"Single-channel formulas" companion
+/// term). No validity check.
 pub fn eq3_accel(da: f64, t: f64, p: &SchulerParams) -> f64 {
     let ws = p.omega_s();
     da * (1.0 - (ws * t).cos()) / (ws * ws)
@@ -191,9 +193,10 @@ mod tests {
 
     #[test]
     fn eq1_values_in_spec_table() {
-        // spec §4.2 validity table, column (1): −1353 m at 1 h, −2106 m at 2 h,
-        // −4656 m at 4 h, −26.6 km at 24 h (0.01 °/h east gyro). The table compares with
-        // the T9 runs, so it uses g = 9.79949: with g = 9.80665 the 4 h value is −4655.1 m.
+        // docs/theory/error-analysis.md §"Single-channel formulas" validity table, column (1):
+        // −1353 m at 1 h, −2106 m at 2 h, −4656 m at 4 h, −26.6 km at 24 h (0.01 °/h east gyro).
+        // The table compares with the T9 runs, so it uses g = 9.79949: with g = 9.80665 the 4 h
+        // value is −4655.1 m.
         let p = SchulerParams::T9;
         let e = 0.01 * DEG_PER_HOUR;
         for (h, want, tol) in [

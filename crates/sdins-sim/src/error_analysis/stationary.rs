@@ -1,10 +1,10 @@
 //! Full stationary closed form of the free-inertial error (Schuler + 24 h + Foucault),
-//! spec §4.3 — the normative reference model.
+//! docs/theory/error-analysis.md §"Full stationary closed form" — the normative reference model.
 //!
 //! Model: stationary vehicle at latitude L, spherical Earth (R0), constant g, Earth rate
 //! Ω, vertical channel held, NED, convention G, errors = estimate − truth.
 //!
-//! Steps (spec §4.3, numbering kept):
+//! Steps (docs/theory/error-analysis.md §"Full stationary closed form", numbering kept):
 //! 1. `u = [cos L, 0, −sin L]`, `ε∥ = (ε·u)u`, `ε⊥ = ε − ε∥`, `φ0⊥ = φ0 − (φ0·u)u`.
 //! 2. Psi-angle solution of `ψ̇ = −ω_ie^n × ψ + ε`, `ψ(0) = ψ0`:
 //!    `ψ(t) = c0 + c1 t + cs sin Ωt + ck (1 − cos Ωt)`, with `c0 = ψ0`, `c1 = ε∥`,
@@ -20,36 +20,36 @@
 //!    `o_N' = o_N cos ω_F t − o_E sin ω_F t`, `o_E' = o_N sin ω_F t + o_E cos ω_F t`.
 //! 6. `φ_D = ψ_D + tan L · δp_E/R0`.
 //!
-//! **Extensions beyond the spec's inputs (derived here, same model):**
+//! **Extensions beyond the inputs of the published model (derived here, same model):**
 //! * initial horizontal position error δp0: the psi angle starts at
 //!   `ψ0 = φ0 + δθ0`, `δθ0 = [δp_E0/R0, −δp_N0/R0, −tan L δp_E0/R0]` (the rotation of the
 //!   computed navigation frame), and the Schuler loop gets the homogeneous term
 //!   `δp0 cos ω_s t` (oscillatory);
 //! * initial horizontal velocity error δv0: homogeneous term `δv0 sin(ω_s t)/ω_s`
-//!   (oscillatory; spec §4.2 companion term);
+//!   (oscillatory; docs/theory/error-analysis.md §"Single-channel formulas" companion term);
 //! * full attitude error: `φ = ψ − δθ(t)`, i.e. `φ_N = ψ_N − δp_E/R0`,
 //!   `φ_E = ψ_E + δp_N/R0`, `φ_D = ψ_D + tan L δp_E/R0` (step 6 is the third component);
 //! * velocity error = time derivative of the position error (analytic). Because step 5
 //!   rotates the Schuler oscillation rigidly, the velocity at t = 0 differs from δv0 by
-//!   `ω_F J o(0)` (a few % of the Schuler velocity amplitude): a property of the spec's
-//!   approximation, kept so that the position values match the spec.
+//!   `ω_F J o(0)` (a few % of the Schuler velocity amplitude): a property of this
+//!   approximation, kept so that the position values match the T9 reference table
+//!   (docs/validation.md §"error propagation").
 //!
-//! **Gain `k` of step 4 ([`SlowGain`]).** The spec text applies `k` (the Schuler loop's
-//! response to a 24 h forcing, Coriolis ignored). But the Coriolis coupling `2 ω_F Ω/ω_s²
-//! = 2 sin L · r²` that the model ignores in the slow response is of the *same order* as
-//! `k − 1 = r²/(1 − r²)`: the exact response of the coupled loop
-//! `z̈ − 2iω_F ż + ω_s² z = ω_s² s` (`z = δp_N + i δp_E`) to `e^{±iΩt}` is
+//! **Gain `k` of step 4 ([`SlowGain`]).** Step 4 as written (docs/theory/error-analysis.md
+//! §"Full stationary closed form") applies `k` (the Schuler loop's response to a 24 h forcing,
+//! Coriolis ignored). But the Coriolis coupling `2 ω_F Ω/ω_s² = 2 sin L · r²` that the model
+//! ignores in the slow response is of the *same order* as `k − 1 = r²/(1 − r²)`: the exact response
+//! of the coupled loop `z̈ − 2iω_F ż + ω_s² z = ω_s² s` (`z = δp_N + i δp_E`) to `e^{±iΩt}` is
 //! `1/(1 − r² ± 2 sin L r²)`. Applying `k` alone is therefore no more accurate than
-//! `k = 1`, and the spec's own §6 T9 closed-form numbers (−1339/−2013/−3839/−4093 m …)
-//! are reproduced only with `k = 1` (with `k` they are 4–23 m off, e.g. −4108 m at 6 h).
-//! Against the 15-state linear model (`linear_model`) over 24 h the maximum deviation is
-//! 7.8 m (`k = 1`) vs 18.5 m (`k`) for the down gyro, equal within 0.2 m for the other
-//! single-source cases and 90.6 vs 82.2 m for the combined T9 case: neither is uniformly
-//! better. Default: [`SlowGain::Unity`] (matches the spec's numbers); [`SlowGain::SchulerK`]
-//! is the spec text taken literally.
+//! `k = 1`, and the T9 reference closed-form numbers (−1339/−2013/−3839/−4093 m …) are reproduced
+//! only with `k = 1` (with `k` they are 4–23 m off, e.g. −4108 m at 6 h). Against the 15-state
+//! linear model (`linear_model`) over 24 h the maximum deviation is 7.8 m (`k = 1`) vs 18.5 m (`k`)
+//! for the down gyro, equal within 0.2 m for the other single-source cases and 90.6 vs 82.2 m for
+//! the combined T9 case: neither is uniformly better. Default: [`SlowGain::Unity`] (matches the T9
+//! reference numbers); [`SlowGain::SchulerK`] is step 4 taken literally.
 //!
 //! Body-frame biases are accepted through [`StationaryErrors::from_body`] (`δa = C_b^n b_a`,
-//! `ε = C_b^n b_g`, spec §0.3).
+//! `ε = C_b^n b_g`, docs/theory/imu-errors.md §"IMU error model").
 
 use super::periods::SchulerParams;
 use sdins_core::{Mat3, Vec3};
@@ -59,10 +59,11 @@ use serde::Serialize;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[non_exhaustive]
 pub enum SlowGain {
-    /// `k = 1`: reproduces the spec's §6 T9 closed-form values (default).
+    /// `k = 1`: reproduces the T9 reference closed-form values (default).
     #[default]
     Unity,
-    /// `k = ω_s²/(ω_s² − Ω²)`: spec §4.3 step 4 as printed.
+    /// `k = ω_s²/(ω_s² − Ω²)`: docs/theory/error-analysis.md §"Full stationary closed form" step 4
+    /// as printed.
     SchulerK,
 }
 
@@ -323,9 +324,9 @@ mod tests {
         }
     }
 
-    /// spec §6 T9, closed-form column (metres, printed to 1 m), asserted to ±1.5 m:
-    /// 0.5 m printing + ≤ 0.9 m = (k − 1)·R0 ε/ω_s, the Schuler-amplitude effect of the
-    /// prototype's (undocumented) gain on the oscillatory term (see [`SlowGain`]).
+    /// docs/validation.md §"error propagation" T9, closed-form column (metres, printed to 1 m),
+    /// asserted to ±1.5 m: 0.5 m printing + ≤ 0.9 m = (k − 1)·R0 ε/ω_s, the Schuler-amplitude
+    /// effect of the prototype's (undocumented) gain on the oscillatory term (see [`SlowGain`]).
     #[test]
     fn t9_closed_form_values() {
         let east = cf(gyro(0.0, 1.0, 0.0));
@@ -393,14 +394,14 @@ mod tests {
                     let got = model.eval(h * H).dp_n[ch];
                     assert!(
                         (got - w).abs() <= 1.5,
-                        "ch {ch} at {h} h: {got:.2} vs spec {w}"
+                        "ch {ch} at {h} h: {got:.2} vs ref {w}"
                     );
                 }
             }
         }
     }
 
-    /// Brief's figures −4097 m (6 h) and −144 m (24 h) are the spec's *nonlinear INS*
+    /// Brief's figures −4097 m (6 h) and −144 m (24 h) are the T9 reference table's *nonlinear INS*
     /// column; the closed form gives −4093/−142. Both are within the T9 acceptance
     /// (1 % of peak + 50 m) of each other — checked here so the relation is explicit.
     #[test]
@@ -410,7 +411,7 @@ mod tests {
         let peak = (0..=24 * 60)
             .map(|m| hnorm(east.eval(m as f64 * 60.0)))
             .fold(0.0, f64::max);
-        // spec: east-gyro peak 5365 m (INS, horizontal); the closed form must agree within
+        // T9 reference: east-gyro peak 5365 m (INS, horizontal); the closed form must agree within
         // the T9 tolerance.
         let peak_n = (0..=24 * 60)
             .map(|m| east.eval(m as f64 * 60.0).dp_n[0].abs())
@@ -418,8 +419,8 @@ mod tests {
         let peak_e = (0..=24 * 60)
             .map(|m| east.eval(m as f64 * 60.0).dp_n[1].abs())
             .fold(0.0, f64::max);
-        // spec: "east gyro: peak 5365 m" (INS) is the east-channel peak (closed form 5368 m);
-        // the horizontal-norm peak is ≈ 5567 m and the north peak ≈ 4476 m.
+        // T9 reference: "east gyro: peak 5365 m" (INS) is the east-channel peak (closed form 5368
+        // m); the horizontal-norm peak is ≈ 5567 m and the north peak ≈ 4476 m.
         assert!(
             (peak_e - 5365.0).abs() < 0.01 * 5365.0 + 50.0,
             "peak {peak_e}"
@@ -438,13 +439,16 @@ mod tests {
 
     #[test]
     fn heading_and_drift_rates() {
-        // East gyro: heading error at 12 h, closed form −1.676 mrad (spec §6 T9).
+        // East gyro: heading error at 12 h, closed form −1.676 mrad (docs/validation.md
+        // §"error propagation" T9).
         let east = cf(gyro(0.0, 1.0, 0.0));
         let h12 = east.eval(12.0 * H).phi[2];
-        // spec §4.3: heading prediction within 0.013 mrad of the INS (−1.680) in all cases
+        // docs/theory/error-analysis.md §"Full stationary closed form": heading prediction within
+        // 0.013 mrad of the INS (−1.680) in all cases
         assert!((h12 * 1e3 + 1.676).abs() < 0.013, "{h12}");
         assert!((h12 * 1e3 + 1.680).abs() < 0.013, "{h12}");
-        // North gyro: linear longitude drift R0 cos²L ε_N = 700 m/h (spec §4.3)
+        // North gyro: linear longitude drift R0 cos²L ε_N = 700 m/h (docs/theory/error-analysis.md
+        // §"Full stationary closed form")
         let north = cf(gyro(1.0, 0.0, 0.0));
         let p = SchulerParams::T9;
         let drift = p.r0_m * L.cos().powi(2) * 0.01 * DEG_PER_HOUR * H;
@@ -455,8 +459,8 @@ mod tests {
 
     #[test]
     fn accel_bias_with_foucault_special_case() {
-        // spec §4.3: δp_N = (δa_N/ω_s²)(1 − cos ω_F t cos ω_s t),
-        // δp_E = −(δa_N/ω_s²) sin ω_F t cos ω_s t — exact identity of the model.
+        // docs/theory/error-analysis.md §"Full stationary closed form": δp_N = (δa_N/ω_s²)(1 − cos
+        // ω_F t cos ω_s t), δp_E = −(δa_N/ω_s²) sin ω_F t cos ω_s t — exact identity of the model.
         let p = SchulerParams::T9;
         let da = 30.0 * MICRO_G;
         let m = cf(StationaryErrors {
@@ -474,7 +478,7 @@ mod tests {
                 assert!(s.phi.iter().all(|x| x.abs() < 1e-15));
             }
         }
-        // spec T9: for t < 6 h the local minima of δp_N come every T_s = 84.4 ± 0.5 min
+        // T9 reference: for t < 6 h the local minima of δp_N come every T_s = 84.4 ± 0.5 min
         let mut minima = Vec::new();
         let step = 1.0;
         let mut prev = (m.eval(0.0).dp_n[0], m.eval(step).dp_n[0]);
@@ -535,8 +539,9 @@ mod tests {
     }
 
     /// T9 last bullet: the \[P2\] formulas (1)–(3) for the east-gyro case are within 2 % of
-    /// the full model at 1 h and 6 % at 2 h (spec: 1.0 % and 4.7 %), and wrong by > 20 %
-    /// at 4 h (spec 21 %) — which is why [`super::super::short_term::position_error`] refuses t > 2 h.
+    /// the full model at 1 h and 6 % at 2 h (reference: 1.0 % and 4.7 %), and wrong by > 20 %
+    /// at 4 h (reference 21 %) — which is why [`super::super::short_term::position_error`] refuses
+    /// t > 2 h.
     #[test]
     fn short_formulas_vs_full_model() {
         let p = SchulerParams::T9;
@@ -558,7 +563,7 @@ mod tests {
         };
         assert!(super::super::short_term::position_error(&inp, 2.0 * H, &p).is_ok());
         assert!(super::super::short_term::position_error(&inp, 2.0 * H + 1.0, &p).is_err());
-        // spec measured values 1 % and 4.7 %
+        // reference values 1 % and 4.7 % (docs/theory/error-analysis.md §"Single-channel formulas")
         assert!((rel(1.0) - 0.010).abs() < 0.002 && (rel(2.0) - 0.047).abs() < 0.003);
         // (2) and (3) against the model at 1 h: (3) matches up to the Foucault factor
         // cos ω_F t (1 − 1e-3 at 1 h), (2) within the Earth-loop neglect (< 3 %)
@@ -574,9 +579,9 @@ mod tests {
         assert!(((s3 - acc.eval(H).dp_n[0]) / s3).abs() < 0.01);
     }
 
-    /// spec §6 REF: body biases b_a = \[50, −80, 30\] μg, b_g = \[0.01, −0.02, 0.015\] °/h at
-    /// roll 2°, pitch −3°, yaw 40° resolve to δa = \[89.2243, −30.8676, 29.7693\] μg and
-    /// ε = \[0.020261, −0.009774, 0.014797\] °/h (printed digits).
+    /// docs/theory/alignment.md §"Reference case": body biases b_a = \[50, −80, 30\] μg, b_g =
+    /// \[0.01, −0.02, 0.015\] °/h at roll 2°, pitch −3°, yaw 40° resolve to δa = \[89.2243,
+    /// −30.8676, 29.7693\] μg and ε = \[0.020261, −0.009774, 0.014797\] °/h (printed digits).
     #[test]
     fn body_biases_resolve_to_spec_ref_ned_values() {
         let c = sdins_core::math::c_b_n_from_euler(&sdins_core::math::Euler {

@@ -1,5 +1,5 @@
 //! IMU error models: the sensor-error terms of docs/theory/imu-errors.md applied to exact
-//! body-frame increments, sensor-grade presets (spec §4.5) and a reproducible,
+//! body-frame increments, sensor-grade presets (docs/imu-errors.md §"Grades") and a reproducible,
 //! stateful corruption of an increment stream.
 //!
 //! * [`ImuErrorModel`]: every term, per axis, in datasheet units (°/h, °/√h, μg,
@@ -63,15 +63,16 @@ use serde::{Deserialize, Serialize};
 pub const DEG: f64 = core::f64::consts::PI / 180.0;
 /// Units: 1 °/h in rad/s.
 pub const DPH: f64 = DEG / 3600.0;
-/// Units: 1 °/√h in rad/√s (spec §0.4: 2.9089e-4).
+/// Units: 1 °/√h in rad/√s (docs/theory/error-analysis.md §"Constants and units": 2.9089e-4).
 pub const DPSH: f64 = DEG / 60.0;
 /// Units: 1 °/h/√h in rad/s/√s.
 pub const DPHPSH: f64 = DPH / 60.0;
-/// Standard gravity for μg and g conversions \[m/s²\] (spec §0.4).
+/// Standard gravity for μg and g conversions \[m/s²\] (docs/theory/error-analysis.md
+/// §"Constants and units").
 pub const G0: f64 = 9.80665;
 /// Units: 1 μg in m/s².
 pub const UG: f64 = 1e-6 * G0;
-/// Units: 1 μg/√Hz in m/s/√s (spec §0.4).
+/// Units: 1 μg/√Hz in m/s/√s (docs/theory/error-analysis.md §"Constants and units").
 pub const UG_PER_SQRT_HZ: f64 = UG;
 /// Units: 1 m/s/√h in m/s/√s.
 pub const MPS_PER_SQRT_H: f64 = 1.0 / 60.0;
@@ -433,7 +434,8 @@ mod tests {
 
     #[test]
     fn units_match_spec_table() {
-        // spec §0.4: 1 °/√h = 2.9089e-4 rad/√s, 1 °/h = 4.8481368e-6 rad/s,
+        // docs/theory/error-analysis.md §"Constants and units": 1 °/√h = 2.9089e-4 rad/√s, 1 °/h =
+        // 4.8481368e-6 rad/s,
         // 1 μg/√Hz = 5.88e-4 m/s/√h
         assert!((DPSH - 2.9089e-4).abs() < 1e-8);
         assert!((DPH - 4.8481368e-6).abs() < 1e-13);

@@ -1,14 +1,14 @@
-//! Sensor-grade presets (spec `alignment_and_errors.md` §4.5).
+//! Sensor-grade presets (docs/imu-errors.md §"Grades").
 //!
-//! Source of the table: spec §4.5, which quotes \[P2\] (Ko, Lee, Park, Kim & Song,
+//! Sources of the table: \[P2\] (Ko, Lee, Park, Kim & Song,
 //! "Analysis of SDINS Performance According to Schuler Period Error Effect") for the
 //! bias ranges and Groves, *Principles of GNSS, Inertial, and Multisensor Integrated
 //! Navigation Systems* (2nd ed.), Tables 4.1/4.2, for the typical biases. The noise
-//! values of aviation, tactical and consumer (**bold** in the spec) are those of the
+//! values of aviation, tactical and consumer (the published ones) are those of the
 //! IMU-error presets in the public companion simulation code of Groves' book; the
-//! **marine and intermediate noise values are engineering interpolations** (spec
-//! §4.5: "assumed"), not published figures. Groves' bias columns are quoted by the
-//! spec from memory of the 2nd edition.
+//! **marine and intermediate noise values are engineering interpolations** ("assumed"),
+//! not published figures. Groves' bias columns are the commonly quoted values of the 2nd
+//! edition.
 //!
 //! **This is the only grade table in sdins** ([`GRADES`]): scenario presets (`grade =`),
 //! `sdins errors --grade`, the Monte Carlo and the tests all read it. Its Markdown form is in
@@ -17,11 +17,11 @@
 //! | grade | accel bias (turn-on σ) | gyro bias (turn-on σ) | VRW | ARW | note |
 //! |---|---|---|---|---|---|
 //! | `ideal` | 0 | 0 | 0 | 0 | every term off |
-//! | `marine` | 10 μg | 0.001 °/h | 15 μg/√Hz | 0.0015 °/√h | noise interpolated (spec: ≈10–20 μg/√Hz, ≤0.001–0.002 °/√h) |
+//! | `marine` | 10 μg | 0.001 °/h | 15 μg/√Hz | 0.0015 °/√h | noise interpolated (between ≈10–20 μg/√Hz, ≤0.001–0.002 °/√h) |
 //! | `aviation` | 50 μg | 0.01 °/h | 20 μg/√Hz | 0.002 °/√h | bias within 30–100 μg; noise from Groves' code |
-//! | `intermediate` | 300 μg | 0.1 °/h | 50 μg/√Hz | 0.007 °/√h | bias within 100–1000 μg; noise interpolated (spec: "assumed") |
+//! | `intermediate` | 300 μg | 0.1 °/h | 50 μg/√Hz | 0.007 °/√h | bias within 100–1000 μg; noise interpolated ("assumed") |
 //! | `tactical` | 1000 μg | 10 °/h | 100 μg/√Hz | 0.01 °/√h | bias within 1–10 mg, 1–100 °/h; noise from Groves' code |
-//! | `consumer` | 10 000 μg | 100 °/h | 1000 μg/√Hz | 1 °/√h | bias at the spec's "> 3–10 mg", "> 100 °/h"; noise from Groves' code |
+//! | `consumer` | 10 000 μg | 100 °/h | 1000 μg/√Hz | 1 °/√h | bias at the quoted "> 3–10 mg", "> 100 °/h"; noise from Groves' code |
 //!
 //! Each grade of \[P2\] also carries the paper's own bias box ([`P2Box`]): the ranges the
 //! paper sweeps for its Schuler-share table. That is a deliberate second column, not a
@@ -32,7 +32,7 @@
 //!
 //! The biases are run-to-run **turn-on σ**'s ([`ImuErrorModel::gyro_bias_turn_on_dph`],
 //! [`ImuErrorModel::accel_bias_turn_on_ug`]): each run draws its own bias. Where the
-//! spec gives a range, the value picked inside it is this module's choice. Presets set
+//! sources give a range, the value picked inside it is this module's choice. Presets set
 //! no scale factor, misalignment, bias instability, quantization or saturation (the
 //! table has none); add them with [`ImuErrorModel::with_overrides`] or struct update:
 //!
@@ -46,7 +46,8 @@ use super::{ImuErrorModel, ImuErrorModelError, DEG, UG};
 use serde::Serialize;
 
 /// \[P2\]'s grade box of one grade: the bias ranges and Schuler-share range the paper
-/// reports (spec §4.4). These are the *paper's* boxes, used only to reproduce its Schuler
+/// reports (docs/theory/error-analysis.md §"The Schuler share"). These are the *paper's* boxes,
+/// used only to reproduce its Schuler
 /// share table (`sdins errors --schuler-share`); they are not a second set of sensor values
 /// (a grade's sensor is the row's turn-on biases and noise).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -73,7 +74,7 @@ pub struct Grade {
     pub accel_vrw_ugpsqrthz: f64,
     /// angle random walk \[°/√h\]
     pub gyro_arw_dpsh: f64,
-    /// true when the noise values are the spec's engineering interpolation
+    /// true when the noise values are an engineering interpolation
     pub noise_interpolated: bool,
     /// \[P2\]'s box for this grade, if the paper has one
     pub p2: Option<P2Box>,

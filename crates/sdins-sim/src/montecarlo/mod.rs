@@ -7,8 +7,9 @@
 //!   ([`crate::imu_error::ImuErrorState`]), navigates with one algorithm (default
 //!   `songlee-complete`) and records the errors of [`crate::pipeline::nav_error`] every
 //!   output epoch. Long runs with sensor errors use the vertical channel **held** to the
-//!   truth (the free inertial vertical channel diverges, spec §4.3), so the horizontal
-//!   channels are the ones to compare; the down channels are then zero.
+//!   truth (the free inertial vertical channel diverges, docs/theory/error-analysis.md
+//!   §"Full stationary closed form"), so the horizontal channels are the ones to compare; the down
+//!   channels are then zero.
 //! * Channels ([`CHANNELS`]): position error N, E, D \[m\], velocity error N, E, D \[m/s\],
 //!   attitude error ε N, E, D \[rad\] (convention G, `C_alg C_trueᵀ = I + [ε×]`).
 //! * Statistics per epoch and channel: mean, sample σ = √(M2/(n − 1)), and the 5/50/95 %

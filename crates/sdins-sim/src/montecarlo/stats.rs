@@ -8,7 +8,6 @@
 use super::state::McState;
 use super::{CHANNELS, N_CHANNELS};
 use serde::Serialize;
-use std::fmt::Write;
 
 /// Statistics of one channel at one epoch.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -73,26 +72,34 @@ impl McState {
 
 impl McStats {
     /// CSV text: `t_s` then `<channel>_{mean,sigma,p05,p50,p95}` for every channel;
-    /// numbers in Rust's shortest round-trip form (so equal files ⇔ equal bits).
+    /// written by the csv crate, numbers in their shortest round-trip form (so equal files
+    /// ⇔ equal bits).
     pub fn to_csv(&self) -> String {
-        let mut s = String::new();
-        s.push_str(
+        let mut out = String::from(
             "# sdins Monte Carlo statistics; errors = algorithm - truth (NED); attitude: C_alg C_true^T = I + [eps x] (rad); sigma = sqrt(M2/(n-1)); percentiles nearest-rank on log bins (1.16 % rel.)\n",
         );
-        s.push_str("t_s");
+        let mut header = vec!["t_s".to_string()];
         for c in CHANNELS {
             for k in ["mean", "sigma", "p05", "p50", "p95"] {
-                let _ = write!(s, ",{c}_{k}");
+                header.push(format!("{c}_{k}"));
             }
         }
-        s.push('\n');
+        let mut w = csv::WriterBuilder::new()
+            .has_headers(false)
+            .from_writer(Vec::new());
+        // in memory, every record of the header's length: cannot fail
+        let _ = w.write_record(&header);
         for (t, row) in self.times_s.iter().zip(&self.cells) {
-            let _ = write!(s, "{t}");
+            let mut rec = Vec::with_capacity(1 + 5 * row.len());
+            rec.push(*t);
             for c in row {
-                let _ = write!(s, ",{},{},{},{},{}", c.mean, c.sigma, c.p05, c.p50, c.p95);
+                rec.extend([c.mean, c.sigma, c.p05, c.p50, c.p95]);
             }
-            s.push('\n');
+            let _ = w.serialize(&rec);
         }
-        s
+        if let Ok(bytes) = w.into_inner() {
+            out.push_str(&String::from_utf8_lossy(&bytes));
+        }
+        out
     }
 }
