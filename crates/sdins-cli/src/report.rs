@@ -200,6 +200,52 @@ pub fn write_run_toml(dir: &Path, fields: toml::Table) -> Result<(), CliError> {
     crate::output::write_string(&dir.join("run.toml"), &text)
 }
 
+/// Print what each `random_vibration` overlay realised and dropped (stderr).
+pub fn print_vibration(scn: &sdins_sim::scenario::Scenario) {
+    for r in &scn.vibration {
+        eprintln!("{}", r.summary());
+    }
+}
+
+/// The `random_vibration` overlays' power bookkeeping for `run.toml`: one table per overlay
+/// with `components`, `df_hz` and per quantity (`accel` (m/s²)², `gyro` (rad/s)²) the
+/// per-axis `[x, y, z]` arrays of specified, realised and dropped power.
+pub fn vibration_toml(scn: &sdins_sim::scenario::Scenario) -> Option<toml::Value> {
+    if scn.vibration.is_empty() {
+        return None;
+    }
+    let list = scn
+        .vibration
+        .iter()
+        .map(|r| {
+            let mut t = toml::Table::new();
+            t.insert("components".into(), (r.components as i64).into());
+            t.insert("df_hz".into(), r.df_hz.into());
+            for (name, p) in [("accel", &r.accel), ("gyro", &r.gyro)] {
+                let Some(p) = p else { continue };
+                let mut q = toml::Table::new();
+                let arr = |f: &dyn Fn(&sdins_sim::random_vibration::AxisPower) -> f64| {
+                    toml::Value::Array(p.iter().map(|a| toml::Value::from(f(a))).collect())
+                };
+                q.insert("specified".into(), arr(&|a| a.specified));
+                q.insert("realised".into(), arr(&|a| a.realised));
+                q.insert("dropped_dc".into(), arr(&|a| a.dropped_dc));
+                q.insert(
+                    "dropped_above_nyquist".into(),
+                    arr(&|a| a.dropped_above_nyquist),
+                );
+                q.insert(
+                    "dropped_below_threshold".into(),
+                    arr(&|a| a.dropped_below_threshold),
+                );
+                t.insert(name.into(), q.into());
+            }
+            toml::Value::Table(t)
+        })
+        .collect();
+    Some(toml::Value::Array(list))
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {

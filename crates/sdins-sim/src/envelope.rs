@@ -18,8 +18,11 @@
 //! integrated from the NED velocity with the trapezoidal rule (dL/dt = v_N/(R_M + h),
 //! dh/dt = −v_D, Groves eq. 5.44), whose error over the grid is far below the limits' scale.
 //! Time enters only through `t`, so the check is independent of how the truth is chunked.
+//! Random vibration ([`crate::random_vibration`]) is part of the kinematics and so of the
+//! check; on the grid its component phases advance by a rotation per step
+//! ([`Trajectory::phases_advance`]), which agrees with the direct evaluation to rounding.
 
-use crate::trajectory::Trajectory;
+use crate::trajectory::{OverlayPhases, Trajectory};
 use sdins_core::earth::EarthModel;
 use std::f64::consts::PI;
 
@@ -235,8 +238,26 @@ pub fn check_trajectory(
         segment: traj.segment_at(t),
         overlays: overlays_at(t),
     };
-    let check_point = |t: f64, t_sel: f64, rep: &mut EnvelopeReport| {
-        let k = traj.kinematics(t, t_sel);
+    // random vibration: thousands of components, whose phases on the grid advance by one
+    // rotation per step instead of a sin/cos each (Trajectory::phases_advance)
+    let phased = !traj.random_vibrations().is_empty();
+    let mut ph = OverlayPhases::default();
+    let mut ph_next = OverlayPhases::default();
+    let mut ph_step = OverlayPhases::default();
+    let mut ph_zero = OverlayPhases::default();
+    if phased {
+        traj.phases_at(0.0, &mut ph);
+        traj.phases_offset(h, &mut ph_step);
+        traj.phases_offset(0.0, &mut ph_zero);
+    }
+    let check_point = |t: f64,
+                       t_sel: f64,
+                       phases: Option<(&OverlayPhases, &OverlayPhases)>,
+                       rep: &mut EnvelopeReport| {
+        let k = match phases {
+            Some((b, z)) => traj.kinematics_phased(t, 0.0, t_sel, b, z),
+            None => traj.kinematics(t, t_sel),
+        };
         rep.evaluations += 1;
         let finite = k.v_n_mps.iter().all(|x| x.is_finite())
             && k.v_dot_n_mps2.iter().all(|x| x.is_finite())
@@ -283,16 +304,23 @@ pub fn check_trajectory(
         Ok(k.v_n_mps)
     };
     for &(t, t_sel) in &extra {
-        check_point(t, t_sel, &mut rep)?;
+        check_point(t, t_sel, None, &mut rep)?;
     }
     // grid with position integration
     let (mut lat, mut hgt) = (start.lat_rad, start.h_m);
-    let mut v_prev = check_point(0.0, 0.0, &mut rep)?;
+    let mut v_prev = check_point(0.0, 0.0, None, &mut rep)?;
     for i in 1..=n_grid {
         let t = if i == n_grid { dur } else { i as f64 * h };
         // the last point belongs to the last segment's branch
         let t_sel = if i == n_grid { t - 0.5 * h } else { t };
-        let v = check_point(t, t_sel, &mut rep)?;
+        let phases = if phased && i < n_grid {
+            traj.phases_advance(&ph, &ph_step, t, &mut ph_next);
+            std::mem::swap(&mut ph, &mut ph_next);
+            Some((&ph, &ph_zero))
+        } else {
+            None
+        };
+        let v = check_point(t, t_sel, phases, &mut rep)?;
         let r_m = earth.radii(lat).r_m_m;
         lat += 0.5 * h * (v_prev.x + v.x) / (r_m + hgt);
         hgt -= 0.5 * h * (v_prev.z + v.z);

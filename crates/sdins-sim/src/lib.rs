@@ -65,6 +65,7 @@ pub mod montecarlo;
 pub mod nav_recorded;
 pub mod navego_params;
 pub mod pipeline;
+pub mod random_vibration;
 pub mod run_setup;
 pub mod scenario;
 pub mod smoother;

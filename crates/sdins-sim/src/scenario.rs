@@ -124,6 +124,11 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "angle_deg",
             "start_s",
             "end_s",
+            "accel_psd_file",
+            "gyro_psd_file",
+            "accel_psd_breakpoints",
+            "gyro_psd_breakpoints",
+            "seed",
         ],
     ),
     GNSS_KEYS,
@@ -263,6 +268,11 @@ struct OverlayDoc {
     angle_deg: Option<S<f64>>,
     start_s: Option<S<f64>>,
     end_s: Option<S<f64>>,
+    accel_psd_file: Option<S<String>>,
+    gyro_psd_file: Option<S<String>>,
+    accel_psd_breakpoints: Option<S<Vec<Vec<f64>>>>,
+    gyro_psd_breakpoints: Option<S<Vec<Vec<f64>>>>,
+    seed: Option<S<u64>>,
 }
 
 /// Which earth model a scenario uses.
@@ -375,6 +385,8 @@ pub struct Scenario {
     pub source_toml: String,
     /// sensor placement (`[mounting]`)
     pub mounting: Mounting,
+    /// per `random_vibration` overlay (in order): the power realised and dropped
+    pub vibration: Vec<crate::random_vibration::VibrationReport>,
 }
 
 struct Ctx<'a> {
@@ -925,9 +937,27 @@ impl Scenario {
         let total: f64 = motions.iter().map(|m| m.1).sum();
 
         let mut overlays = Vec::new();
-        for o in &doc.overlay {
+        let mut vib_list = Vec::new();
+        let mut vib_reports = Vec::new();
+        for (oi, o) in doc.overlay.iter().enumerate() {
             let od = o.get_ref();
             let kind = od.kind.get_ref().as_str();
+            let rv_keys = [
+                od.accel_psd_file.as_ref().map(|v| v.span()),
+                od.gyro_psd_file.as_ref().map(|v| v.span()),
+                od.accel_psd_breakpoints.as_ref().map(|v| v.span()),
+                od.gyro_psd_breakpoints.as_ref().map(|v| v.span()),
+                od.seed.as_ref().map(|v| v.span()),
+            ];
+            if kind != "random_vibration" {
+                if let Some(span) = rv_keys.iter().flatten().next() {
+                    return cx.err(
+                        span.clone(),
+                        "overlay",
+                        format!("a PSD or seed key belongs to overlay type `random_vibration`, not `{kind}`"),
+                    );
+                }
+            }
             let need_pos = |v: &Option<S<f64>>, key: &str| -> Result<f64, ScenarioError> {
                 match v {
                     Some(v) => cx.positive(v, key),
@@ -963,6 +993,26 @@ impl Scenario {
                     "overlay.angle_deg",
                     format!("angle_deg belongs to overlay type `rotation`, not `{kind}`"),
                 );
+            }
+            let (start_s, end_s) = overlay_window(&cx, od, total)?;
+            if kind == "random_vibration" {
+                let (rv, rep) = parse_random_vibration(
+                    &cx,
+                    o,
+                    file,
+                    rate_hz,
+                    im.seed.unwrap_or(1),
+                    end_s.min(total) - start_s,
+                    oi as u64,
+                )?;
+                overlays.push(Overlay {
+                    kind: OverlayKind::RandomVibration { id: vib_list.len() },
+                    start_s,
+                    end_s,
+                });
+                vib_list.push(rv);
+                vib_reports.push(rep);
+                continue;
             }
             let freq = need_pos(&od.freq_hz, "overlay.freq_hz")?;
             if freq > 0.5 * rate_hz {
@@ -1029,28 +1079,8 @@ impl Scenario {
                     }
                 }
                 other => {
-                    return cx.err(od.kind.span(), "overlay.type", format!("unknown overlay type `{other}`: expected coning, sculling, vibration, sway or rotation"));
+                    return cx.err(od.kind.span(), "overlay.type", format!("unknown overlay type `{other}`: expected coning, sculling, vibration, sway, random_vibration or rotation"));
                 }
-            };
-            let start_s = match &od.start_s {
-                Some(v) => cx.range(
-                    v,
-                    "overlay.start_s",
-                    0.0,
-                    total,
-                    "a time within the scenario",
-                )?,
-                None => 0.0,
-            };
-            let end_s = match &od.end_s {
-                Some(v) => cx.range(
-                    v,
-                    "overlay.end_s",
-                    start_s,
-                    f64::INFINITY,
-                    "a time after start_s",
-                )?,
-                None => f64::INFINITY,
             };
             overlays.push(Overlay {
                 kind: k,
@@ -1062,7 +1092,8 @@ impl Scenario {
         if let Some(sched) = &calibration {
             overlays.extend(sched.overlays());
         }
-        let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays);
+        let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays)
+            .with_random_vibration(vib_list);
         let trajectory = match trajectory.with_vehicle(vehicle, nav.earth.model(), lat * D2R, h) {
             Ok(t) => t,
             Err(e) => {
@@ -1135,6 +1166,7 @@ impl Scenario {
             gnss,
             source_toml: text.to_string(),
             mounting,
+            vibration: vib_reports,
         })
     }
 
@@ -1345,6 +1377,129 @@ fn parse_rotation(cx: &Ctx<'_>, o: &S<OverlayDoc>, total: f64) -> Result<Overlay
         );
     }
     Ok(OverlayKind::rotation(axis, angle * D2R, start_s, end_s))
+}
+
+/// `start_s`/`end_s` of an overlay (defaults 0 and ∞).
+fn overlay_window(cx: &Ctx<'_>, od: &OverlayDoc, total: f64) -> Result<(f64, f64), ScenarioError> {
+    let start_s = match &od.start_s {
+        Some(v) => cx.range(
+            v,
+            "overlay.start_s",
+            0.0,
+            total,
+            "a time within the scenario",
+        )?,
+        None => 0.0,
+    };
+    let end_s = match &od.end_s {
+        Some(v) => cx.range(
+            v,
+            "overlay.end_s",
+            start_s,
+            f64::INFINITY,
+            "a time after start_s",
+        )?,
+        None => f64::INFINITY,
+    };
+    Ok((start_s, end_s))
+}
+
+/// A `random_vibration` overlay: its PSD tables (files relative to the scenario file),
+/// realised over its window ([`crate::random_vibration`]).
+fn parse_random_vibration(
+    cx: &Ctx<'_>,
+    o: &S<OverlayDoc>,
+    file: &str,
+    rate_hz: f64,
+    imu_seed: u64,
+    window_s: f64,
+    index: u64,
+) -> Result<
+    (
+        crate::random_vibration::RandomVibration,
+        crate::random_vibration::VibrationReport,
+    ),
+    ScenarioError,
+> {
+    use crate::random_vibration::{PsdTable, RandomVibration, RandomVibrationSpec};
+    let od = o.get_ref();
+    for (k, v) in [
+        ("overlay.axis", od.axis.as_ref().map(|v| v.span())),
+        ("overlay.freq_hz", od.freq_hz.as_ref().map(|v| v.span())),
+        (
+            "overlay.half_angle_deg",
+            od.half_angle_deg.as_ref().map(|v| v.span()),
+        ),
+        (
+            "overlay.angle_amp_deg",
+            od.angle_amp_deg.as_ref().map(|v| v.span()),
+        ),
+        (
+            "overlay.accel_amp_mps2",
+            od.accel_amp_mps2.as_ref().map(|v| v.span()),
+        ),
+        ("overlay.phase_deg", od.phase_deg.as_ref().map(|v| v.span())),
+    ] {
+        if let Some(span) = v {
+            return cx.err(
+                span,
+                k,
+                "not a key of overlay type `random_vibration` (its spectrum comes from the PSD keys)",
+            );
+        }
+    }
+    let base = Path::new(file).parent().unwrap_or(Path::new(""));
+    let table = |path: &Option<S<String>>,
+                 bp: &Option<S<Vec<Vec<f64>>>>,
+                 what: &str|
+     -> Result<Option<PsdTable>, ScenarioError> {
+        let fkey = format!("overlay.{what}_psd_file");
+        let bkey = format!("overlay.{what}_psd_breakpoints");
+        match (path, bp) {
+            (Some(p), Some(_)) => cx.err(
+                p.span(),
+                &fkey,
+                format!("give either {fkey} or {bkey}, not both"),
+            ),
+            (Some(p), None) => {
+                let full = base.join(p.get_ref());
+                PsdTable::read_csv(&full)
+                    .map(Some)
+                    .or_else(|e| cx.err(p.span(), &fkey, e.to_string()))
+            }
+            (None, Some(b)) => PsdTable::from_breakpoints(b.get_ref(), &bkey)
+                .map(Some)
+                .or_else(|e| {
+                    let msg = match e {
+                        crate::random_vibration::PsdError::Invalid {
+                            line,
+                            column,
+                            message,
+                            ..
+                        } => format!("breakpoint {line}, entry {column}: {message}"),
+                        other => other.to_string(),
+                    };
+                    cx.err(b.span(), &bkey, msg)
+                }),
+            (None, None) => Ok(None),
+        }
+    };
+    let accel = table(&od.accel_psd_file, &od.accel_psd_breakpoints, "accel")?;
+    let gyro = table(&od.gyro_psd_file, &od.gyro_psd_breakpoints, "gyro")?;
+    if accel.is_none() && gyro.is_none() {
+        return cx.err(
+            o.span(),
+            "overlay",
+            "a random_vibration overlay needs accel_psd_file, accel_psd_breakpoints, gyro_psd_file or gyro_psd_breakpoints",
+        );
+    }
+    let spec = RandomVibrationSpec {
+        accel,
+        gyro,
+        seed: od.seed.as_ref().map_or(imu_seed, |s| *s.get_ref()),
+    };
+    RandomVibration::realise(&spec, window_s, 0.5 * rate_hz, index)
+        .or_else(|m| cx.err(o.span(), "overlay", m))
 }
 
 fn parse_mounting(cx: &Ctx<'_>, m: Option<&S<MountingDoc>>) -> Result<Mounting, ScenarioError> {

@@ -7,12 +7,14 @@
 //! values (flat turns, as in the papers' scenarios). Overlays add body coning, sculling
 //! and vibration on top.
 
+use crate::random_vibration::RandomVibration;
 use crate::vehicle::{
     aircraft_attitude, car_attitude, velocity_derivs, Track, Vehicle, VehicleError,
 };
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Mat3, Quat, Vec3};
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// A motion segment (one of the `[[segment]]` tables of a scenario).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -202,6 +204,14 @@ pub enum OverlayKind {
         /// `Ω = 2π/T` of the window \[rad/s\] (set by [`OverlayKind::rotation`])
         omega_rps: f64,
     },
+    /// random vibration from a PSD ([`crate::random_vibration`]): linear along the nominal
+    /// body axes (as [`OverlayKind::Vibration`]), angular as rotations about the body
+    /// axes composed `R_x(θ_x) R_y(θ_y) R_z(θ_z)` (as [`OverlayKind::Sway`]); `id` indexes
+    /// the realisations given to [`Trajectory::with_random_vibration`]
+    RandomVibration {
+        /// index into the trajectory's realisations
+        id: usize,
+    },
 }
 
 impl OverlayKind {
@@ -213,6 +223,8 @@ impl OverlayKind {
             | OverlayKind::Vibration { omega_rps, .. }
             | OverlayKind::Sway { omega_rps, .. }
             | OverlayKind::Rotation { omega_rps, .. } => omega_rps,
+            // many frequencies: their phases follow the overlay phases
+            OverlayKind::RandomVibration { .. } => 0.0,
         }
     }
 
@@ -291,6 +303,11 @@ pub struct Trajectory {
     track: Option<Box<Track>>,
     /// aircraft: sin/cos of the angle of attack
     sc_alpha: (f64, f64),
+    /// random-vibration realisations ([`OverlayKind::RandomVibration`])
+    random: Vec<Arc<RandomVibration>>,
+    /// per overlay: where its component phases start in [`OverlayPhases`] (after the one
+    /// phase per overlay), for random-vibration overlays
+    rv_offset: Vec<usize>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -492,7 +509,59 @@ impl Trajectory {
             vehicle: Vehicle::Free,
             track: None,
             sc_alpha: (0.0, 1.0),
+            random: Vec::new(),
+            rv_offset: Vec::new(),
         }
+    }
+
+    /// Attach the realisations that the [`OverlayKind::RandomVibration`] overlays index
+    /// (each overlay's state is frozen at its window end, clipped to the duration).
+    /// Panics never: an overlay whose `id` has no realisation stays at rest.
+    pub fn with_random_vibration(mut self, list: Vec<RandomVibration>) -> Self {
+        let mut list = list;
+        for o in &self.overlays {
+            if let OverlayKind::RandomVibration { id } = o.kind {
+                if let Some(rv) = list.get_mut(id) {
+                    rv.freeze_at(o.end_s.min(self.duration_s) - o.start_s);
+                }
+            }
+        }
+        self.random = list.into_iter().map(Arc::new).collect();
+        let mut off = self.overlays.len();
+        self.rv_offset = self
+            .overlays
+            .iter()
+            .map(|o| {
+                let here = off;
+                if let OverlayKind::RandomVibration { id } = o.kind {
+                    off += self.random.get(id).map_or(0, |r| r.len());
+                }
+                here
+            })
+            .collect();
+        self
+    }
+
+    /// The random-vibration realisations.
+    pub fn random_vibrations(&self) -> &[Arc<RandomVibration>] {
+        &self.random
+    }
+
+    fn rv_of(&self, kind: &OverlayKind) -> Option<&RandomVibration> {
+        match kind {
+            OverlayKind::RandomVibration { id } => self.random.get(*id).map(|r| r.as_ref()),
+            _ => None,
+        }
+    }
+
+    /// The Gauss-panel count the random vibrations need at `dt_s`
+    /// ([`RandomVibration::gauss_panels`]; 0: one 3-node panel suffices).
+    pub fn random_vibration_panels(&self, dt_s: f64) -> usize {
+        self.random
+            .iter()
+            .map(|r| r.gauss_panels(dt_s))
+            .max()
+            .unwrap_or(0)
     }
 
     /// The same motion flown or driven by `vehicle` ([`crate::vehicle`]): the attitude
@@ -589,6 +658,8 @@ impl Trajectory {
                 omega_rps,
                 ..
             } => omega_rps.max(omega_rps * angle_rad.abs() / PI),
+            // resolved by amplitude: `Trajectory::random_vibration_panels`
+            OverlayKind::RandomVibration { .. } => 0.0,
         });
         seg.chain(ov).fold(0.0, f64::max)
     }
@@ -636,6 +707,45 @@ impl Trajectory {
                 .iter()
                 .map(|o| (o.kind.omega_rps() * (t_base - o.start_s)).sin_cos()),
         );
+        for o in &self.overlays {
+            if let Some(rv) = self.rv_of(&o.kind) {
+                rv.push_phases(t_base - o.start_s, &mut out.0);
+            }
+        }
+    }
+
+    /// The phases at `t_base` from those of an earlier time `prev` and the phases `step`
+    /// of the time step ([`Trajectory::phases_offset`]): the periodic overlays as
+    /// [`Trajectory::phases_at`], the random-vibration components by the rotation
+    /// `(sin, cos)(φ + δ)` from `(sin, cos) φ` and `δ` (renormalised to unit length to
+    /// first order), which is what keeps thousands of components cheap per sample.
+    pub fn phases_advance(
+        &self,
+        prev: &OverlayPhases,
+        step: &OverlayPhases,
+        t_base: f64,
+        out: &mut OverlayPhases,
+    ) {
+        let n = self.overlays.len();
+        if prev.0.len() != step.0.len() || prev.0.len() <= n {
+            return self.phases_at(t_base, out);
+        }
+        out.0.clear();
+        out.0.extend(
+            self.overlays
+                .iter()
+                .map(|o| (o.kind.omega_rps() * (t_base - o.start_s)).sin_cos()),
+        );
+        out.0.extend(
+            prev.0[n..]
+                .iter()
+                .zip(&step.0[n..])
+                .map(|(&(sp, cp), &(ss, cs))| {
+                    let (s, c) = (sp * cs + cp * ss, cp * cs - sp * ss);
+                    let r = 1.5 - 0.5 * (s * s + c * c);
+                    (s * r, c * r)
+                }),
+        );
     }
 
     /// `(sin, cos)` of `Ω_k·off` for every overlay `k` into `out`: the per-node part of
@@ -647,6 +757,11 @@ impl Trajectory {
                 .iter()
                 .map(|o| (o.kind.omega_rps() * off).sin_cos()),
         );
+        for o in &self.overlays {
+            if let Some(rv) = self.rv_of(&o.kind) {
+                rv.push_phases(off, &mut out.0);
+            }
+        }
     }
 
     /// Exact kinematics at time `t`, with the analytic branch selected by `t_sel`
@@ -677,8 +792,8 @@ impl Trajectory {
         base: &OverlayPhases,
         offset: &OverlayPhases,
     ) -> Kinematics {
-        debug_assert_eq!(base.0.len(), self.overlays.len());
-        debug_assert_eq!(offset.0.len(), self.overlays.len());
+        debug_assert_eq!(base.0.len(), offset.0.len());
+        debug_assert!(base.0.len() >= self.overlays.len());
         self.kinematics_impl(t_base, off, t_sel, Some((&base.0, &offset.0)))
     }
 
@@ -840,6 +955,43 @@ impl Trajectory {
                         angle_rad
                     };
                     (axis_rotation(axis, theta.sin_cos()), w)
+                }
+                OverlayKind::RandomVibration { .. } => {
+                    let Some(rv) = self.rv_of(&ov.kind) else {
+                        continue;
+                    };
+                    let st = if active {
+                        let ph = phases.map(|(b, o)| {
+                            let a = self.rv_offset[j];
+                            (&b[a..a + rv.len()], &o[a..a + rv.len()])
+                        });
+                        rv.state(tau_base + tau_off, ph)
+                    } else if t_sel < ov.start_s {
+                        crate::random_vibration::VibState::default()
+                    } else {
+                        rv.frozen(tau_base)
+                    };
+                    let u = Vec3::from(st.u);
+                    let u_dot = Vec3::from(st.u_dot);
+                    v += c_nom * u;
+                    v_dot += c_nom * (w_nom.cross(&u) + u_dot);
+                    if !rv.has_rotation() {
+                        (Mat3::identity(), Vec3::zeros())
+                    } else {
+                        let [tx, ty, tz] = st.theta;
+                        let (sx, cx) = tx.sin_cos();
+                        let (sy, cy) = ty.sin_cos();
+                        let (sz, cz) = tz.sin_cos();
+                        let rx = Mat3::new(1.0, 0.0, 0.0, 0.0, cx, -sx, 0.0, sx, cx);
+                        let ry = Mat3::new(cy, 0.0, sy, 0.0, 1.0, 0.0, -sy, 0.0, cy);
+                        let rz = Mat3::new(cz, -sz, 0.0, sz, cz, 0.0, 0.0, 0.0, 1.0);
+                        // ω = R_zᵀR_yᵀ θ̇_x e_x + R_zᵀ θ̇_y e_y + θ̇_z e_z
+                        let [dx, dy, dz] = st.theta_dot;
+                        let w = rz.transpose()
+                            * (ry.transpose() * Vec3::new(dx, 0.0, 0.0) + Vec3::new(0.0, dy, 0.0))
+                            + Vec3::new(0.0, 0.0, dz);
+                        (rx * ry * rz, w)
+                    }
                 }
             };
             // compose: C_c ← C_c C_k, ω_c ← C_kᵀ ω_c + ω_k (the first directly: the

@@ -211,6 +211,9 @@ pub struct TruthGenerator<'a> {
     ph_tmp: [OverlayPhases; 4],
     /// phases of offset 0
     ph_zero: OverlayPhases,
+    /// phases of offset δt: the sample-to-sample rotation of the random-vibration
+    /// components ([`Trajectory::phases_advance`])
+    ph_step: OverlayPhases,
     /// `(L, sin L, cos L)` of the last latitude whose sin/cos was taken (the sample-end
     /// latitude is the next panel's start latitude)
     lat_sc: (f64, f64, f64),
@@ -438,11 +441,13 @@ impl<'a> TruthGenerator<'a> {
             ph_nodes: Vec::new(),
             ph_tmp: Default::default(),
             ph_zero: OverlayPhases::default(),
+            ph_step: OverlayPhases::default(),
             lat_sc: (f64::NAN, 0.0, 1.0),
             mount: None,
             w_ib_prev: None,
         };
         traj.phases_offset(0.0, &mut g.ph_zero);
+        traj.phases_offset(cfg.dt_s, &mut g.ph_step);
         // node offsets of the regular panel layout, formed as in `sample_gauss`
         let (nodes, panels) = gauss_layout(cfg.substeps);
         let hp = cfg.dt_s / panels as f64;
@@ -850,7 +855,15 @@ impl Iterator for TruthGenerator<'_> {
                 // attitude and velocity at the sample end are analytic (branch of the
                 // last substep); its overlay phases are the next sample's base phases
                 let t_sel = t1 - 0.25 * dt / self.cfg.substeps.max(1) as f64;
-                self.traj.phases_at(t1, &mut self.ph_end);
+                // the random-vibration phases advance by one rotation per sample from
+                // the sample start's (the same values the increments used), the others
+                // are evaluated at t1
+                if self.ph_base_t.to_bits() == t0.to_bits() {
+                    self.traj
+                        .phases_advance(&self.ph_base, &self.ph_step, t1, &mut self.ph_end);
+                } else {
+                    self.traj.phases_at(t1, &mut self.ph_end);
+                }
                 let kin = self
                     .traj
                     .kinematics_phased(t1, 0.0, t_sel, &self.ph_end, &self.ph_zero);
@@ -892,10 +905,18 @@ impl Iterator for TruthGenerator<'_> {
 /// 0.5° coning at 100 Hz this is 4.5e-17 rad with 16 substeps and 2.8e-18 rad with 32.
 /// Rounded up to a power of two. The default Gauss scheme uses one 3-node panel for 16 and
 /// `substeps/32` 4-node panels above, i.e. at most 0.032 rad (3 nodes) or 0.064 rad (4 nodes)
-/// of the fastest motion per panel ([`TruthScheme::Gauss`]).
+/// of the fastest motion per panel ([`TruthScheme::Gauss`]). Random vibration, whose
+/// components reach the Nyquist frequency with tiny amplitudes, is resolved instead by its
+/// amplitude-weighted Gauss remainder ([`crate::random_vibration::RandomVibration::gauss_panels`]:
+/// at most 1e-17 m/s and 1e-19 rad per sample).
 pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
     let w_max = traj.max_frequency_rps();
-    let need = (dt_s * w_max / 2e-3).ceil().clamp(16.0, 4096.0) as usize;
+    let mut need = (dt_s * w_max / 2e-3).ceil().clamp(16.0, 4096.0) as usize;
+    // random vibration: by the amplitude-weighted Gauss remainder of its components
+    let panels = traj.random_vibration_panels(dt_s);
+    if panels > 0 {
+        need = need.max(32 * panels).min(4096);
+    }
     need.next_power_of_two()
 }
 

@@ -212,6 +212,7 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
 /// Run, write the CSV files, the report and run.toml, and return everything.
 pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     let scn = Scenario::load(&args.scenario)?;
+    crate::report::print_vibration(&scn);
     let algos = algorithms(args, &scn)?;
     if algos.is_empty() {
         return Err(CliError::bad("--algo: no algorithm given"));
@@ -388,6 +389,9 @@ fn write_run_toml(out: &std::path::Path, scn: &Scenario, args: &Args) -> Result<
     );
     t.insert("plot_scale".into(), args.plot_scale.name().into());
     t.insert("scenario".into(), scn.source_toml.clone().into());
+    if let Some(v) = crate::report::vibration_toml(scn) {
+        t.insert("random_vibration".into(), v);
+    }
     crate::report::write_run_toml(out, t)
 }
 

@@ -30,6 +30,7 @@ pub struct Args {
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let scn = Scenario::load(&args.scenario)?;
+    crate::report::print_vibration(&scn);
     if args.every == 0 {
         return Err(CliError::bad("--every: must be at least 1"));
     }
