@@ -67,18 +67,27 @@ impl<'a> CsvOut<'a> {
     }
 }
 
-/// Header of the navigation tables `nav_<algo>.csv` of `sdins nav` and `sdins run`.
-pub const NAV_HEADER: [&str; 10] = [
+/// Header of the navigation tables `nav_<algo>.csv` of `sdins nav` and `sdins run`: the
+/// columns of an sdins truth.csv, so either file reads back as a reference trajectory.
+pub const NAV_HEADER: [&str; 10] = sdins_sim::truth_file::SDINS_TRUTH_COLUMNS;
+
+/// Header of `err_<algo>.csv`: `sdins run` writes all 14 columns, `sdins nav` (errors
+/// against a truth file) the first 10.
+pub const ERR_HEADER: [&str; 14] = [
     "t_s",
-    "lat_deg",
-    "lon_deg",
-    "h_m",
-    "v_n_mps",
-    "v_e_mps",
-    "v_d_mps",
-    "roll_deg",
-    "pitch_deg",
-    "yaw_deg",
+    "pos_err_n_m",
+    "pos_err_e_m",
+    "pos_err_d_m",
+    "vel_err_n_mps",
+    "vel_err_e_mps",
+    "vel_err_d_mps",
+    "att_err_n_rad",
+    "att_err_e_rad",
+    "att_err_d_rad",
+    "height_err_m",
+    "roll_err_rad",
+    "pitch_err_rad",
+    "yaw_err_rad",
 ];
 
 /// One record of [`NAV_HEADER`].

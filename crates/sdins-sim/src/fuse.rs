@@ -112,6 +112,13 @@ pub struct ScaleFactorPrior {
 }
 
 impl ScaleFactorPrior {
+    /// The same σ on every axis: `accel_ppm` for the accelerometers, `gyro_ppm` for the gyros.
+    pub fn uniform(accel_ppm: f64, gyro_ppm: f64) -> Self {
+        Self {
+            accel_ppm: [accel_ppm; 3],
+            gyro_ppm: [gyro_ppm; 3],
+        }
+    }
     /// Every σ finite and in \[0, 100 000\] ppm.
     pub fn validate(&self) -> Result<(), FuseError> {
         if self

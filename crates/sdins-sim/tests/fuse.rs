@@ -831,10 +831,7 @@ fn loops_scenario(minutes: u32) -> Scenario {
 
 fn sf_opts(accel_ppm: f64, gyro_ppm: f64) -> FuseOptions {
     FuseOptions {
-        scale_factors: Some(ScaleFactorPrior {
-            accel_ppm: [accel_ppm; 3],
-            gyro_ppm: [gyro_ppm; 3],
-        }),
+        scale_factors: Some(ScaleFactorPrior::uniform(accel_ppm, gyro_ppm)),
         ..no_gate()
     }
 }

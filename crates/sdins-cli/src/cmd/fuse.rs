@@ -166,10 +166,9 @@ pub(crate) fn scale_factor_prior(s: &str) -> Result<sdins_sim::fuse::ScaleFactor
     let v: Vec<&str> = s.split(',').map(str::trim).collect();
     let parsed: Vec<f64> = v.iter().filter_map(|t| t.parse::<f64>().ok()).collect();
     let prior = match parsed[..] {
-        [a, g] if v.len() == 2 && a > 0.0 && g > 0.0 => Some(sdins_sim::fuse::ScaleFactorPrior {
-            accel_ppm: [a; 3],
-            gyro_ppm: [g; 3],
-        }),
+        [a, g] if v.len() == 2 && a > 0.0 && g > 0.0 => {
+            Some(sdins_sim::fuse::ScaleFactorPrior::uniform(a, g))
+        }
         _ => None,
     };
     match prior {

@@ -4,7 +4,7 @@
 
 use super::fuse::Args;
 use super::fuse_report::{ErrRow, FuseReportData, Thin};
-use crate::csv_out::{innovation_row, nav_row, CsvOut, INNOVATION_HEADER};
+use crate::csv_out::{innovation_row, nav_row, CsvOut, INNOVATION_HEADER, NAV_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
@@ -73,18 +73,9 @@ fn err_row(p: &RecordPoint, e: &[f64; 9]) -> ErrRow {
     )
 }
 
-/// Header of nav.csv / smoothed.csv on recorded data: [`crate::csv_out::NAV_HEADER`] and σ.
-const POINT_HEADER: [&str; 19] = [
-    "t_s",
-    "lat_deg",
-    "lon_deg",
-    "h_m",
-    "v_n_mps",
-    "v_e_mps",
-    "v_d_mps",
-    "roll_deg",
-    "pitch_deg",
-    "yaw_deg",
+/// The σ columns that nav.csv / smoothed.csv on recorded data add to
+/// [`crate::csv_out::NAV_HEADER`].
+const SIGMA_HEADER: [&str; 9] = [
     "sigma_n_m",
     "sigma_e_m",
     "sigma_d_m",
@@ -208,9 +199,10 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
     } else {
         None
     };
-    let mut nav_csv = CsvOut::new(&mut nav, &POINT_HEADER)?;
+    let point_header = [NAV_HEADER.as_slice(), &SIGMA_HEADER].concat();
+    let mut nav_csv = CsvOut::new(&mut nav, &point_header)?;
     let mut smo_csv = match smo.as_mut() {
-        Some(f) => Some(CsvOut::new(f, &POINT_HEADER)?),
+        Some(f) => Some(CsvOut::new(f, &point_header)?),
         None => None,
     };
     let mut inn_csv = CsvOut::new(&mut inn, &INNOVATION_HEADER)?;

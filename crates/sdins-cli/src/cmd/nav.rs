@@ -1,6 +1,6 @@
 //! `sdins nav`: run one navigation algorithm over a recorded IMU file.
 
-use crate::csv_out::{nav_row, CsvOut, NAV_HEADER};
+use crate::csv_out::{nav_row, CsvOut, ERR_HEADER, NAV_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_sim::imu_file::{read_imu_file, ImuFormat};
@@ -10,20 +10,6 @@ use sdins_sim::truth_file::read_truth;
 use std::path::PathBuf;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
-
-/// Header of `err_<algo>.csv` (errors against the truth file).
-const ERR_HEADER: [&str; 10] = [
-    "t_s",
-    "pos_err_n_m",
-    "pos_err_e_m",
-    "pos_err_d_m",
-    "vel_err_n_mps",
-    "vel_err_e_mps",
-    "vel_err_d_mps",
-    "att_err_n_rad",
-    "att_err_e_rad",
-    "att_err_d_rad",
-];
 
 /// Arguments of `sdins nav`.
 #[derive(clap::Args, Debug)]
@@ -178,7 +164,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     nav_file.commit()?;
     if truth.is_some() {
         let mut ef = AtomicFile::create(&out.join(format!("err_{}.csv", spec.kind.name())))?;
-        let mut ec = CsvOut::new(&mut ef, &ERR_HEADER)?;
+        let mut ec = CsvOut::new(&mut ef, &ERR_HEADER[..10])?;
         for e in &errs {
             let (p, v, a) = (e.pos_err_ned_m, e.vel_err_ned_mps, e.att_err_rad);
             ec.row(&[e.t_s, p[0], p[1], p[2], v[0], v[1], v[2], a[0], a[1], a[2]])?;

@@ -1,6 +1,6 @@
 //! `sdins run`: truth → IMU → navigation → errors for algorithms side by side.
 
-use crate::csv_out::{nav_row, CsvOut, NAV_HEADER};
+use crate::csv_out::{nav_row, CsvOut, ERR_HEADER, NAV_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use crate::plot::PlotScale;
@@ -111,24 +111,6 @@ const ERR_CHANNELS: usize = 13;
 
 /// The comment line of `err_<algo>.csv`: the error definitions.
 const ERR_COMMENT: &str = "attitude error eps: C_alg C_true^T = I + [eps x] (NED, rad); position error dN = dLat(R_M+h), dE = dLon(R_N+h)cosL, dD = -(h_alg - h_true)";
-
-/// Header of `err_<algo>.csv`.
-const ERR_HEADER: [&str; 14] = [
-    "t_s",
-    "pos_err_n_m",
-    "pos_err_e_m",
-    "pos_err_d_m",
-    "vel_err_n_mps",
-    "vel_err_e_mps",
-    "vel_err_d_mps",
-    "att_err_n_rad",
-    "att_err_e_rad",
-    "att_err_d_rad",
-    "height_err_m",
-    "roll_err_rad",
-    "pitch_err_rad",
-    "yaw_err_rad",
-];
 
 /// Full-rate (every navigation update) figure data of a run, decimated online with
 /// min/max per column ([`crate::plot::MinMaxColumns`]) so that short manoeuvres show.
