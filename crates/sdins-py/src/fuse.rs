@@ -78,7 +78,8 @@ pub fn fuse<'py>(
             Some(false) => None,
             None => d.in_motion,
         },
-        scale_factors: scale_factors_ppm.map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior::uniform(a, g)),
+        scale_factors: scale_factors_ppm
+            .map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior::uniform(a, g)),
         ..d
     };
     let gnss = scn.gnss.clone().unwrap_or_default();
@@ -342,7 +343,8 @@ pub fn fuse_files<'py>(
         lever_arm_b_m: lever_arm_m.unwrap_or(d.lever_arm_b_m),
         nhc_sigma_mps,
         smooth: smooth.unwrap_or(d.smooth),
-        scale_factors: scale_factors_ppm.map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior::uniform(a, g)),
+        scale_factors: scale_factors_ppm
+            .map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior::uniform(a, g)),
         ..d
     };
     #[derive(Default)]
