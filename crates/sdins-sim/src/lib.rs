@@ -66,6 +66,8 @@ pub mod nav_recorded;
 pub mod navego_params;
 pub mod pipeline;
 pub mod random_vibration;
+pub mod reference;
+pub mod reference_file;
 pub mod run_setup;
 pub mod scenario;
 pub mod smoother;

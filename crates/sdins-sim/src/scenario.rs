@@ -1581,20 +1581,28 @@ fn parse_vehicle(cx: &Ctx<'_>, doc: &FileDoc) -> Result<Vehicle, ScenarioError> 
     Ok(v)
 }
 
+impl Default for NavConfig {
+    /// N = 3, the four paper algorithms, WGS-84, free vertical channel, automatic truth
+    /// substeps (`substeps = 0` until the trajectory is known).
+    fn default() -> Self {
+        NavConfig {
+            samples: 3,
+            algos: vec![
+                "savage".into(),
+                "songlee".into(),
+                "songlee-complete".into(),
+                "dualquat".into(),
+            ],
+            coning: None,
+            earth: EarthChoice::Wgs84,
+            vertical_hold: false,
+            substeps: 0,
+        }
+    }
+}
+
 fn parse_nav(cx: &Ctx<'_>, nav: Option<&NavDoc>) -> Result<NavConfig, ScenarioError> {
-    let mut cfg = NavConfig {
-        samples: 3,
-        algos: vec![
-            "savage".into(),
-            "songlee".into(),
-            "songlee-complete".into(),
-            "dualquat".into(),
-        ],
-        coning: None,
-        earth: EarthChoice::Wgs84,
-        vertical_hold: false,
-        substeps: 0,
-    };
+    let mut cfg = NavConfig::default();
     let Some(n) = nav else { return Ok(cfg) };
     if let Some(s) = &n.samples {
         let v = *s.get_ref();

@@ -8,6 +8,7 @@
 //! and vibration on top.
 
 use crate::random_vibration::RandomVibration;
+use crate::reference::ReferenceTrack;
 use crate::vehicle::{
     aircraft_attitude, car_attitude, velocity_derivs, Track, Vehicle, VehicleError,
 };
@@ -308,6 +309,9 @@ pub struct Trajectory {
     /// per overlay: where its component phases start in [`OverlayPhases`] (after the one
     /// phase per overlay), for random-vibration overlays
     rv_offset: Vec<usize>,
+    /// a recorded trajectory's interpolant, in place of the segments
+    /// ([`Trajectory::from_reference`])
+    reference: Option<Arc<ReferenceTrack>>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -511,7 +515,33 @@ impl Trajectory {
             sc_alpha: (0.0, 1.0),
             random: Vec::new(),
             rv_offset: Vec::new(),
+            reference: None,
         }
+    }
+
+    /// A recorded trajectory ([`crate::reference`]): its interpolant gives velocity,
+    /// attitude and their rates, with the overlays on top; `duration_s` (at most the
+    /// track's) ends it, e.g. on a whole number of IMU samples.
+    pub fn from_reference(track: ReferenceTrack, duration_s: f64, overlays: Vec<Overlay>) -> Self {
+        let mut t = Self::new(0.0, 0.0, Euler::new(0.0, 0.0, 0.0), &[], overlays);
+        t.duration_s = duration_s.min(track.duration_s());
+        t.reference = Some(Arc::new(track));
+        t
+    }
+
+    /// The recorded trajectory this one follows, if any ([`Trajectory::from_reference`]).
+    pub fn reference(&self) -> Option<&ReferenceTrack> {
+        self.reference.as_deref()
+    }
+
+    /// Times inside the trajectory where the motion's analytic branch changes (segment
+    /// starts, reference knots): the truth generator's panels never straddle one.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut b: Vec<f64> = self.segments.iter().skip(1).map(|s| s.t0_s).collect();
+        if let Some(r) = &self.reference {
+            b.extend(r.knots().iter().skip(1).copied());
+        }
+        b
     }
 
     /// Attach the realisations that the [`OverlayKind::RandomVibration`] overlays index
@@ -674,6 +704,7 @@ impl Trajectory {
     /// §"Truth generation" (A0, A1).
     pub fn is_constant_parallel(&self) -> bool {
         self.track.is_none()
+            && self.reference.is_none()
             && self.overlays.is_empty()
             && self
                 .segments
@@ -806,6 +837,19 @@ impl Trajectory {
         phases: Option<PhasePair<'_>>,
     ) -> Kinematics {
         let t = t_base + off;
+        if let Some(r) = &self.reference {
+            let k = r.at_split(t_base, off, t_sel).kin;
+            return self.apply_overlays(
+                t_base,
+                off,
+                t_sel,
+                phases,
+                k.v_n_mps,
+                k.v_dot_n_mps2,
+                k.c_b_n,
+                k.omega_nb_b_rps,
+            );
+        }
         let seg = self.segment_at(t_sel);
         let n = match seg {
             Some(i) => self.segments[i].eval(t),
@@ -816,8 +860,8 @@ impl Trajectory {
             Some(sc) => sc,
             None => n.heading.sin_cos(),
         };
-        let mut v = Vec3::new(n.speed * ch, n.speed * sh, n.v_d);
-        let mut v_dot = Vec3::new(
+        let v = Vec3::new(n.speed * ch, n.speed * sh, n.v_d);
+        let v_dot = Vec3::new(
             n.speed_dot * ch - n.speed * n.heading_dot * sh,
             n.speed_dot * sh + n.speed * n.heading_dot * ch,
             n.v_d_dot,
@@ -842,7 +886,23 @@ impl Trajectory {
                 (c_nom, w_nom)
             }
         };
+        self.apply_overlays(t_base, off, t_sel, phases, v, v_dot, c_nom, w_nom)
+    }
 
+    /// The overlays on top of the nominal motion `(v, v̇, C_nom, ω_nom)`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn apply_overlays(
+        &self,
+        t_base: f64,
+        off: f64,
+        t_sel: f64,
+        phases: Option<PhasePair<'_>>,
+        mut v: Vec3,
+        mut v_dot: Vec3,
+        c_nom: Mat3,
+        w_nom: Vec3,
+    ) -> Kinematics {
         // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (docs/theory/mechanizations.md
         // §"Truth generation")
         let mut c_c = Mat3::identity();

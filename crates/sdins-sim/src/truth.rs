@@ -524,7 +524,7 @@ impl<'a> TruthGenerator<'a> {
 
     /// Interior segment starts and overlay window ends, sorted.
     fn boundaries(traj: &Trajectory) -> Vec<f64> {
-        let mut b: Vec<f64> = traj.segments().iter().skip(1).map(|s| s.t0_s).collect();
+        let mut b = traj.breakpoints();
         for o in traj.overlays() {
             b.push(o.start_s);
             b.push(o.end_s);
@@ -903,7 +903,8 @@ impl Iterator for TruthGenerator<'_> {
 /// the fastest periodic motion advances at most 2e-3 rad per substep. RK4 on a pure
 /// quadrature is Simpson's rule, whose error per sample is δt·h⁴·|ω⁗|/2880; for 1 Hz,
 /// 0.5° coning at 100 Hz this is 4.5e-17 rad with 16 substeps and 2.8e-18 rad with 32.
-/// Rounded up to a power of two. The default Gauss scheme uses one 3-node panel for 16 and
+/// A recorded trajectory ([`Trajectory::reference`]) also gets panels of at most 1/8 of its
+/// shortest row step. Rounded up to a power of two. The default Gauss scheme uses one 3-node panel for 16 and
 /// `substeps/32` 4-node panels above, i.e. at most 0.032 rad (3 nodes) or 0.064 rad (4 nodes)
 /// of the fastest motion per panel ([`TruthScheme::Gauss`]). Random vibration, whose
 /// components reach the Nyquist frequency with tiny amplitudes, is resolved instead by its
@@ -916,6 +917,17 @@ pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
     let panels = traj.random_vibration_panels(dt_s);
     if panels > 0 {
         need = need.max(32 * panels).min(4096);
+    }
+    // a recorded trajectory: panels of at most 1/8 of the shortest row step. Where the
+    // rows step the angular rate, the C² interpolant turns it within one row h, and the
+    // Gauss remainder grows with the interpolant's high derivatives (~Δω/hᵏ): on NaveGo's
+    // 20°/s steps one 3-node panel per 5 ms sample leaves 1.6e-10 rad, 4-node panels of
+    // h/2 4.6e-15 rad, h/4 1.8e-17 rad, h/8 8.7e-19 rad (the order-8 rate, 2⁸ per halving)
+    if let Some(r) = traj.reference() {
+        let p = (8.0 * dt_s / r.min_step_s() * (1.0 - 1e-9)).ceil();
+        if p > 1.0 {
+            need = need.max((32.0 * p).min(4096.0) as usize);
+        }
     }
     need.next_power_of_two()
 }
