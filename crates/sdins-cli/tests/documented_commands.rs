@@ -84,6 +84,11 @@ const RULES: &[Rule] = &[
         "--imu imu.csv",
         Before("test -f imu.csv || sdins truth turn-90dps --out . --quiet"),
     ),
+    // a recorded trajectory in a CSV of its own: sdins's truth with other column names
+    rule(
+        "--from-reference log.csv",
+        Before("test -f log.csv || (sdins truth turn-90dps --out lg --quiet && sed '1s/.*/time,lat,lon,alt,vn,ve,vd,roll,pitch,yaw,qw,qx,qy,qz/' lg/truth.csv > log.csv)"),
+    ),
     rule(
         "sdins merge mc/shard0 mc/shard1 mc/shard2 mc/shard3 ",
         Before("rm -rf mc && for i in 0 1 2 3; do sdins montecarlo mach1-east --runs 64 --seed 1 --until-s 5 --shard $i/4 --out mc/shard$i --quiet; done"),

@@ -924,7 +924,9 @@ pub fn auto_substeps(dt_s: f64, traj: &Trajectory) -> usize {
     // 20°/s steps one 3-node panel per 5 ms sample leaves 1.6e-10 rad, 4-node panels of
     // h/2 4.6e-15 rad, h/4 1.8e-17 rad, h/8 8.7e-19 rad (the order-8 rate, 2⁸ per halving)
     if let Some(r) = traj.reference() {
-        let p = (8.0 * dt_s / r.min_step_s() * (1.0 - 1e-9)).ceil();
+        // panels are laid per piece between knots, so a sample holding several rows needs
+        // 8 per piece, not per sample
+        let p = (8.0 * (dt_s / r.min_step_s()).min(1.0) * (1.0 - 1e-9)).ceil();
         if p > 1.0 {
             need = need.max((32.0 * p).min(4096.0) as usize);
         }

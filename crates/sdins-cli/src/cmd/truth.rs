@@ -12,10 +12,29 @@ use std::path::PathBuf;
 
 /// Arguments of `sdins truth`.
 #[derive(clap::Args, Debug)]
-#[command(after_help = "Example:\n  sdins truth turn-90dps --out out/turn")]
+#[command(
+    after_help = "Examples:\n  sdins truth turn-90dps --out out/turn\n  sdins truth --from-reference ref.csv --rate-hz 200 --out out/ref\n  sdins truth --from-reference log.csv --columns t_s=time,lat_deg=lat,lon_deg=lon,h_m=alt,roll_deg=roll,pitch_deg=pitch,yaw_deg=yaw,v_n_mps=vn,v_e_mps=ve,v_d_mps=vd --rate-hz 500 --out out/log"
+)]
 pub struct Args {
     /// built-in scenario name or scenario file
-    pub scenario: String,
+    #[arg(required_unless_present = "from_reference")]
+    pub scenario: Option<String>,
+    /// a recorded trajectory instead of a scenario: an sdins truth.csv, a PSINS avp CSV,
+    /// NaveGo's ref.csv (told apart by the header), or any CSV with --columns; its C²
+    /// interpolant becomes the truth (docs/scenarios.md §"Recorded trajectories")
+    #[arg(long, value_name = "FILE", conflicts_with = "scenario")]
+    pub from_reference: Option<PathBuf>,
+    /// IMU rate for --from-reference [Hz]
+    #[arg(long, default_value_t = 100.0, requires = "from_reference")]
+    pub rate_hz: f64,
+    /// column map of a generic --from-reference CSV:
+    /// t_s=COL,lat_deg=COL,lon_deg=COL,h_m=COL,roll_deg=COL,pitch_deg=COL,yaw_deg=COL
+    /// (`_rad` for radians; optional v_n_mps=,v_e_mps=,v_d_mps=)
+    #[arg(long, value_name = "MAP", requires = "from_reference")]
+    pub columns: Option<String>,
+    /// earth model for --from-reference: wgs84 or psins
+    #[arg(long, default_value = "wgs84", requires = "from_reference")]
+    pub earth: String,
     /// output folder (default ./sdins-out/truth-<scenario>)
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -29,7 +48,11 @@ pub struct Args {
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let scn = Scenario::load(&args.scenario)?;
+    let (scn, t_offset) = match (&args.from_reference, &args.scenario) {
+        (Some(file), _) => from_reference(file, &args)?,
+        (None, Some(name)) => (Scenario::load(name)?, 0.0),
+        (None, None) => return Err(CliError::bad("give a scenario or --from-reference FILE")),
+    };
     crate::report::print_vibration(&scn);
     if args.every == 0 {
         return Err(CliError::bad("--every: must be at least 1"));
@@ -92,7 +115,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ]
     };
     truth_csv.row(&truth_row(
-        0.0,
+        t_offset,
         init.lat_rad,
         init.lon_rad,
         init.h_m,
@@ -103,7 +126,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     for (k, s) in gen.enumerate() {
         let i = &s.inc;
         imu_csv.row(&[
-            s.t_s,
+            s.t_s + t_offset,
             i.dtheta_b_rad.x,
             i.dtheta_b_rad.y,
             i.dtheta_b_rad.z,
@@ -113,7 +136,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ])?;
         if (k as u64 + 1).is_multiple_of(args.every) {
             truth_csv.row(&truth_row(
-                s.t_s, s.lat_rad, s.lon_rad, s.h_m, &s.v_n_mps, &s.c_b_n,
+                s.t_s + t_offset,
+                s.lat_rad,
+                s.lon_rad,
+                s.h_m,
+                &s.v_n_mps,
+                &s.c_b_n,
             ))?;
         }
         if k % 65536 == 0 {
@@ -137,4 +165,45 @@ pub fn run(args: Args) -> Result<(), CliError> {
         scn.duration_s()
     );
     Ok(())
+}
+
+/// The scenario of `--from-reference` and the reference time of its first row.
+fn from_reference(file: &std::path::Path, args: &Args) -> Result<(Scenario, f64), CliError> {
+    use sdins_sim::reference_file::{
+        scenario_from_reference, ColumnMap, ReferenceFormat, ReferenceOptions,
+    };
+    use sdins_sim::scenario::EarthChoice;
+    let earth = match args.earth.as_str() {
+        "wgs84" => EarthChoice::Wgs84,
+        "psins" => EarthChoice::Psins,
+        other => {
+            return Err(CliError::bad(format!(
+                "--earth: `{other}`: expected wgs84 or psins (a recorded trajectory needs an ellipsoid)"
+            )))
+        }
+    };
+    let format = match &args.columns {
+        Some(m) => ReferenceFormat::Generic(Box::new(
+            ColumnMap::parse(m).map_err(|e| CliError::bad(e.to_string()))?,
+        )),
+        None => ReferenceFormat::Auto,
+    };
+    let opts = ReferenceOptions {
+        format,
+        rate_hz: args.rate_hz,
+        earth,
+    };
+    let (scn, sum) =
+        scenario_from_reference(file, &opts).map_err(|e| CliError::bad(e.to_string()))?;
+    eprintln!(
+        "reference: {} rows over {} s from t = {} s; truth {} s at {} Hz (C² interpolant through every row)",
+        sum.rows, sum.span_s, sum.t0_s, sum.duration_s, args.rate_hz
+    );
+    if let Some(v) = sum.velocity {
+        eprintln!(
+            "reference velocity columns against the interpolant's velocity: RMS {:.3e} m/s, max {:.3e} m/s at t = {} s",
+            v.rms_mps, v.max_mps, v.t_max_s
+        );
+    }
+    Ok((scn, sum.t0_s))
 }
