@@ -7,6 +7,7 @@
 //! values (flat turns, as in the papers' scenarios). Overlays add body coning, sculling
 //! and vibration on top.
 
+use crate::body_motion::BodyMotion;
 use crate::random_vibration::RandomVibration;
 use crate::vehicle::{
     aircraft_attitude, car_attitude, velocity_derivs, Track, Vehicle, VehicleError,
@@ -308,6 +309,9 @@ pub struct Trajectory {
     /// per overlay: where its component phases start in [`OverlayPhases`] (after the one
     /// phase per overlay), for random-vibration overlays
     rv_offset: Vec<usize>,
+    /// "Euler angles + body velocity" base ([`crate::body_motion`]) in place of the
+    /// segments' nominal motion (the segments then only carry the command time spans)
+    body: Option<Arc<BodyMotion>>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -511,7 +515,29 @@ impl Trajectory {
             sc_alpha: (0.0, 1.0),
             random: Vec::new(),
             rv_offset: Vec::new(),
+            body: None,
         }
+    }
+
+    /// A trajectory on the "Euler angles + body velocity" base ([`crate::body_motion`]):
+    /// one placeholder segment per command (its time span, for the envelope check and
+    /// error locations) and the overlays on top, free vehicle.
+    pub fn from_body_motion(body: BodyMotion, overlays: Vec<Overlay>) -> Self {
+        let motions: Vec<(Motion, f64)> = body
+            .pieces()
+            .iter()
+            .map(|p| (Motion::Cruise, p.duration_s))
+            .collect();
+        let mut tr = Trajectory::new(0.0, 0.0, Euler::new(0.0, 0.0, 0.0), &motions, overlays);
+        // the placeholder segments start where the pieces start (same sums)
+        tr.duration_s = body.duration_s;
+        tr.body = Some(Arc::new(body));
+        tr
+    }
+
+    /// The body-motion base, if the trajectory has one ([`Trajectory::from_body_motion`]).
+    pub fn body_motion(&self) -> Option<&BodyMotion> {
+        self.body.as_deref()
     }
 
     /// Attach the realisations that the [`OverlayKind::RandomVibration`] overlays index
@@ -661,7 +687,8 @@ impl Trajectory {
             // resolved by amplitude: `Trajectory::random_vibration_panels`
             OverlayKind::RandomVibration { .. } => 0.0,
         });
-        seg.chain(ov).fold(0.0, f64::max)
+        let body = self.body.as_deref().map_or(0.0, BodyMotion::max_frequency_rps);
+        seg.chain(ov).fold(body, f64::max)
     }
 
     /// The overlays.
@@ -673,7 +700,8 @@ impl Trajectory {
     /// cruise segments): then the truth has the closed form of docs/theory/mechanizations.md
     /// §"Truth generation" (A0, A1).
     pub fn is_constant_parallel(&self) -> bool {
-        self.track.is_none()
+        self.body.is_none()
+            && self.track.is_none()
             && self.overlays.is_empty()
             && self
                 .segments
@@ -816,8 +844,8 @@ impl Trajectory {
             Some(sc) => sc,
             None => n.heading.sin_cos(),
         };
-        let mut v = Vec3::new(n.speed * ch, n.speed * sh, n.v_d);
-        let mut v_dot = Vec3::new(
+        let v = Vec3::new(n.speed * ch, n.speed * sh, n.v_d);
+        let v_dot = Vec3::new(
             n.speed_dot * ch - n.speed * n.heading_dot * sh,
             n.speed_dot * sh + n.speed * n.heading_dot * ch,
             n.v_d_dot,
@@ -841,6 +869,11 @@ impl Trajectory {
                 );
                 (c_nom, w_nom)
             }
+        };
+        // the body-motion base replaces the nominal motion (crate::body_motion)
+        let (mut v, mut v_dot, c_nom, w_nom) = match self.body.as_deref() {
+            Some(b) => b.kinematics(t, t_sel),
+            None => (v, v_dot, c_nom, w_nom),
         };
 
         // attitude overlays: C_b^n = C_nom C_c, ω = C_cᵀ ω_nom + ω_c (docs/theory/mechanizations.md

@@ -529,6 +529,9 @@ impl<'a> TruthGenerator<'a> {
             b.push(o.start_s);
             b.push(o.end_s);
         }
+        if let Some(bm) = traj.body_motion() {
+            b.extend(bm.breaks());
+        }
         b.retain(|t| t.is_finite() && *t > 0.0 && *t < traj.duration_s);
         b.sort_by(f64::total_cmp);
         b.dedup();
