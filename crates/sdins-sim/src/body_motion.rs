@@ -287,7 +287,9 @@ impl BodyMotion {
             start.vel_b[1],
             start.vel_b[2],
         ];
-        let mut t = 0.0;
+        // start times as whole sample counts × δt while the durations are whole samples
+        // (then the boundaries are the sample grid's own k·δt), else the running sum
+        let (mut t, mut n_sum, mut whole) = (0.0, 0.0, true);
         let mut pieces = Vec::with_capacity(commands.len());
         let mut extended = Vec::new();
         for (index, c) in commands.iter().enumerate() {
@@ -353,12 +355,19 @@ impl BodyMotion {
             for k in 0..6 {
                 x[k] = channels[k].end_value(duration);
             }
+            let n = (duration / dt_s).round();
+            whole &= (n * dt_s - duration).abs() <= 1e-9 * duration;
+            let t0_s = if whole { n_sum * dt_s } else { t };
             pieces.push(Piece {
-                t0_s: t,
+                t0_s,
                 duration_s: duration,
                 channels,
             });
-            t += duration;
+            t = t0_s + duration;
+            n_sum += n;
+            if whole {
+                t = n_sum * dt_s;
+            }
         }
         Self {
             pieces,

@@ -60,6 +60,9 @@ pub struct MotionFile {
     pub gps_visible: Vec<bool>,
     /// per command: its 1-based line in the file
     pub lines: Vec<usize>,
+    /// the numbers as written: the initial-state row and the command rows (the TOML
+    /// repeats them digit for digit)
+    pub raw: Vec<[f64; COLUMNS]>,
 }
 
 /// Parse the text of a motion-definition file (`file` names it in errors).
@@ -134,6 +137,7 @@ pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> 
     let mut commands = Vec::new();
     let mut gps_visible = Vec::new();
     let mut lines = Vec::new();
+    let mut raw = vec![ini];
     for row in &rows[3..] {
         let c = numbers(row)?;
         let line = row.0;
@@ -174,6 +178,7 @@ pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> 
         });
         gps_visible.push(c[8] == 1.0);
         lines.push(line);
+        raw.push(c);
     }
     Ok(MotionFile {
         lat_deg: ini[0],
@@ -183,6 +188,7 @@ pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> 
         commands,
         gps_visible,
         lines,
+        raw,
     })
 }
 
@@ -303,7 +309,6 @@ pub fn to_scenario_toml(
         .collect();
     let body = BodyMotion::compile(mf.start, &commands, opts.limits, dt);
     let g = |x: f64| fmt_f64(x);
-    let deg = |x: f64| fmt_f64(x.to_degrees());
     let mut s = String::new();
     let [a, aa, ar] = opts.limits.to_mode();
     let _ = writeln!(s, "# imported from the gnss-ins-sim motion file {file}");
@@ -320,10 +325,10 @@ pub fn to_scenario_toml(
     let _ = writeln!(s, "lat_deg = {}", g(mf.lat_deg));
     let _ = writeln!(s, "lon_deg = {}", g(mf.lon_deg));
     let _ = writeln!(s, "h_m = {}", g(mf.h_m));
-    let [y, p, r] = mf.start.euler_ypr;
-    let _ = writeln!(s, "yaw_deg = {}", deg(y));
-    let _ = writeln!(s, "pitch_deg = {}", deg(p));
-    let _ = writeln!(s, "roll_deg = {}\n", deg(r));
+    let ini = mf.raw.first().copied().unwrap_or([0.0; COLUMNS]);
+    let _ = writeln!(s, "yaw_deg = {}", g(ini[6]));
+    let _ = writeln!(s, "pitch_deg = {}", g(ini[7]));
+    let _ = writeln!(s, "roll_deg = {}\n", g(ini[8]));
     let _ = writeln!(s, "[imu]\nrate_hz = {}\n", g(opts.rate_hz));
     let _ = writeln!(s, "[body_motion]");
     let [vx, vy, vz] = mf.start.vel_b;
@@ -346,15 +351,15 @@ pub fn to_scenario_toml(
     for (i, (c, &line)) in mf.commands.iter().zip(&mf.lines).enumerate() {
         let _ = writeln!(s, "\n[[command]] # line {line}");
         let _ = writeln!(s, "type = {}", c.kind.number());
-        let [y, p, r] = c.euler_ypr;
-        let [x1, x2, x3] = c.vel_b;
+        let row = mf.raw.get(i + 1).copied().unwrap_or([0.0; COLUMNS]);
+        let [y, p, r, x1, x2, x3] = [row[1], row[2], row[3], row[4], row[5], row[6]];
         if c.kind == CommandKind::Rates {
             let _ = writeln!(
                 s,
                 "yaw_rate_dps = {}\npitch_rate_dps = {}\nroll_rate_dps = {}",
-                deg(y),
-                deg(p),
-                deg(r)
+                g(y),
+                g(p),
+                g(r)
             );
             let _ = writeln!(
                 s,
@@ -367,9 +372,9 @@ pub fn to_scenario_toml(
             let _ = writeln!(
                 s,
                 "yaw_deg = {}\npitch_deg = {}\nroll_deg = {}",
-                deg(y),
-                deg(p),
-                deg(r)
+                g(y),
+                g(p),
+                g(r)
             );
             let _ = writeln!(
                 s,

@@ -1264,7 +1264,44 @@ impl Scenario {
             file: file.clone(),
             reason: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         })?;
+        if crate::gnss_ins_sim::looks_like_motion_def(&text) {
+            return Scenario::from_motion_def(&text, path, &Default::default());
+        }
         Scenario::from_toml(&text, &file)
+    }
+
+    /// A gnss-ins-sim motion-definition file as a scenario
+    /// ([`crate::gnss_ins_sim::to_scenario_toml`], then [`Scenario::from_toml`] on the result).
+    pub fn from_motion_def(
+        text: &str,
+        path: &Path,
+        opts: &crate::gnss_ins_sim::ImportOptions,
+    ) -> Result<Scenario, ScenarioError> {
+        use crate::gnss_ins_sim::{parse_motion_def, to_scenario_toml, GisError};
+        let file = path.display().to_string();
+        let conv = |e: GisError| match e {
+            GisError::Invalid {
+                file,
+                line,
+                column,
+                message,
+            } => ScenarioError::Invalid {
+                file,
+                line,
+                key: format!("column {column}"),
+                message,
+            },
+            other => ScenarioError::Read {
+                file: file.clone(),
+                reason: other.to_string(),
+            },
+        };
+        let mf = parse_motion_def(text, &file).map_err(conv)?;
+        let name = path
+            .file_stem()
+            .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned());
+        let toml = to_scenario_toml(&mf, &name, &file, opts).map_err(conv)?;
+        Scenario::from_toml(&toml, &file)
     }
 
     /// A built-in name or a file path.

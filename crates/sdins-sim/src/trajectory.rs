@@ -529,7 +529,10 @@ impl Trajectory {
             .map(|p| (Motion::Cruise, p.duration_s))
             .collect();
         let mut tr = Trajectory::new(0.0, 0.0, Euler::new(0.0, 0.0, 0.0), &motions, overlays);
-        // the placeholder segments start where the pieces start (same sums)
+        // the placeholder segments start where the pieces start
+        for (seg, p) in tr.segments.iter_mut().zip(body.pieces()) {
+            seg.t0_s = p.t0_s;
+        }
         tr.duration_s = body.duration_s;
         tr.body = Some(Arc::new(body));
         tr
