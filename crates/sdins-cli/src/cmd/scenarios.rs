@@ -17,7 +17,7 @@ pub struct Args {
     pub file: Option<std::path::PathBuf>,
     /// with `import`: gnss-ins-sim `mode` = max acceleration [m/s²], max angular
     /// acceleration [deg/s²], max angular rate [deg/s]
-    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [1.0, 0.5, 2.0])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1.0, 0.5, 2.0])]
     pub mode: Vec<f64>,
     /// with `import`: IMU rate of the scenario [Hz] (command durations must be whole samples)
     #[arg(long, default_value_t = 100.0)]
