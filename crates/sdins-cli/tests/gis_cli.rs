@@ -26,7 +26,10 @@ fn import_and_run_motion_files() {
     let g = good.to_str().unwrap();
     let (code, out, err) = sdins(&["scenarios", "import", g, "--mode", "1.0,0.5,2.0"]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("[[command]]") && out.contains("outages_s = [[0.0, 5.0]]"), "{out}");
+    assert!(
+        out.contains("[[command]]") && out.contains("outages_s = [[0.0, 5.0]]"),
+        "{out}"
+    );
     // the relative yaw of 30 deg at 2 deg/s needs 30 s: extended, and said so
     assert!(out.contains("extended"), "{out}");
     let toml = dir.join("my.toml");
@@ -38,11 +41,23 @@ fn import_and_run_motion_files() {
     let bad = dir.join("bad.csv");
     for (text, want) in [
         (GOOD.replace("3,30,", "9,30,"), "bad.csv:5:1: command type"),
-        (GOOD.replace(",10,1", ",0,1"), "bad.csv:5:8: duration 0 s must be > 0"),
+        (
+            GOOD.replace(",10,1", ",0,1"),
+            "bad.csv:5:8: duration 0 s must be > 0",
+        ),
         (GOOD.replace(",10,1", ",10"), "bad.csv:5:1: expected 9"),
-        (GOOD.replace("32,120", "32,abc"), "bad.csv:2:2: `abc` is not a number"),
-        (GOOD.replace("32,120", "32,NaN"), "bad.csv:2:2: `NaN` is not a finite"),
-        (GOOD.replace(",5,0", ",5.005,0"), "bad.csv:4:8: duration 5.005 s is not a whole number"),
+        (
+            GOOD.replace("32,120", "32,abc"),
+            "bad.csv:2:2: `abc` is not a number",
+        ),
+        (
+            GOOD.replace("32,120", "32,NaN"),
+            "bad.csv:2:2: `NaN` is not a finite",
+        ),
+        (
+            GOOD.replace(",5,0", ",5.005,0"),
+            "bad.csv:4:8: duration 5.005 s is not a whole number",
+        ),
     ] {
         std::fs::write(&bad, text).unwrap();
         let (code, _, err) = sdins(&["scenarios", "import", bad.to_str().unwrap()]);
@@ -53,11 +68,26 @@ fn import_and_run_motion_files() {
         assert!(err.contains(&want[..10]), "{want}: {err}");
     }
     for (args, want) in [
-        (vec!["scenarios", "import", g, "--mode", "1,0,2"], "--mode: max angular acceleration"),
-        (vec!["scenarios", "import", g, "--mode", "1,nan,2"], "--mode"),
-        (vec!["scenarios", "import", g, "--rate-hz", "0"], "--rate-hz"),
-        (vec!["scenarios", "import"], "give the motion-definition file"),
-        (vec!["scenarios", "import", "/nonexistent/m.csv"], "cannot read"),
+        (
+            vec!["scenarios", "import", g, "--mode", "1,0,2"],
+            "--mode: max angular acceleration",
+        ),
+        (
+            vec!["scenarios", "import", g, "--mode", "1,nan,2"],
+            "--mode",
+        ),
+        (
+            vec!["scenarios", "import", g, "--rate-hz", "0"],
+            "--rate-hz",
+        ),
+        (
+            vec!["scenarios", "import"],
+            "give the motion-definition file",
+        ),
+        (
+            vec!["scenarios", "import", "/nonexistent/m.csv"],
+            "cannot read",
+        ),
     ] {
         let (code, _, err) = sdins(&args);
         assert_eq!(code, 2, "{args:?}: {err}");

@@ -111,7 +111,11 @@ pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> 
     let ini = numbers(&rows[1])?;
     let l1 = rows[1].0;
     if !(-90.0..=90.0).contains(&ini[0]) {
-        return Err(err(l1, 1, format!("latitude {} is outside [-90, 90] deg", ini[0])));
+        return Err(err(
+            l1,
+            1,
+            format!("latitude {} is outside [-90, 90] deg", ini[0]),
+        ));
     }
     if !(-180.0..=360.0).contains(&ini[1]) {
         return Err(err(
@@ -154,11 +158,7 @@ pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> 
             ));
         };
         if c[7] <= 0.0 {
-            return Err(err(
-                line,
-                8,
-                format!("duration {} s must be > 0", c[7]),
-            ));
+            return Err(err(line, 8, format!("duration {} s must be > 0", c[7])));
         }
         if c[7] > crate::scenario::MAX_SEGMENT_S {
             return Err(err(line, 8, format!("duration {} s is too long", c[7])));
@@ -215,7 +215,10 @@ pub fn looks_like_motion_def(text: &str) -> bool {
         .lines()
         .next()
         .unwrap_or("");
-    first.trim_start().to_ascii_lowercase().starts_with("ini lat")
+    first
+        .trim_start()
+        .to_ascii_lowercase()
+        .starts_with("ini lat")
 }
 
 /// Import options.
@@ -387,11 +390,7 @@ pub fn to_scenario_toml(
         let _ = write!(s, "duration_s = {}", g(c.duration_s));
         match ext.get(&i) {
             Some(u) => {
-                let _ = writeln!(
-                    s,
-                    " # the limits need {} s: extended to that",
-                    g(*u)
-                );
+                let _ = writeln!(s, " # the limits need {} s: extended to that", g(*u));
             }
             None => s.push('\n'),
         }
@@ -476,5 +475,4 @@ mod tests {
         assert!(limits_from_mode([1.0, 0.5, f64::NAN]).is_err());
         assert!(limits_from_mode([-1.0, 0.5, 2.0]).is_err());
     }
-
 }

@@ -46,9 +46,9 @@
 pub mod align;
 pub mod align_run;
 pub mod allan;
+pub mod body_motion;
 pub mod calibration;
 pub mod cancel;
-pub mod body_motion;
 pub mod envelope;
 pub mod error_analysis;
 pub mod errors_run;

@@ -1943,8 +1943,7 @@ fn parse_body_motion(
     euler: Euler,
     vehicle: Vehicle,
     dt: f64,
-) -> Result<Option<(crate::body_motion::BodyMotion, Vec<std::ops::Range<usize>>)>, ScenarioError>
-{
+) -> Result<Option<(crate::body_motion::BodyMotion, Vec<std::ops::Range<usize>>)>, ScenarioError> {
     use crate::body_motion::{BodyCommand, BodyMotion, BodyStart, CommandKind, MotionLimits};
     if doc.command.is_empty() {
         if let Some(b) = &doc.body_motion {
@@ -2005,13 +2004,32 @@ fn parse_body_motion(
         }
     };
     let vel_b = [
-        opt(bm.and_then(|b| b.vx_mps.as_ref()), "body_motion.vx_mps", 3000.0, 0.0)?,
-        opt(bm.and_then(|b| b.vy_mps.as_ref()), "body_motion.vy_mps", 3000.0, 0.0)?,
-        opt(bm.and_then(|b| b.vz_mps.as_ref()), "body_motion.vz_mps", 3000.0, 0.0)?,
+        opt(
+            bm.and_then(|b| b.vx_mps.as_ref()),
+            "body_motion.vx_mps",
+            3000.0,
+            0.0,
+        )?,
+        opt(
+            bm.and_then(|b| b.vy_mps.as_ref()),
+            "body_motion.vy_mps",
+            3000.0,
+            0.0,
+        )?,
+        opt(
+            bm.and_then(|b| b.vz_mps.as_ref()),
+            "body_motion.vz_mps",
+            3000.0,
+            0.0,
+        )?,
     ];
     let d = MotionLimits::DEFAULT.to_mode();
     let limits = MotionLimits::from_mode([
-        pos(bm.and_then(|b| b.max_accel_mps2.as_ref()), "body_motion.max_accel_mps2", d[0])?,
+        pos(
+            bm.and_then(|b| b.max_accel_mps2.as_ref()),
+            "body_motion.max_accel_mps2",
+            d[0],
+        )?,
         pos(
             bm.and_then(|b| b.max_angular_accel_dps2.as_ref()),
             "body_motion.max_angular_accel_dps2",
@@ -2031,7 +2049,10 @@ fn parse_body_motion(
             return cx.err(
                 cd.kind.span(),
                 "command.type",
-                format!("{} is not a command type: expected 1, 2, 3, 4 or 5", cd.kind.get_ref()),
+                format!(
+                    "{} is not a command type: expected 1, 2, 3, 4 or 5",
+                    cd.kind.get_ref()
+                ),
             );
         };
         let rates = kind == CommandKind::Rates;
@@ -2064,7 +2085,10 @@ fn parse_body_motion(
                 return cx.err(
                     v.span(),
                     &format!("command.{k}"),
-                    format!("not a key of command type {} (it takes: {takes}, duration_s)", kind.number()),
+                    format!(
+                        "not a key of command type {} (it takes: {takes}, duration_s)",
+                        kind.number()
+                    ),
                 );
             }
         }
@@ -2102,5 +2126,8 @@ fn parse_body_motion(
         euler_ypr: [euler.yaw_rad, euler.pitch_rad, euler.roll_rad],
         vel_b,
     };
-    Ok(Some((BodyMotion::compile(start, &commands, limits, dt), spans)))
+    Ok(Some((
+        BodyMotion::compile(start, &commands, limits, dt),
+        spans,
+    )))
 }

@@ -690,7 +690,10 @@ impl Trajectory {
             // resolved by amplitude: `Trajectory::random_vibration_panels`
             OverlayKind::RandomVibration { .. } => 0.0,
         });
-        let body = self.body.as_deref().map_or(0.0, BodyMotion::max_frequency_rps);
+        let body = self
+            .body
+            .as_deref()
+            .map_or(0.0, BodyMotion::max_frequency_rps);
         seg.chain(ov).fold(body, f64::max)
     }
 

@@ -237,10 +237,19 @@ fn limits_are_honoured_and_zero_lateral_body_velocity_is_exact() {
             for j in 0..3 {
                 let (r, a) = (st.euler_rate_ypr[j].abs(), st.euler_accel_ypr[j].abs());
                 peak_rate = peak_rate.max(r);
-                assert!(r <= lim.max_angular_rate_rps * (1.0 + 1e-12), "{name} t {t}: rate {r}");
-                assert!(a <= lim.max_angular_accel_rps2 * (1.0 + 1e-12), "{name} t {t}: {a}");
+                assert!(
+                    r <= lim.max_angular_rate_rps * (1.0 + 1e-12),
+                    "{name} t {t}: rate {r}"
+                );
+                assert!(
+                    a <= lim.max_angular_accel_rps2 * (1.0 + 1e-12),
+                    "{name} t {t}: {a}"
+                );
                 let vd = st.vel_dot_b[j].abs();
-                assert!(vd <= lim.max_accel_mps2 * (1.0 + 1e-12), "{name} t {t}: {vd}");
+                assert!(
+                    vd <= lim.max_accel_mps2 * (1.0 + 1e-12),
+                    "{name} t {t}: {vd}"
+                );
             }
         }
         let planar = mf.start.vel_b[1] == 0.0
@@ -298,7 +307,10 @@ fn gauss_matches_rk4_reference_on_imported_3d_motion() {
         );
         dpos = dpos.max(p.norm());
     }
-    eprintln!("3d: Gauss ({base}) vs RK4 ({}): dθ {dth:e} rad, dv {dv:e} m/s, pos {dpos:e} m", 2 * base);
+    eprintln!(
+        "3d: Gauss ({base}) vs RK4 ({}): dθ {dth:e} rad, dv {dv:e} m/s, pos {dpos:e} m",
+        2 * base
+    );
     assert!(dth <= 2e-17, "{dth:e}");
     assert!(dv <= 2e-16, "{dv:e}");
     assert!(dpos <= 1e-9, "{dpos:e}");
@@ -313,17 +325,29 @@ fn scenario_command_errors_are_located() {
     let err = |t: &str| Scenario::from_toml(t, "f.toml").unwrap_err().to_string();
     let line_of = |pat: &str| toml.lines().position(|l| l.contains(pat)).unwrap() + 1;
     let e = err(&toml.replacen("type = 2", "type = 7", 1));
-    assert!(e.starts_with(&format!("f.toml:{}: command.type:", line_of("type = 2"))), "{e}");
+    assert!(
+        e.starts_with(&format!("f.toml:{}: command.type:", line_of("type = 2"))),
+        "{e}"
+    );
     let e = err(&toml.replacen("duration_s = 20.0", "duration_s = -1.0", 1));
-    assert!(e.contains("command.duration_s") && e.contains("must be > 0"), "{e}");
+    assert!(
+        e.contains("command.duration_s") && e.contains("must be > 0"),
+        "{e}"
+    );
     let e = err(&toml.replacen("duration_s = 20.0", "duration_s = 20.005", 1));
     assert!(e.contains("whole number of IMU samples"), "{e}");
     let e = err(&toml.replacen("max_accel_mps2 = 1.0", "max_accel_mps2 = 0.0", 1));
     assert!(e.contains("body_motion.max_accel_mps2"), "{e}");
     let e = err(&toml.replacen("yaw_rate_dps = 0.0", "yaw_deg = 0.0", 1));
-    assert!(e.contains("command.yaw_deg") && e.contains("not a key of command type 1"), "{e}");
+    assert!(
+        e.contains("command.yaw_deg") && e.contains("not a key of command type 1"),
+        "{e}"
+    );
     let e = err(&toml.replacen("vehicle = \"free\"", "vehicle = \"car\"", 1));
-    assert!(e.contains("vehicle = \\\"free\\\"") || e.contains("free"), "{e}");
+    assert!(
+        e.contains("vehicle = \\\"free\\\"") || e.contains("free"),
+        "{e}"
+    );
     let e = err(&toml.replacen("[start]", "[start]\nspeed_mps = 3.0", 1));
     assert!(e.contains("start.speed_mps"), "{e}");
 }
@@ -332,14 +356,21 @@ fn scenario_command_errors_are_located() {
 fn motion_file_errors_are_located() {
     let good = "ini lat (deg),a,b,c,d,e,f,g,h\n32,120,0,0,0,0,0,0,0\nh,a,b,c,d,e,f,g,h\n2,90,0,0,10,0,0,20,1\n";
     let e = |t: &str| parse_motion_def(t, "m.csv").unwrap_err().to_string();
-    assert!(e(&good.replace("2,90,0,0,10,0,0,20,1", "2,90,0,0,10,0,0,20")).starts_with("m.csv:4:1: expected 9"));
-    assert!(e(&good.replace(",10,0,0,20", ",ten,0,0,20")).starts_with("m.csv:4:5: `ten` is not a number"));
+    assert!(
+        e(&good.replace("2,90,0,0,10,0,0,20,1", "2,90,0,0,10,0,0,20"))
+            .starts_with("m.csv:4:1: expected 9")
+    );
+    assert!(e(&good.replace(",10,0,0,20", ",ten,0,0,20"))
+        .starts_with("m.csv:4:5: `ten` is not a number"));
     assert!(e(&good.replace("32,120,0,", "32,nan,0,")).starts_with("m.csv:2:2:"));
     assert!(e(&good.replace("2,90,", "6,90,")).starts_with("m.csv:4:1: command type"));
     assert!(e(&good.replace(",20,1", ",0,1")).starts_with("m.csv:4:8:"));
     let dir = std::env::temp_dir().join(format!("sdins-gis-{}", std::process::id()));
     let missing = dir.join("none.csv");
-    assert!(read_motion_def(&missing).unwrap_err().to_string().contains("cannot read"));
+    assert!(read_motion_def(&missing)
+        .unwrap_err()
+        .to_string()
+        .contains("cannot read"));
     // a passed-in CSV goes through the scenario path with its location
     std::fs::create_dir_all(&dir).unwrap();
     let f = dir.join("bad.csv");
