@@ -1840,98 +1840,10 @@ pub fn builtin(name: &str) -> Option<&'static Builtin> {
     BUILTINS.iter().find(|b| b.name == name)
 }
 
-#[cfg(test)]
-#[allow(clippy::unwrap_used)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn all_builtins_parse() {
-        for b in BUILTINS {
-            let s = Scenario::from_toml(b.toml, b.name);
-            assert!(s.is_ok(), "{}: {:?}", b.name, s.err());
-        }
-    }
-
-    fn err_of(text: &str) -> ScenarioError {
-        match Scenario::from_toml(text, "t.toml") {
-            Err(e) => e,
-            Ok(_) => panic!("expected an error for:\n{text}"),
-        }
-    }
-
-    const BASE: &str = "[start]\nlat_deg = 37.5\nlon_deg = 127.0\n[imu]\nrate_hz = 100.0\n[[segment]]\ntype = \"static\"\nduration_s = 10.0\n";
-
-    #[test]
-    fn unknown_key_names_line_and_suggests() {
-        let e = err_of(&BASE.replace("lon_deg = 127.0", "lon_deg = 127.0\nlat_dg = 3.0"));
-        let ScenarioError::Invalid {
-            line, key, message, ..
-        } = &e
-        else {
-            panic!("{e}")
-        };
-        assert_eq!((*line, key.as_str()), (4, "lat_dg"));
-        assert!(message.contains("did you mean `lat_deg`"), "{message}");
-    }
-
-    #[test]
-    fn missing_key() {
-        let e = err_of(&BASE.replace("rate_hz = 100.0\n", ""));
-        assert!(
-            e.to_string().contains("rate_hz") && e.to_string().contains("missing"),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn impossible_values_name_line_and_key() {
-        for (from, to, line, key) in [
-            (
-                "duration_s = 10.0",
-                "duration_s = -1.0",
-                8,
-                "segment.duration_s",
-            ),
-            ("rate_hz = 100.0", "rate_hz = 0.0", 5, "imu.rate_hz"),
-            ("lat_deg = 37.5", "lat_deg = 95.0", 2, "start.lat_deg"),
-            (
-                "duration_s = 10.0",
-                "duration_s = 10.001",
-                8,
-                "segment.duration_s",
-            ),
-            ("lat_deg = 37.5", "lat_deg = nan", 2, "start.lat_deg"),
-        ] {
-            let e = err_of(&BASE.replace(from, to));
-            let ScenarioError::Invalid {
-                line: l, key: k, ..
-            } = &e
-            else {
-                panic!("{e}")
-            };
-            assert_eq!((*l, k.as_str()), (line, key), "{e}");
-        }
-        let e = err_of(&format!("{BASE}[start2]\n"));
-        assert!(e.to_string().contains("start2"), "{e}");
-        let e = err_of(&BASE.replace(
-            "[start]\nlat_deg = 37.5\n",
-            "[start]\nlat_deg = 37.5\nh_m = -2000.0\n",
-        ));
-        assert!(e.to_string().contains("start.h_m"), "{e}");
-    }
-
-    #[test]
-    fn wrong_segment_keys() {
-        let e = err_of(&BASE.replace("type = \"static\"", "type = \"staticc\""));
-        assert!(e.to_string().contains("unknown segment type"), "{e}");
-        let e = err_of(&BASE.replace("duration_s = 10.0", "duration_s = 10.0\nrate_dps = 3.0"));
-        assert!(
-            e.to_string().contains("not a key of segment type `static`"),
-            "{e}"
-        );
-    }
-}
+/// The compiled `[[command]]` motion and each command's span.
+type CompiledCommands = (crate::body_motion::BodyMotion, Vec<std::ops::Range<usize>>);
+/// The six channel keys of a command, with their values.
+type ChannelKeys<'a> = [(&'a Option<S<f64>>, &'static str); 6];
 
 /// `[[command]]` and `[body_motion]`: gnss-ins-sim motion commands on the "Euler angles +
 /// body velocity" base ([`crate::body_motion`]), in place of `[[segment]]`; free vehicle,
@@ -1943,7 +1855,7 @@ fn parse_body_motion(
     euler: Euler,
     vehicle: Vehicle,
     dt: f64,
-) -> Result<Option<(crate::body_motion::BodyMotion, Vec<std::ops::Range<usize>>)>, ScenarioError> {
+) -> Result<Option<CompiledCommands>, ScenarioError> {
     use crate::body_motion::{BodyCommand, BodyMotion, BodyStart, CommandKind, MotionLimits};
     if doc.command.is_empty() {
         if let Some(b) = &doc.body_motion {
@@ -2056,7 +1968,7 @@ fn parse_body_motion(
             );
         };
         let rates = kind == CommandKind::Rates;
-        let (given, other): ([(&Option<S<f64>>, &str); 6], [(&Option<S<f64>>, &str); 6]) = {
+        let (given, other): (ChannelKeys<'_>, ChannelKeys<'_>) = {
             let a = [
                 (&cd.yaw_deg, "yaw_deg"),
                 (&cd.pitch_deg, "pitch_deg"),
@@ -2130,4 +2042,97 @@ fn parse_body_motion(
         BodyMotion::compile(start, &commands, limits, dt),
         spans,
     )))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn all_builtins_parse() {
+        for b in BUILTINS {
+            let s = Scenario::from_toml(b.toml, b.name);
+            assert!(s.is_ok(), "{}: {:?}", b.name, s.err());
+        }
+    }
+
+    fn err_of(text: &str) -> ScenarioError {
+        match Scenario::from_toml(text, "t.toml") {
+            Err(e) => e,
+            Ok(_) => panic!("expected an error for:\n{text}"),
+        }
+    }
+
+    const BASE: &str = "[start]\nlat_deg = 37.5\nlon_deg = 127.0\n[imu]\nrate_hz = 100.0\n[[segment]]\ntype = \"static\"\nduration_s = 10.0\n";
+
+    #[test]
+    fn unknown_key_names_line_and_suggests() {
+        let e = err_of(&BASE.replace("lon_deg = 127.0", "lon_deg = 127.0\nlat_dg = 3.0"));
+        let ScenarioError::Invalid {
+            line, key, message, ..
+        } = &e
+        else {
+            panic!("{e}")
+        };
+        assert_eq!((*line, key.as_str()), (4, "lat_dg"));
+        assert!(message.contains("did you mean `lat_deg`"), "{message}");
+    }
+
+    #[test]
+    fn missing_key() {
+        let e = err_of(&BASE.replace("rate_hz = 100.0\n", ""));
+        assert!(
+            e.to_string().contains("rate_hz") && e.to_string().contains("missing"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn impossible_values_name_line_and_key() {
+        for (from, to, line, key) in [
+            (
+                "duration_s = 10.0",
+                "duration_s = -1.0",
+                8,
+                "segment.duration_s",
+            ),
+            ("rate_hz = 100.0", "rate_hz = 0.0", 5, "imu.rate_hz"),
+            ("lat_deg = 37.5", "lat_deg = 95.0", 2, "start.lat_deg"),
+            (
+                "duration_s = 10.0",
+                "duration_s = 10.001",
+                8,
+                "segment.duration_s",
+            ),
+            ("lat_deg = 37.5", "lat_deg = nan", 2, "start.lat_deg"),
+        ] {
+            let e = err_of(&BASE.replace(from, to));
+            let ScenarioError::Invalid {
+                line: l, key: k, ..
+            } = &e
+            else {
+                panic!("{e}")
+            };
+            assert_eq!((*l, k.as_str()), (line, key), "{e}");
+        }
+        let e = err_of(&format!("{BASE}[start2]\n"));
+        assert!(e.to_string().contains("start2"), "{e}");
+        let e = err_of(&BASE.replace(
+            "[start]\nlat_deg = 37.5\n",
+            "[start]\nlat_deg = 37.5\nh_m = -2000.0\n",
+        ));
+        assert!(e.to_string().contains("start.h_m"), "{e}");
+    }
+
+    #[test]
+    fn wrong_segment_keys() {
+        let e = err_of(&BASE.replace("type = \"static\"", "type = \"staticc\""));
+        assert!(e.to_string().contains("unknown segment type"), "{e}");
+        let e = err_of(&BASE.replace("duration_s = 10.0", "duration_s = 10.0\nrate_dps = 3.0"));
+        assert!(
+            e.to_string().contains("not a key of segment type `static`"),
+            "{e}"
+        );
+    }
 }
