@@ -1,6 +1,6 @@
 //! gnss-ins-sim motion files: import, round trip, runs, analytic checks on the truth,
-//! truth refinement, located errors (docs/scenarios.md §"Importing gnss-ins-sim motion
-//! files").
+//! truth refinement, located errors
+//! (docs/scenarios.md §"Importing gnss-ins-sim motion files").
 #![allow(clippy::unwrap_used)]
 use sdins_core::math::{euler_from_c_b_n, Vec3};
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};

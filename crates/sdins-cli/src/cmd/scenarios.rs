@@ -12,8 +12,8 @@ use sdins_sim::scenario::{builtin, BUILTINS};
 pub struct Args {
     /// print this built-in scenario as a TOML file, or `import` to translate FILE
     pub name: Option<String>,
-    /// with `import`: a gnss-ins-sim motion-definition CSV (docs/scenarios.md §"Importing
-    /// gnss-ins-sim motion files")
+    /// with `import`: a gnss-ins-sim motion-definition CSV
+    /// (docs/scenarios.md §"Importing gnss-ins-sim motion files")
     pub file: Option<std::path::PathBuf>,
     /// with `import`: gnss-ins-sim `mode` = max acceleration [m/s²], max angular
     /// acceleration [deg/s²], max angular rate [deg/s]
