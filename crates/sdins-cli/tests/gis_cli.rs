@@ -34,8 +34,10 @@ fn import_and_run_motion_files() {
     assert!(out.contains("extended"), "{out}");
     let toml = dir.join("my.toml");
     std::fs::write(&toml, &out).unwrap();
+    let out_dir = dir.join("out");
+    let o = out_dir.to_str().unwrap();
     for scn in [g, toml.to_str().unwrap()] {
-        let (code, _, err) = sdins(&["run", scn, "--quiet"]);
+        let (code, _, err) = sdins(&["run", scn, "--quiet", "--out", o]);
         assert_eq!(code, 0, "{scn}: {err}");
     }
     let bad = dir.join("bad.csv");
@@ -63,7 +65,7 @@ fn import_and_run_motion_files() {
         let (code, _, err) = sdins(&["scenarios", "import", bad.to_str().unwrap()]);
         assert_eq!(code, 2, "{err}");
         assert!(err.contains(want), "{want}: {err}");
-        let (code, _, err) = sdins(&["run", bad.to_str().unwrap(), "--quiet"]);
+        let (code, _, err) = sdins(&["run", bad.to_str().unwrap(), "--quiet", "--out", o]);
         assert_eq!(code, 2, "{err}");
         assert!(err.contains(&want[..10]), "{want}: {err}");
     }
