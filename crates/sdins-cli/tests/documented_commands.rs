@@ -112,6 +112,11 @@ const RULES: &[Rule] = &[
         Replace(" lasergyro.imu", " ../shared/data/psins/lasergyro.imu"),
     ),
     rule("lasergyro.imu", NeedsData("psins/lasergyro.imu")),
+    rule(
+        "motion_def-3d.csv",
+        Replace(" motion_def-3d.csv", " ../shared/data/gnss_ins_sim/motion_def-3d.csv"),
+    ),
+    rule("gnss_ins_sim/", NeedsData("gnss_ins_sim/motion_def-3d.csv")),
     // the NaveGo example of `sdins fuse --help`
     rule(
         "imu1_params.txt",

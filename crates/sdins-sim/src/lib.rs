@@ -46,6 +46,7 @@
 pub mod align;
 pub mod align_run;
 pub mod allan;
+pub mod body_motion;
 pub mod calibration;
 pub mod cancel;
 pub mod envelope;
@@ -57,6 +58,7 @@ pub mod fuse_records;
 pub mod gnss;
 pub mod gnss_file;
 pub mod gnss_fix;
+pub mod gnss_ins_sim;
 pub mod imu_error;
 pub mod imu_file;
 pub mod initial;

@@ -69,8 +69,12 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "mounting",
             "gnss",
             "calibration",
+            "body_motion",
+            "command",
         ],
     ),
+    BODY_MOTION_KEYS,
+    COMMAND_KEYS,
     ("calibration", &["schedule", "dwell_s", "rotation_s"]),
     (
         "mounting",
@@ -134,6 +138,72 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
     GNSS_KEYS,
 ];
 
+// ---- [body_motion] and [[command]] (gnss-ins-sim motion commands) ----
+/// Keys of `[body_motion]` (start body velocity and the motion limits).
+const BODY_MOTION_KEYS: (&str, &[&str]) = (
+    "body_motion",
+    &[
+        "vx_mps",
+        "vy_mps",
+        "vz_mps",
+        "max_accel_mps2",
+        "max_angular_accel_dps2",
+        "max_angular_rate_dps",
+    ],
+);
+/// Keys of `[[command]]` ([`crate::body_motion::BodyCommand`]).
+const COMMAND_KEYS: (&str, &[&str]) = (
+    "command",
+    &[
+        "type",
+        "yaw_deg",
+        "pitch_deg",
+        "roll_deg",
+        "vx_mps",
+        "vy_mps",
+        "vz_mps",
+        "yaw_rate_dps",
+        "pitch_rate_dps",
+        "roll_rate_dps",
+        "ax_mps2",
+        "ay_mps2",
+        "az_mps2",
+        "duration_s",
+    ],
+);
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BodyMotionDoc {
+    vx_mps: Option<S<f64>>,
+    vy_mps: Option<S<f64>>,
+    vz_mps: Option<S<f64>>,
+    max_accel_mps2: Option<S<f64>>,
+    max_angular_accel_dps2: Option<S<f64>>,
+    max_angular_rate_dps: Option<S<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CommandDoc {
+    #[serde(rename = "type")]
+    kind: S<i64>,
+    yaw_deg: Option<S<f64>>,
+    pitch_deg: Option<S<f64>>,
+    roll_deg: Option<S<f64>>,
+    vx_mps: Option<S<f64>>,
+    vy_mps: Option<S<f64>>,
+    vz_mps: Option<S<f64>>,
+    yaw_rate_dps: Option<S<f64>>,
+    pitch_rate_dps: Option<S<f64>>,
+    roll_rate_dps: Option<S<f64>>,
+    ax_mps2: Option<S<f64>>,
+    ay_mps2: Option<S<f64>>,
+    az_mps2: Option<S<f64>>,
+    duration_s: S<f64>,
+}
+// ---- end [body_motion] ----
+
 // ---- [gnss] section (INS/GNSS fusion) ----
 /// Keys of the `[gnss]` table (`crate::gnss::GnssConfig`).
 const GNSS_KEYS: (&str, &[&str]) = (
@@ -176,6 +246,9 @@ struct FileDoc {
     // [gnss] section
     gnss: Option<S<crate::gnss::GnssConfig>>,
     calibration: Option<S<CalibrationDoc>>,
+    body_motion: Option<S<BodyMotionDoc>>,
+    #[serde(default)]
+    command: Vec<S<CommandDoc>>,
 }
 
 #[derive(Deserialize)]
@@ -693,6 +766,7 @@ impl Scenario {
             }
         }
         let calibration = parse_calibration(&cx, &doc, speed, climb, vehicle, 1.0 / rate_hz)?;
+        let body = parse_body_motion(&cx, &doc, euler, vehicle, dt)?;
         let mut motions = Vec::new();
         // the [[segment]] of each motion (a coordinated turn is three motions)
         let mut seg_of_motion: Vec<std::ops::Range<usize>> = Vec::new();
@@ -925,7 +999,10 @@ impl Scenario {
             motions.push((Motion::Static, sched.duration_s));
             seg_of_motion.push(doc.calibration.as_ref().map_or(0..0, |c| c.span()));
         }
-        if motions.is_empty() {
+        if let Some((_, spans)) = &body {
+            seg_of_motion = spans.clone();
+        }
+        if motions.is_empty() && body.is_none() {
             return Err(ScenarioError::Invalid {
                 file: file.into(),
                 line: 1,
@@ -934,7 +1011,10 @@ impl Scenario {
                     .into(),
             });
         }
-        let total: f64 = motions.iter().map(|m| m.1).sum();
+        let total: f64 = match &body {
+            Some((b, _)) => b.duration_s,
+            None => motions.iter().map(|m| m.1).sum(),
+        };
 
         let mut overlays = Vec::new();
         let mut vib_list = Vec::new();
@@ -1092,8 +1172,11 @@ impl Scenario {
         if let Some(sched) = &calibration {
             overlays.extend(sched.overlays());
         }
-        let trajectory = Trajectory::new(speed, -climb, euler, &motions, overlays)
-            .with_random_vibration(vib_list);
+        let trajectory = match body {
+            Some((b, _)) => Trajectory::from_body_motion(b, overlays),
+            None => Trajectory::new(speed, -climb, euler, &motions, overlays),
+        }
+        .with_random_vibration(vib_list);
         let trajectory = match trajectory.with_vehicle(vehicle, nav.earth.model(), lat * D2R, h) {
             Ok(t) => t,
             Err(e) => {
@@ -1181,7 +1264,44 @@ impl Scenario {
             file: file.clone(),
             reason: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         })?;
+        if crate::gnss_ins_sim::looks_like_motion_def(&text) {
+            return Scenario::from_motion_def(&text, path, &Default::default());
+        }
         Scenario::from_toml(&text, &file)
+    }
+
+    /// A gnss-ins-sim motion-definition file as a scenario
+    /// ([`crate::gnss_ins_sim::to_scenario_toml`], then [`Scenario::from_toml`] on the result).
+    pub fn from_motion_def(
+        text: &str,
+        path: &Path,
+        opts: &crate::gnss_ins_sim::ImportOptions,
+    ) -> Result<Scenario, ScenarioError> {
+        use crate::gnss_ins_sim::{parse_motion_def, to_scenario_toml, GisError};
+        let file = path.display().to_string();
+        let conv = |e: GisError| match e {
+            GisError::Invalid {
+                file,
+                line,
+                column,
+                message,
+            } => ScenarioError::Invalid {
+                file,
+                line,
+                key: format!("column {column}"),
+                message,
+            },
+            other => ScenarioError::Read {
+                file: file.clone(),
+                reason: other.to_string(),
+            },
+        };
+        let mf = parse_motion_def(text, &file).map_err(conv)?;
+        let name = path
+            .file_stem()
+            .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned());
+        let toml = to_scenario_toml(&mf, &name, &file, opts).map_err(conv)?;
+        Scenario::from_toml(&toml, &file)
     }
 
     /// A built-in name or a file path.
@@ -1726,6 +1846,210 @@ pub const BUILTINS: &[Builtin] = &[
 /// Look up a built-in scenario by name.
 pub fn builtin(name: &str) -> Option<&'static Builtin> {
     BUILTINS.iter().find(|b| b.name == name)
+}
+
+/// The compiled `[[command]]` motion and each command's span.
+type CompiledCommands = (crate::body_motion::BodyMotion, Vec<std::ops::Range<usize>>);
+/// The six channel keys of a command, with their values.
+type ChannelKeys<'a> = [(&'a Option<S<f64>>, &'static str); 6];
+
+/// `[[command]]` and `[body_motion]`: gnss-ins-sim motion commands on the "Euler angles +
+/// body velocity" base ([`crate::body_motion`]), in place of `[[segment]]`; free vehicle,
+/// start attitude from `[start]`, start body velocity from `[body_motion]`. Returns the
+/// compiled motion and the span of each command.
+fn parse_body_motion(
+    cx: &Ctx<'_>,
+    doc: &FileDoc,
+    euler: Euler,
+    vehicle: Vehicle,
+    dt: f64,
+) -> Result<Option<CompiledCommands>, ScenarioError> {
+    use crate::body_motion::{BodyCommand, BodyMotion, BodyStart, CommandKind, MotionLimits};
+    if doc.command.is_empty() {
+        if let Some(b) = &doc.body_motion {
+            return cx.err(
+                b.span(),
+                "body_motion",
+                "[body_motion] goes with [[command]] tables: add commands or remove it",
+            );
+        }
+        return Ok(None);
+    }
+    let first = doc.command[0].span();
+    if let Some(s) = doc.segment.first() {
+        return cx.err(
+            s.span(),
+            "segment",
+            "[[command]] tables replace [[segment]]: use one or the other",
+        );
+    }
+    if let Some(c) = &doc.calibration {
+        return cx.err(
+            c.span(),
+            "calibration",
+            "[[command]] tables and [calibration] exclude each other",
+        );
+    }
+    if vehicle != Vehicle::Free {
+        return cx.err(
+            first,
+            "vehicle",
+            "[[command]] motion sets the body velocity directly: it needs vehicle = \"free\"",
+        );
+    }
+    let st = doc.start.get_ref();
+    for (v, key) in [
+        (&st.speed_mps, "start.speed_mps"),
+        (&st.climb_rate_mps, "start.climb_rate_mps"),
+    ] {
+        if let Some(v) = v {
+            return cx.err(
+                v.span(),
+                key,
+                "with [[command]] tables the start velocity is [body_motion] vx_mps, vy_mps, vz_mps: leave this key out",
+            );
+        }
+    }
+    let bm = doc.body_motion.as_ref().map(|b| b.get_ref());
+    let opt = |v: Option<&S<f64>>, key: &str, lim: f64, def: f64| -> Result<f64, ScenarioError> {
+        match v {
+            Some(v) => cx.range(v, key, -lim, lim, &format!("a value in [-{lim}, {lim}]")),
+            None => Ok(def),
+        }
+    };
+    let pos = |v: Option<&S<f64>>, key: &str, def: f64| -> Result<f64, ScenarioError> {
+        match v {
+            Some(v) => cx.positive(v, key),
+            None => Ok(def),
+        }
+    };
+    let vel_b = [
+        opt(
+            bm.and_then(|b| b.vx_mps.as_ref()),
+            "body_motion.vx_mps",
+            3000.0,
+            0.0,
+        )?,
+        opt(
+            bm.and_then(|b| b.vy_mps.as_ref()),
+            "body_motion.vy_mps",
+            3000.0,
+            0.0,
+        )?,
+        opt(
+            bm.and_then(|b| b.vz_mps.as_ref()),
+            "body_motion.vz_mps",
+            3000.0,
+            0.0,
+        )?,
+    ];
+    let d = MotionLimits::DEFAULT.to_mode();
+    let limits = MotionLimits::from_mode([
+        pos(
+            bm.and_then(|b| b.max_accel_mps2.as_ref()),
+            "body_motion.max_accel_mps2",
+            d[0],
+        )?,
+        pos(
+            bm.and_then(|b| b.max_angular_accel_dps2.as_ref()),
+            "body_motion.max_angular_accel_dps2",
+            d[1],
+        )?,
+        pos(
+            bm.and_then(|b| b.max_angular_rate_dps.as_ref()),
+            "body_motion.max_angular_rate_dps",
+            d[2],
+        )?,
+    ]);
+    let mut commands = Vec::with_capacity(doc.command.len());
+    let mut spans = Vec::with_capacity(doc.command.len());
+    for c in &doc.command {
+        let cd = c.get_ref();
+        let Some(kind) = CommandKind::from_number(*cd.kind.get_ref()) else {
+            return cx.err(
+                cd.kind.span(),
+                "command.type",
+                format!(
+                    "{} is not a command type: expected 1, 2, 3, 4 or 5",
+                    cd.kind.get_ref()
+                ),
+            );
+        };
+        let rates = kind == CommandKind::Rates;
+        let (given, other): (ChannelKeys<'_>, ChannelKeys<'_>) = {
+            let a = [
+                (&cd.yaw_deg, "yaw_deg"),
+                (&cd.pitch_deg, "pitch_deg"),
+                (&cd.roll_deg, "roll_deg"),
+                (&cd.vx_mps, "vx_mps"),
+                (&cd.vy_mps, "vy_mps"),
+                (&cd.vz_mps, "vz_mps"),
+            ];
+            let r = [
+                (&cd.yaw_rate_dps, "yaw_rate_dps"),
+                (&cd.pitch_rate_dps, "pitch_rate_dps"),
+                (&cd.roll_rate_dps, "roll_rate_dps"),
+                (&cd.ax_mps2, "ax_mps2"),
+                (&cd.ay_mps2, "ay_mps2"),
+                (&cd.az_mps2, "az_mps2"),
+            ];
+            if rates {
+                (r, a)
+            } else {
+                (a, r)
+            }
+        };
+        for (v, k) in other {
+            if let Some(v) = v {
+                let takes = given.map(|g| g.1).join(", ");
+                return cx.err(
+                    v.span(),
+                    &format!("command.{k}"),
+                    format!(
+                        "not a key of command type {} (it takes: {takes}, duration_s)",
+                        kind.number()
+                    ),
+                );
+            }
+        }
+        let mut x = [0.0; 6];
+        for (i, (v, k)) in given.iter().enumerate() {
+            if let Some(v) = v {
+                x[i] = cx.range(v, &format!("command.{k}"), -1e6, 1e6, "a value within ±1e6")?;
+            }
+        }
+        let dur = cx.positive(&cd.duration_s, "command.duration_s")?;
+        if dur > MAX_SEGMENT_S {
+            return cx.err(
+                cd.duration_s.span(),
+                "command.duration_s",
+                format!("{dur} s is too long: expected at most {MAX_SEGMENT_S:e} s"),
+            );
+        }
+        let n = dur / dt;
+        if n.round() < 1.0 || (n - n.round()).abs() > 1e-6 * n.max(1.0) {
+            return cx.err(
+                cd.duration_s.span(),
+                "command.duration_s",
+                format!("{dur} s is not a whole number of IMU samples ({dt} s) (command boundaries must fall on sample boundaries)"),
+            );
+        }
+        commands.push(BodyCommand {
+            kind,
+            euler_ypr: [x[0] * D2R, x[1] * D2R, x[2] * D2R],
+            vel_b: [x[3], x[4], x[5]],
+            duration_s: n.round() * dt,
+        });
+        spans.push(c.span());
+    }
+    let start = BodyStart {
+        euler_ypr: [euler.yaw_rad, euler.pitch_rad, euler.roll_rad],
+        vel_b,
+    };
+    Ok(Some((
+        BodyMotion::compile(start, &commands, limits, dt),
+        spans,
+    )))
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@
 //! values (flat turns, as in the papers' scenarios). Overlays add body coning, sculling
 //! and vibration on top.
 
+use crate::body_motion::BodyMotion;
 use crate::random_vibration::RandomVibration;
 use crate::reference::ReferenceTrack;
 use crate::vehicle::{
@@ -312,6 +313,9 @@ pub struct Trajectory {
     /// a recorded trajectory's interpolant, in place of the segments
     /// ([`Trajectory::from_reference`])
     reference: Option<Arc<ReferenceTrack>>,
+    /// "Euler angles + body velocity" base ([`crate::body_motion`]) in place of the
+    /// segments' nominal motion (the segments then only carry the command time spans)
+    body: Option<Arc<BodyMotion>>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -516,6 +520,7 @@ impl Trajectory {
             random: Vec::new(),
             rv_offset: Vec::new(),
             reference: None,
+            body: None,
         }
     }
 
@@ -541,7 +546,34 @@ impl Trajectory {
         if let Some(r) = &self.reference {
             b.extend(r.knots().iter().skip(1).copied());
         }
+        if let Some(bm) = &self.body {
+            b.extend(bm.breaks());
+        }
         b
+    }
+
+    /// A trajectory on the "Euler angles + body velocity" base ([`crate::body_motion`]):
+    /// one placeholder segment per command (its time span, for the envelope check and
+    /// error locations) and the overlays on top, free vehicle.
+    pub fn from_body_motion(body: BodyMotion, overlays: Vec<Overlay>) -> Self {
+        let motions: Vec<(Motion, f64)> = body
+            .pieces()
+            .iter()
+            .map(|p| (Motion::Cruise, p.duration_s))
+            .collect();
+        let mut tr = Trajectory::new(0.0, 0.0, Euler::new(0.0, 0.0, 0.0), &motions, overlays);
+        // the placeholder segments start where the pieces start
+        for (seg, p) in tr.segments.iter_mut().zip(body.pieces()) {
+            seg.t0_s = p.t0_s;
+        }
+        tr.duration_s = body.duration_s;
+        tr.body = Some(Arc::new(body));
+        tr
+    }
+
+    /// The body-motion base, if the trajectory has one ([`Trajectory::from_body_motion`]).
+    pub fn body_motion(&self) -> Option<&BodyMotion> {
+        self.body.as_deref()
     }
 
     /// Attach the realisations that the [`OverlayKind::RandomVibration`] overlays index
@@ -691,7 +723,11 @@ impl Trajectory {
             // resolved by amplitude: `Trajectory::random_vibration_panels`
             OverlayKind::RandomVibration { .. } => 0.0,
         });
-        seg.chain(ov).fold(0.0, f64::max)
+        let body = self
+            .body
+            .as_deref()
+            .map_or(0.0, BodyMotion::max_frequency_rps);
+        seg.chain(ov).fold(body, f64::max)
     }
 
     /// The overlays.
@@ -703,7 +739,8 @@ impl Trajectory {
     /// cruise segments): then the truth has the closed form of docs/theory/mechanizations.md
     /// §"Truth generation" (A0, A1).
     pub fn is_constant_parallel(&self) -> bool {
-        self.track.is_none()
+        self.body.is_none()
+            && self.track.is_none()
             && self.reference.is_none()
             && self.overlays.is_empty()
             && self
@@ -885,6 +922,11 @@ impl Trajectory {
                 );
                 (c_nom, w_nom)
             }
+        };
+        // the body-motion base replaces the nominal motion (crate::body_motion)
+        let (v, v_dot, c_nom, w_nom) = match self.body.as_deref() {
+            Some(b) => b.kinematics(t, t_sel),
+            None => (v, v_dot, c_nom, w_nom),
         };
         self.apply_overlays(t_base, off, t_sel, phases, v, v_dot, c_nom, w_nom)
     }
