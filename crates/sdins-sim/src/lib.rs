@@ -66,6 +66,7 @@ pub mod nav_recorded;
 pub mod navego_params;
 pub mod pipeline;
 pub mod random_vibration;
+pub mod route;
 pub mod run_setup;
 pub mod scenario;
 pub mod smoother;
