@@ -877,3 +877,32 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
         report,
     })
 }
+
+impl CompiledRoute {
+    /// One line per waypoint: arrival time, distance from the waypoint to the flown path,
+    /// turn angle and lead distance (what `sdins truth` and `sdins run` print).
+    pub fn summary(&self) -> Vec<String> {
+        let n = self.report.len();
+        self.report
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let what = if i == 0 {
+                    "start"
+                } else if i + 1 == n {
+                    "arrival miss"
+                } else {
+                    "distance to path"
+                };
+                format!(
+                    "route: waypoint {} at t = {:.3} s: {what} {:.4} m, turn {:.3} deg, lead {:.2} m",
+                    i + 1,
+                    r.arrival_s,
+                    r.miss_m,
+                    r.turn_rad.to_degrees(),
+                    r.lead_m
+                )
+            })
+            .collect()
+    }
+}
