@@ -700,9 +700,11 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
             return Err(RouteError::Turn { waypoint: j + 1, turn_deg: d.to_degrees(), why: "turns above 170 deg (reversals) are not supported".into() });
         }
         let v = wps[j].speed_mps;
+        // designed at (1 − 1e-4) of the limit: the angle iteration and the geodesic rates
+        // at the ramp ends move the hold rate by far less
         let bank = match lim.turn {
-            TurnLimit::Bank(b) => b,
-            TurnLimit::Rate(r) => (r * v / G).atan(),
+            TurnLimit::Bank(b) => (b.tan() * (1.0 - 1e-4)).atan(),
+            TurnLimit::Rate(r) => (r * (1.0 - 1e-4) * v / G).atan(),
         };
         let parts = crate::vehicle::coordinated_turn(v, d, bank, lim.roll_rate_rps, dt_s)
             .map_err(|e| RouteError::Turn { waypoint: j + 1, turn_deg: d.to_degrees(), why: e.to_string() })?;
