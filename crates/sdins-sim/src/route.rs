@@ -276,8 +276,7 @@ impl Ctx {
         &self,
         seg: &Segment,
         p0: P,
-        t0: f64,
-        t1: f64,
+        (t0, t1): (f64, f64),
         max_step: f64,
         ode: bool,
         mut visit: impl FnMut(f64, &P),
@@ -321,7 +320,7 @@ impl Ctx {
     fn arc(&self, p: P, len: f64) -> (P, f64) {
         let seg = Segment::with_start(Motion::Cruise, 0.0, len, (1.0, p.psi, 0.0));
         let mut max_lat = p.lat.abs();
-        let q = self.fly(&seg, p, 0.0, len, 500.0, true, |_, q| {
+        let q = self.fly(&seg, p, (0.0, len), 500.0, true, |_, q| {
             max_lat = max_lat.max(q.lat.abs());
         });
         (q, max_lat)
@@ -329,15 +328,33 @@ impl Ctx {
 
     /// The ideal leg from `a` to `b` at height `h`: start heading, end heading, length,
     /// largest |L| (Newton on start heading and length).
-    fn ideal_leg(&self, a: &Waypoint, b: &Waypoint, wp: usize) -> Result<(f64, f64, f64, f64), RouteError> {
+    fn ideal_leg(
+        &self,
+        a: &Waypoint,
+        b: &Waypoint,
+        wp: usize,
+    ) -> Result<(f64, f64, f64, f64), RouteError> {
         let h = 0.5 * (a.h_m + b.h_m);
-        let pa = P { lat: a.lat_rad, lon: a.lon_rad, h, psi: 0.0 };
-        let pb = P { lat: b.lat_rad, lon: b.lon_rad, h, psi: 0.0 };
+        let pa = P {
+            lat: a.lat_rad,
+            lon: a.lon_rad,
+            h,
+            psi: 0.0,
+        };
+        let pb = P {
+            lat: b.lat_rad,
+            lon: b.lon_rad,
+            h,
+            psi: 0.0,
+        };
         let d0 = self.ned(&pa, &pb);
         let mut psi = d0.y.atan2(d0.x);
         let mut len = (d0.x * d0.x + d0.y * d0.y).sqrt();
         if len < 1.0 {
-            return Err(RouteError::Coincident { waypoint: wp, distance_m: len });
+            return Err(RouteError::Coincident {
+                waypoint: wp,
+                distance_m: len,
+            });
         }
         let miss = |psi: f64, len: f64| -> Vec3 {
             let (q, _) = self.arc(P { psi, ..pa }, len);
@@ -362,10 +379,16 @@ impl Ctx {
             len = (len - step_l).max(0.5 * len);
             let (_, max_lat) = self.arc(P { psi, ..pa }, len);
             if max_lat > MAX_LAT_RAD {
-                return Err(RouteError::Pole { waypoint: wp, lat_deg: max_lat.to_degrees() });
+                return Err(RouteError::Pole {
+                    waypoint: wp,
+                    lat_deg: max_lat.to_degrees(),
+                });
             }
         }
-        Err(RouteError::Solve { waypoint: wp, why: "the ideal leg did not converge".into() })
+        Err(RouteError::Solve {
+            waypoint: wp,
+            why: "the ideal leg did not converge".into(),
+        })
     }
 
     fn round_dt(&self, t: f64) -> f64 {
@@ -397,7 +420,11 @@ fn leg_pieces(
     if v1 != v0 {
         // smooth step: peak acceleration 2Δ/T
         let dur = ctx.round_dt(2.0 * (v1 - v0).abs() / a);
-        pre.push(Piece { d_speed: v1 - v0, d_vd: 0.0, dur });
+        pre.push(Piece {
+            d_speed: v1 - v0,
+            d_vd: 0.0,
+            dur,
+        });
         len += 0.5 * (v0 + v1) * dur;
     }
     if dh != 0.0 {
@@ -415,17 +442,33 @@ fn leg_pieces(
         // the exact rate so the height change is dh: c (T_r + T_h) = |dh|
         let c = dh.abs() / (t_r + t_h);
         let vd = -c * dh.signum();
-        pre.push(Piece { d_speed: 0.0, d_vd: vd, dur: t_r });
+        pre.push(Piece {
+            d_speed: 0.0,
+            d_vd: vd,
+            dur: t_r,
+        });
         if t_h > 0.0 {
-            pre.push(Piece { d_speed: 0.0, d_vd: 0.0, dur: t_h });
+            pre.push(Piece {
+                d_speed: 0.0,
+                d_vd: 0.0,
+                dur: t_h,
+            });
         }
-        pre.push(Piece { d_speed: 0.0, d_vd: -vd, dur: t_r });
+        pre.push(Piece {
+            d_speed: 0.0,
+            d_vd: -vd,
+            dur: t_r,
+        });
         len += v1 * (2.0 * t_r + t_h);
     }
     let mut post = Vec::new();
     if stop {
         let dur = ctx.round_dt(2.0 * v1 / a);
-        post.push(Piece { d_speed: -v1, d_vd: 0.0, dur });
+        post.push(Piece {
+            d_speed: -v1,
+            d_vd: 0.0,
+            dur,
+        });
         len += 0.5 * v1 * dur;
     }
     (pre, post, len)
@@ -468,7 +511,14 @@ impl Ctx {
     fn fly_leg(&self, leg: &Leg, p: P) -> P {
         let mut q = p;
         for (seg, t) in leg.segs(p.psi, 0.0) {
-            q = self.fly(&seg, q, t, t + seg.duration_s, piece_step(seg.duration_s), true, |_, _| {});
+            q = self.fly(
+                &seg,
+                q,
+                (t, t + seg.duration_s),
+                piece_step(seg.duration_s),
+                true,
+                |_, _| {},
+            );
         }
         q
     }
@@ -478,10 +528,8 @@ impl Ctx {
     /// miss. Returns the start heading and the leg.
     fn shoot(
         &self,
-        pre: &[Piece],
-        post: &[Piece],
-        speed0: f64,
-        cruise_speed: f64,
+        (pre, post): (&[Piece], &[Piece]),
+        (speed0, cruise_speed): (f64, f64),
         p: P,
         target: &P,
         t_cruise0: f64,
@@ -492,7 +540,11 @@ impl Ctx {
             let mut left = t_c;
             while left > 0.0 {
                 let d = left.min(MAX_PIECE_S);
-                pieces.push(Piece { d_speed: 0.0, d_vd: 0.0, dur: d });
+                pieces.push(Piece {
+                    d_speed: 0.0,
+                    d_vd: 0.0,
+                    dur: d,
+                });
                 left -= d;
                 if left < 1e-9 {
                     break;
@@ -508,7 +560,10 @@ impl Ctx {
         let d0 = self.ned(&p, target);
         let mut psi = p.psi;
         let mut t_c = t_cruise0.max(0.0);
-        let fail = |why: &str| RouteError::Solve { waypoint: wp, why: why.into() };
+        let fail = |why: &str| RouteError::Solve {
+            waypoint: wp,
+            why: why.into(),
+        };
         let mut ok = false;
         for _ in 0..30 {
             let m = miss(psi, t_c);
@@ -539,7 +594,11 @@ impl Ctx {
             return Err(fail("the shooting did not converge"));
         }
         // whole samples, then zero cross-track miss (normal to the arrival heading)
-        let t_r = if t_c < 0.5 * self.dt { 0.0 } else { (t_c / self.dt).round() * self.dt };
+        let t_r = if t_c < 0.5 * self.dt {
+            0.0
+        } else {
+            (t_c / self.dt).round() * self.dt
+        };
         let cross = |psi: f64| -> f64 {
             let q = self.fly_leg(&build(t_r), P { psi, ..p });
             let m = self.ned(target, &q);
@@ -568,7 +627,11 @@ impl Ctx {
             let dur = seg.duration_s;
             let mut cheb = [0.0; GEO_CHEB_N];
             let pc = match seg.motion {
-                Motion::Geodesic { delta_speed_mps, delta_v_d_mps, .. } => (delta_speed_mps, delta_v_d_mps),
+                Motion::Geodesic {
+                    delta_speed_mps,
+                    delta_v_d_mps,
+                    ..
+                } => (delta_speed_mps, delta_v_d_mps),
                 _ => (0.0, 0.0),
             };
             if self.legs == LegKind::GreatCircle {
@@ -582,7 +645,7 @@ impl Ctx {
                 let (mut tc, mut pp) = (t0, q);
                 for &(j, x) in &nodes {
                     let tn = t0 + x * dur;
-                    pp = self.fly(&seg, pp, tc, tn, piece_step(dur), true, |_, _| {});
+                    pp = self.fly(&seg, pp, (tc, tn), piece_step(dur), true, |_, _| {});
                     tc = tn;
                     f[j] = pp.psi - q.psi;
                 }
@@ -593,9 +656,13 @@ impl Ctx {
                     *ck = 2.0 * s / n as f64 * if k == 0 { 0.5 } else { 1.0 };
                 }
             }
-            q = self.fly(&seg, q, t0, t0 + dur, piece_step(dur), true, |_, _| {});
+            q = self.fly(&seg, q, (t0, t0 + dur), piece_step(dur), true, |_, _| {});
             out.push((
-                Motion::Geodesic { heading_cheb: cheb, delta_speed_mps: pc.0, delta_v_d_mps: pc.1 },
+                Motion::Geodesic {
+                    heading_cheb: cheb,
+                    delta_speed_mps: pc.0,
+                    delta_v_d_mps: pc.1,
+                },
                 dur,
             ));
         }
@@ -615,11 +682,23 @@ impl Ctx {
 fn turn_motions(timing: (f64, f64), dpsi: f64, a: f64, b: f64) -> Vec<(Motion, f64)> {
     let (t_r, t_h) = timing;
     let r = (dpsi - 0.5 * t_r * (a + b)) / (t_r + t_h);
-    let mut m = vec![(Motion::TurnRamp { from_rps: a, to_rps: r }, t_r)];
+    let mut m = vec![(
+        Motion::TurnRamp {
+            from_rps: a,
+            to_rps: r,
+        },
+        t_r,
+    )];
     if t_h > 0.0 {
         m.push((Motion::TurnRate { rate_rps: r }, t_h));
     }
-    m.push((Motion::TurnRamp { from_rps: r, to_rps: b }, t_r));
+    m.push((
+        Motion::TurnRamp {
+            from_rps: r,
+            to_rps: b,
+        },
+        t_r,
+    ));
     m
 }
 
@@ -631,7 +710,13 @@ fn turn_displacement(motions: &[(Motion, f64)], v: f64) -> (f64, f64) {
         let n = ((d / 0.01).ceil() as usize).max(2) * 2;
         let h = d / n as f64;
         for i in 0..=n {
-            let w = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
             let ps = seg.eval(t + i as f64 * h).heading;
             x += w * h / 3.0 * v * ps.cos();
             y += w * h / 3.0 * v * ps.sin();
@@ -654,34 +739,63 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
     }
     let lim = &route.limits;
     for (i, w) in wps.iter().enumerate() {
-        let bad = |what: String| Err(RouteError::Value { waypoint: i + 1, what });
-        for (name, v) in [("lat_deg", w.lat_rad), ("lon_deg", w.lon_rad), ("h_m", w.h_m), ("speed_mps", w.speed_mps), ("hold_s", w.hold_s)] {
+        let bad = |what: String| {
+            Err(RouteError::Value {
+                waypoint: i + 1,
+                what,
+            })
+        };
+        for (name, v) in [
+            ("lat_deg", w.lat_rad),
+            ("lon_deg", w.lon_rad),
+            ("h_m", w.h_m),
+            ("speed_mps", w.speed_mps),
+            ("hold_s", w.hold_s),
+        ] {
             if !v.is_finite() {
                 return bad(format!("{name} must be a finite number"));
             }
         }
         if w.lat_rad.abs() > MAX_LAT_RAD {
-            return Err(RouteError::Pole { waypoint: i + 1, lat_deg: w.lat_rad.to_degrees() });
+            return Err(RouteError::Pole {
+                waypoint: i + 1,
+                lat_deg: w.lat_rad.to_degrees(),
+            });
         }
-        if !(w.speed_mps > 0.0) {
+        if w.speed_mps <= 0.0 {
             return bad(format!("speed_mps {} must be > 0", w.speed_mps));
         }
         if w.hold_s < 0.0 || (w.hold_s > 0.0 && i != 0 && i != n - 1) {
             return bad("hold_s (time at rest) must be ≥ 0 and is accepted on the first and last waypoints only".into());
         }
     }
-    for (what, v) in [("roll-rate limit", lim.roll_rate_rps), ("climb-rate limit", lim.climb_rate_mps), ("acceleration limit", lim.accel_mps2), ("sample period", dt_s)] {
+    for (what, v) in [
+        ("roll-rate limit", lim.roll_rate_rps),
+        ("climb-rate limit", lim.climb_rate_mps),
+        ("acceleration limit", lim.accel_mps2),
+        ("sample period", dt_s),
+    ] {
         if !(v.is_finite() && v > 0.0) {
-            return Err(RouteError::Value { waypoint: 1, what: format!("{what} must be positive and finite (got {v})") });
+            return Err(RouteError::Value {
+                waypoint: 1,
+                what: format!("{what} must be positive and finite (got {v})"),
+            });
         }
     }
-    let ctx = Ctx { earth, dt: dt_s, legs: route.legs };
+    let ctx = Ctx {
+        earth,
+        dt: dt_s,
+        legs: route.legs,
+    };
     // ideal legs
     let mut ideal = Vec::with_capacity(n - 1);
     for k in 0..n - 1 {
         let l = ctx.ideal_leg(&wps[k], &wps[k + 1], k + 2)?;
         if l.3 > MAX_LAT_RAD {
-            return Err(RouteError::Pole { waypoint: k + 2, lat_deg: l.3.to_degrees() });
+            return Err(RouteError::Pole {
+                waypoint: k + 2,
+                lat_deg: l.3.to_degrees(),
+            });
         }
         ideal.push(l);
     }
@@ -697,7 +811,11 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
             continue;
         }
         if d.abs() > 170f64.to_radians() {
-            return Err(RouteError::Turn { waypoint: j + 1, turn_deg: d.to_degrees(), why: "turns above 170 deg (reversals) are not supported".into() });
+            return Err(RouteError::Turn {
+                waypoint: j + 1,
+                turn_deg: d.to_degrees(),
+                why: "turns above 170 deg (reversals) are not supported".into(),
+            });
         }
         let v = wps[j].speed_mps;
         // designed at (1 − 1e-4) of the limit: the angle iteration and the geodesic rates
@@ -706,8 +824,14 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
             TurnLimit::Bank(b) => (b.tan() * (1.0 - 1e-4)).atan(),
             TurnLimit::Rate(r) => (r * (1.0 - 1e-4) * v / G).atan(),
         };
-        let parts = crate::vehicle::coordinated_turn(v, d, bank, lim.roll_rate_rps, dt_s)
-            .map_err(|e| RouteError::Turn { waypoint: j + 1, turn_deg: d.to_degrees(), why: e.to_string() })?;
+        let parts =
+            crate::vehicle::coordinated_turn(v, d, bank, lim.roll_rate_rps, dt_s).map_err(|e| {
+                RouteError::Turn {
+                    waypoint: j + 1,
+                    turn_deg: d.to_degrees(),
+                    why: e.to_string(),
+                }
+            })?;
         let t_r = parts[0].1;
         let t_h = if parts.len() == 3 { parts[1].1 } else { 0.0 };
         timing[j] = (t_r, t_h);
@@ -718,16 +842,36 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
     }
     // room on each leg
     let stop_last = wps[n - 1].hold_s > 0.0;
-    let start_speed = if wps[0].hold_s > 0.0 { 0.0 } else { wps[0].speed_mps };
+    let start_speed = if wps[0].hold_s > 0.0 {
+        0.0
+    } else {
+        wps[0].speed_mps
+    };
     let mut pieces = Vec::with_capacity(n - 1);
     for k in 0..n - 1 {
-        let v0 = if k == 0 { start_speed } else { wps[k].speed_mps };
-        let pc = leg_pieces(&ctx, lim, v0, wps[k + 1].speed_mps, wps[k + 1].h_m - wps[k].h_m, stop_last && k == n - 2);
+        let v0 = if k == 0 {
+            start_speed
+        } else {
+            wps[k].speed_mps
+        };
+        let pc = leg_pieces(
+            &ctx,
+            lim,
+            v0,
+            wps[k + 1].speed_mps,
+            wps[k + 1].h_m - wps[k].h_m,
+            stop_last && k == n - 2,
+        );
         let need = pc.2 + lead_out[k] + lead_in[k + 1];
         if need > ideal[k].2 {
             return Err(RouteError::TooShort {
                 waypoint: k + 2,
-                what: format!("turn leads {:.1} m + {:.1} m, speed change and climb {:.1} m", lead_out[k], lead_in[k + 1], pc.2),
+                what: format!(
+                    "turn leads {:.1} m + {:.1} m, speed change and climb {:.1} m",
+                    lead_out[k],
+                    lead_in[k + 1],
+                    pc.2
+                ),
                 need_m: need,
                 have_m: ideal[k].2,
             });
@@ -737,7 +881,15 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
     // fly
     let mut motions: Vec<(Motion, f64)> = Vec::new();
     let mut motion_wp = Vec::new();
-    let mut report = vec![WaypointReport { arrival_s: 0.0, miss_m: 0.0, turn_rad: 0.0, lead_m: 0.0 }; n];
+    let mut report = vec![
+        WaypointReport {
+            arrival_s: 0.0,
+            miss_m: 0.0,
+            turn_rad: 0.0,
+            lead_m: 0.0
+        };
+        n
+    ];
     let mut t = 0.0;
     if wps[0].hold_s > 0.0 {
         let d = ctx.round_dt(wps[0].hold_s);
@@ -747,16 +899,30 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
     }
     report[0].arrival_s = t;
     let w0 = &wps[0];
-    let mut p = P { lat: w0.lat_rad, lon: w0.lon_rad, h: w0.h_m, psi: ideal[0].0 };
+    let mut p = P {
+        lat: w0.lat_rad,
+        lon: w0.lon_rad,
+        h: w0.h_m,
+        psi: ideal[0].0,
+    };
     let mut start_heading = p.psi;
     let mut rate_in = 0.0; // heading rate at the end of the previous leg
     for k in 0..n - 1 {
         let (pre, post, _) = &pieces[k];
-        let v0 = if k == 0 { start_speed } else { wps[k].speed_mps };
+        let v0 = if k == 0 {
+            start_speed
+        } else {
+            wps[k].speed_mps
+        };
         let v1 = wps[k + 1].speed_mps;
         let wn = &wps[k + 1];
         // the target: entry point of the next turn on the ideal leg, or the last waypoint
-        let pw = P { lat: wn.lat_rad, lon: wn.lon_rad, h: wn.h_m, psi: wrap(ideal[k].1 + PI) };
+        let pw = P {
+            lat: wn.lat_rad,
+            lon: wn.lon_rad,
+            h: wn.h_m,
+            psi: wrap(ideal[k].1 + PI),
+        };
         let target = if k + 1 == n - 1 || lead_in[k + 1] == 0.0 {
             pw
         } else {
@@ -766,19 +932,29 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
         let guess_tc = ((ideal[k].2 - lead_out[k] - lead_in[k + 1] - pre_len) / v1).max(0.0);
         // turn at waypoint k (interior): iterate the angle on the shot heading
         let (leg, psi0, turn, p_exit) = if k == 0 {
-            let (psi0, leg) = ctx.shoot(pre, post, v0, v1, p, &target, guess_tc, k + 2)?;
+            let (psi0, leg) = ctx.shoot((pre, post), (v0, v1), p, &target, guess_tc, k + 2)?;
             start_heading = psi0;
             (leg, psi0, Vec::new(), P { psi: psi0, ..p })
         } else if timing[k].0 == 0.0 {
-            let (psi0, leg) = ctx.shoot(pre, post, v0, v1, p, &target, guess_tc, k + 2)?;
+            let (psi0, leg) = ctx.shoot((pre, post), (v0, v1), p, &target, guess_tc, k + 2)?;
             if (wrap(psi0 - p.psi)).abs() > 1e-6 {
-                return Err(RouteError::Turn { waypoint: k + 1, turn_deg: wrap(psi0 - p.psi).to_degrees(), why: "a straight-through waypoint needs a heading change after all".into() });
+                return Err(RouteError::Turn {
+                    waypoint: k + 1,
+                    turn_deg: wrap(psi0 - p.psi).to_degrees(),
+                    why: "a straight-through waypoint needs a heading change after all".into(),
+                });
             }
             (leg, p.psi, Vec::new(), p)
         } else {
             let v = wps[k].speed_mps;
             let mut dpsi = dpsi0[k];
-            let mut b = ctx.geo_rate(&P { psi: p.psi + dpsi, ..p }, v);
+            let mut b = ctx.geo_rate(
+                &P {
+                    psi: p.psi + dpsi,
+                    ..p
+                },
+                v,
+            );
             let mut best = None;
             for _ in 0..8 {
                 let tm = turn_motions(timing[k], dpsi, rate_in, b);
@@ -787,12 +963,12 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
                 let mut psi_h = p.psi;
                 for &(m, d) in &tm {
                     let seg = Segment::with_start(m, tt, d, (v, psi_h, 0.0));
-                    q = ctx.fly(&seg, q, tt, tt + d, 0.01, false, |_, _| {});
+                    q = ctx.fly(&seg, q, (tt, tt + d), 0.01, false, |_, _| {});
                     psi_h = seg.end().1;
                     tt += d;
                 }
                 q.psi = psi_h;
-                let (psi0, leg) = ctx.shoot(pre, post, v, v1, q, &target, guess_tc, k + 2)?;
+                let (psi0, leg) = ctx.shoot((pre, post), (v, v1), q, &target, guess_tc, k + 2)?;
                 let err = wrap(psi0 - q.psi);
                 dpsi += err;
                 b = ctx.geo_rate(&P { psi: psi0, ..q }, v);
@@ -803,13 +979,23 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
             }
             match best {
                 Some(b) => b,
-                None => return Err(RouteError::Solve { waypoint: k + 1, why: "turn iteration".into() }),
+                None => {
+                    return Err(RouteError::Solve {
+                        waypoint: k + 1,
+                        why: "turn iteration".into(),
+                    })
+                }
             }
         };
         // the turn (exact heading chain: integrate with the trajectory's closed forms)
         if !turn.is_empty() {
             let wk = &wps[k];
-            let pk = P { lat: wk.lat_rad, lon: wk.lon_rad, h: wk.h_m, psi: 0.0 };
+            let pk = P {
+                lat: wk.lat_rad,
+                lon: wk.lon_rad,
+                h: wk.h_m,
+                psi: 0.0,
+            };
             let xw = ctx.ecef(&pk);
             let v = wk.speed_mps;
             let mut best = (f64::INFINITY, t);
@@ -819,7 +1005,7 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
             let mut prev: Vec<(f64, f64)> = Vec::new();
             for &(m, d) in &turn {
                 let seg = Segment::with_start(m, tt, d, (v, psi_h, 0.0));
-                q = ctx.fly(&seg, q, tt, tt + d, 0.005, false, |ts, qq| {
+                q = ctx.fly(&seg, q, (tt, tt + d), 0.005, false, |ts, qq| {
                     let dist = (ctx.ecef(qq) - xw).norm();
                     prev.push((ts, dist));
                     if dist < best.0 {
@@ -863,7 +1049,12 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
     }
     // arrival at the last waypoint
     let wl = &wps[n - 1];
-    let pl = P { lat: wl.lat_rad, lon: wl.lon_rad, h: wl.h_m, psi: 0.0 };
+    let pl = P {
+        lat: wl.lat_rad,
+        lon: wl.lon_rad,
+        h: wl.h_m,
+        psi: 0.0,
+    };
     report[n - 1].arrival_s = t;
     report[n - 1].miss_m = (ctx.ecef(&p) - ctx.ecef(&pl)).norm();
     if stop_last {

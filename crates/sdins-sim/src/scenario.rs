@@ -627,7 +627,9 @@ impl Scenario {
                     file: file.into(),
                     line: 1,
                     key: "start".into(),
-                    message: "missing required key (a [start] table, or a route of [[waypoint]] tables)".into(),
+                    message:
+                        "missing required key (a [start] table, or a route of [[waypoint]] tables)"
+                            .into(),
                 });
             }
         };
@@ -1317,26 +1319,73 @@ fn parse_route(
     let route_span = doc.route.as_ref().map_or(0..0, |r| r.span());
     if doc.waypoint.len() < 2 {
         let span = doc.waypoint.first().map_or(route_span, |w| w.span());
-        return cx.err(span, "waypoint", format!("a route needs at least two [[waypoint]] tables (got {})", doc.waypoint.len()));
+        return cx.err(
+            span,
+            "waypoint",
+            format!(
+                "a route needs at least two [[waypoint]] tables (got {})",
+                doc.waypoint.len()
+            ),
+        );
     }
     let mut wps = Vec::with_capacity(doc.waypoint.len());
     for w in &doc.waypoint {
         let wd = w.get_ref();
-        let lat = cx.range(&wd.lat_deg, "waypoint.lat_deg", -89.5, 89.5, "latitude in [-89.5, 89.5] deg")?;
-        let lon = cx.range(&wd.lon_deg, "waypoint.lon_deg", -180.0, 360.0, "longitude in [-180, 360] deg")?;
+        let lat = cx.range(
+            &wd.lat_deg,
+            "waypoint.lat_deg",
+            -89.5,
+            89.5,
+            "latitude in [-89.5, 89.5] deg",
+        )?;
+        let lon = cx.range(
+            &wd.lon_deg,
+            "waypoint.lon_deg",
+            -180.0,
+            360.0,
+            "longitude in [-180, 360] deg",
+        )?;
         let h = match &wd.h_m {
-            Some(v) => cx.range(v, "waypoint.h_m", -1000.0, 100_000.0, "height in [-1000, 100000] m")?,
+            Some(v) => cx.range(
+                v,
+                "waypoint.h_m",
+                -1000.0,
+                100_000.0,
+                "height in [-1000, 100000] m",
+            )?,
             None => 0.0,
         };
-        let v = cx.range(&wd.speed_mps, "waypoint.speed_mps", 0.0, 3000.0, "speed in (0, 3000] m/s")?;
+        let v = cx.range(
+            &wd.speed_mps,
+            "waypoint.speed_mps",
+            0.0,
+            3000.0,
+            "speed in (0, 3000] m/s",
+        )?;
         if v <= 0.0 {
-            return cx.err(wd.speed_mps.span(), "waypoint.speed_mps", "a route's speed must be > 0 (use hold_s for time at rest)");
+            return cx.err(
+                wd.speed_mps.span(),
+                "waypoint.speed_mps",
+                "a route's speed must be > 0 (use hold_s for time at rest)",
+            );
         }
         let hold = match &wd.hold_s {
-            Some(x) => cx.range(x, "waypoint.hold_s", 0.0, MAX_SEGMENT_S, "a time at rest in [0, 1e7] s")?,
+            Some(x) => cx.range(
+                x,
+                "waypoint.hold_s",
+                0.0,
+                MAX_SEGMENT_S,
+                "a time at rest in [0, 1e7] s",
+            )?,
             None => 0.0,
         };
-        wps.push(Waypoint { lat_rad: lat * D2R, lon_rad: lon * D2R, h_m: h, speed_mps: v, hold_s: hold });
+        wps.push(Waypoint {
+            lat_rad: lat * D2R,
+            lon_rad: lon * D2R,
+            h_m: h,
+            speed_mps: v,
+            hold_s: hold,
+        });
     }
     let mut limits = RouteLimits::default();
     let mut legs = LegKind::GreatCircle;
@@ -1346,26 +1395,80 @@ fn parse_route(
             legs = match l.get_ref().as_str() {
                 "great_circle" => LegKind::GreatCircle,
                 "rhumb" => LegKind::Rhumb,
-                other => return cx.err(l.span(), "route.legs", format!("unknown leg kind `{other}`: expected great_circle or rhumb")),
+                other => {
+                    return cx.err(
+                        l.span(),
+                        "route.legs",
+                        format!("unknown leg kind `{other}`: expected great_circle or rhumb"),
+                    )
+                }
             };
         }
         match (&rd.turn_rate_limit_dps, &rd.bank_limit_deg) {
-            (Some(a), Some(_)) => return cx.err(a.span(), "route.turn_rate_limit_dps", "give either turn_rate_limit_dps or bank_limit_deg, not both"),
-            (Some(a), None) => limits.turn = TurnLimit::Rate(cx.range(a, "route.turn_rate_limit_dps", 1e-3, 360.0, "a turn-rate limit in [0.001, 360] deg/s")? * D2R),
-            (None, Some(b)) => limits.turn = TurnLimit::Bank(cx.range(b, "route.bank_limit_deg", 0.1, 80.0, "a bank limit in [0.1, 80] deg")? * D2R),
+            (Some(a), Some(_)) => {
+                return cx.err(
+                    a.span(),
+                    "route.turn_rate_limit_dps",
+                    "give either turn_rate_limit_dps or bank_limit_deg, not both",
+                )
+            }
+            (Some(a), None) => {
+                limits.turn = TurnLimit::Rate(
+                    cx.range(
+                        a,
+                        "route.turn_rate_limit_dps",
+                        1e-3,
+                        360.0,
+                        "a turn-rate limit in [0.001, 360] deg/s",
+                    )? * D2R,
+                )
+            }
+            (None, Some(b)) => {
+                limits.turn = TurnLimit::Bank(
+                    cx.range(
+                        b,
+                        "route.bank_limit_deg",
+                        0.1,
+                        80.0,
+                        "a bank limit in [0.1, 80] deg",
+                    )? * D2R,
+                )
+            }
             (None, None) => {}
         }
         if let Some(x) = &rd.roll_rate_limit_dps {
-            limits.roll_rate_rps = cx.range(x, "route.roll_rate_limit_dps", 0.01, 360.0, "a roll-rate limit in [0.01, 360] deg/s")? * D2R;
+            limits.roll_rate_rps = cx.range(
+                x,
+                "route.roll_rate_limit_dps",
+                0.01,
+                360.0,
+                "a roll-rate limit in [0.01, 360] deg/s",
+            )? * D2R;
         }
         if let Some(x) = &rd.climb_rate_limit_mps {
-            limits.climb_rate_mps = cx.range(x, "route.climb_rate_limit_mps", 1e-3, 500.0, "a climb-rate limit in [0.001, 500] m/s")?;
+            limits.climb_rate_mps = cx.range(
+                x,
+                "route.climb_rate_limit_mps",
+                1e-3,
+                500.0,
+                "a climb-rate limit in [0.001, 500] m/s",
+            )?;
         }
         if let Some(x) = &rd.accel_limit_mps2 {
-            limits.accel_mps2 = cx.range(x, "route.accel_limit_mps2", 1e-3, 100.0, "an acceleration limit in [0.001, 100] m/s²")?;
+            limits.accel_mps2 = cx.range(
+                x,
+                "route.accel_limit_mps2",
+                1e-3,
+                100.0,
+                "an acceleration limit in [0.001, 100] m/s²",
+            )?;
         }
     }
-    let route = Route { waypoints: wps, legs, limits };
+    let route = Route {
+        waypoints: wps,
+        legs,
+        limits,
+    };
     crate::route::compile(&route, earth, dt).map_err(|e| {
         let wp = match &e {
             RouteError::Value { waypoint, .. }

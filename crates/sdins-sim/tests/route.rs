@@ -109,12 +109,24 @@ fn great_circle_leg_100km_holds_the_geodesic() {
     assert!(cross.abs() <= 1e-3, "{cross:e}");
     assert!(along.abs() <= 0.5 * 100.0 * dt + 1e-3, "{along:e}");
     let rep = (ecef_s(s.last().unwrap()) - ecef_w(&route.waypoints[1])).norm();
-    assert!((rep - c.report[1].miss_m).abs() <= 1e-3, "{rep} vs {:?}", c.report[1]);
+    assert!(
+        (rep - c.report[1].miss_m).abs() <= 1e-3,
+        "{rep} vs {:?}",
+        c.report[1]
+    );
     // a great circle on a sphere would not do: the spherical initial course differs
     let (l1, l2, dl) = (45.0 * D2R, 45.5 * D2R, 1.1 * D2R);
     let sph = (dl.sin() * l2.cos()).atan2(l1.cos() * l2.sin() - l1.sin() * l2.cos() * dl.cos());
-    eprintln!("start heading {:.9} deg, spherical formula {:.9} deg", c.start_heading_rad / D2R, sph / D2R);
-    assert!((c.start_heading_rad - sph).abs() < 0.01, "{}", c.start_heading_rad - sph);
+    eprintln!(
+        "start heading {:.9} deg, spherical formula {:.9} deg",
+        c.start_heading_rad / D2R,
+        sph / D2R
+    );
+    assert!(
+        (c.start_heading_rad - sph).abs() < 0.01,
+        "{}",
+        c.start_heading_rad - sph
+    );
 }
 
 #[test]
@@ -178,6 +190,7 @@ fn from_leg(a: &Waypoint, b: &Waypoint, x: Vec3) -> f64 {
 }
 
 #[test]
+#[allow(clippy::needless_range_loop)]
 fn fly_by_turns_cut_the_corner_and_meet_the_next_leg() {
     let route = demo_route();
     let dt = 0.01;
@@ -189,7 +202,9 @@ fn fly_by_turns_cut_the_corner_and_meet_the_next_leg() {
         // independent closest approach on the truth samples, refined by a parabola
         let xw = ecef_w(&w[j]);
         let d: Vec<f64> = s.iter().map(|x| (ecef_s(x) - xw).norm()).collect();
-        let i = (1..d.len() - 1).min_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap();
+        let i = (1..d.len() - 1)
+            .min_by(|&a, &b| d[a].total_cmp(&d[b]))
+            .unwrap();
         let (y0, y1, y2) = (d[i - 1], d[i], d[i + 1]);
         let u = 0.5 * (y0 - y2) / (y0 - 2.0 * y1 + y2);
         let closest = y1 - 0.25 * (y0 - y2) * u;
@@ -207,9 +222,16 @@ fn fly_by_turns_cut_the_corner_and_meet_the_next_leg() {
         );
         // the compiler's path agrees with the truth to its RK4 (≪ 1 mm) and the
         // parabola (≈ (V dt)²·κ ≪ 1 mm)
-        assert!((closest - r.miss_m).abs() <= 1e-3, "{closest} vs {}", r.miss_m);
+        assert!(
+            (closest - r.miss_m).abs() <= 1e-3,
+            "{closest} vs {}",
+            r.miss_m
+        );
         assert!((s[i].t_s + u * dt - r.arrival_s).abs() <= 2.0 * dt);
-        assert!(closest >= arc && closest <= 1.05 * arc, "{closest} vs arc {arc}");
+        assert!(
+            closest >= arc && closest <= 1.05 * arc,
+            "{closest} vs arc {arc}"
+        );
     }
     // after each turn (and before the next) the path lies on the next leg: the turn exit
     // is placed on the ideal leg by the flat-turn geometry (error ~ d³/R² ≪ 1 mm), and
@@ -226,7 +248,10 @@ fn fly_by_turns_cut_the_corner_and_meet_the_next_leg() {
             worst[k] = worst[k].max(from_leg(&w[k], &w[k + 1], ecef_s(x)).abs());
         }
     }
-    eprintln!("cross-track from the next leg after the turns: {:?} m", &worst[1..]);
+    eprintln!(
+        "cross-track from the next leg after the turns: {:?} m",
+        &worst[1..]
+    );
     for (k, v) in worst.iter().enumerate().skip(1) {
         assert!(*v <= 0.5 * w[k].speed_mps * dt + 1e-3, "leg {k}: {v}");
     }
@@ -261,7 +286,10 @@ fn limits_are_honoured() {
     );
     assert!(worst_rate_ratio <= 1.0 + 1e-9, "{worst_rate_ratio}");
     assert!(climb <= lim.climb_rate_mps * (1.0 + 1e-12), "{climb}");
-    assert!(climb >= 0.9 * lim.climb_rate_mps, "the climb should reach its limit: {climb}");
+    assert!(
+        climb >= 0.9 * lim.climb_rate_mps,
+        "the climb should reach its limit: {climb}"
+    );
     assert!(acc <= lim.accel_mps2 * (1.0 + 1e-9), "{acc}");
 }
 
@@ -275,17 +303,25 @@ fn route_truth_refines_and_navigates() {
     let mut c1 = scn.truth_config();
     let base = scn.nav.substeps;
     c1.substeps = base;
-    let c2 = TruthConfig { substeps: 2 * base, ..c1 };
+    let c2 = TruthConfig {
+        substeps: 2 * base,
+        ..c1
+    };
     let k = (40.0 / c1.dt_s).round() as u64;
     let mut a = TruthGenerator::new(&scn.trajectory, c1).starting_at_sample(k);
-    let mut b = TruthGenerator::new(&scn.trajectory, c2).reference_rk4().starting_at_sample(k);
+    let mut b = TruthGenerator::new(&scn.trajectory, c2)
+        .reference_rk4()
+        .starting_at_sample(k);
     let (mut dth, mut dv) = (0.0_f64, 0.0_f64);
     for _ in 0..3000 {
         let (x, y) = (a.next().unwrap(), b.next().unwrap());
         dth = dth.max((x.inc.dtheta_b_rad - y.inc.dtheta_b_rad).norm());
         dv = dv.max((x.inc.dv_b_mps - y.inc.dv_b_mps).norm());
     }
-    eprintln!("route Gauss ({base}) vs RK4 ({}): dθ {dth:e} rad, dv {dv:e} m/s", 2 * base);
+    eprintln!(
+        "route Gauss ({base}) vs RK4 ({}): dθ {dth:e} rad, dv {dv:e} m/s",
+        2 * base
+    );
     // the bounds of the built-in scenarios' refinement checks (tests/truth.rs)
     assert!(dth <= 2e-17 * 10.0, "{dth:e}");
     assert!(dv <= 2e-15, "{dv:e}");
@@ -309,7 +345,9 @@ fn route_truth_refines_and_navigates() {
         let p = Vec3::from(m.pos_err_ned_m).norm();
         let v = Vec3::from(m.vel_err_ned_mps).norm();
         let att = Vec3::from(m.att_err_rad).norm();
-        eprintln!("route songlee N=2 at {rate} Hz: max pos {p:e} m, vel {v:e} m/s, att {att:e} rad");
+        eprintln!(
+            "route songlee N=2 at {rate} Hz: max pos {p:e} m, vel {v:e} m/s, att {att:e} rad"
+        );
         errs.push((p, v, att));
     }
     assert!(errs[0].0 <= 1e-2 && errs[0].2 <= 2e-9, "{:?}", errs[0]);
@@ -319,7 +357,9 @@ fn route_truth_refines_and_navigates() {
 
 fn err_of(text: &str) -> (usize, String, String) {
     match Scenario::from_toml(text, "r.toml") {
-        Err(ScenarioError::Invalid { line, key, message, .. }) => (line, key, message),
+        Err(ScenarioError::Invalid {
+            line, key, message, ..
+        }) => (line, key, message),
         other => panic!("expected an error, got {other:?}"),
     }
 }
@@ -327,16 +367,25 @@ fn err_of(text: &str) -> (usize, String, String) {
 #[test]
 fn bad_routes_are_located_errors() {
     // waypoint 2 too close for the turn at it: named with its line
-    let close = DEMO.replace("lat_deg = 45.03\nlon_deg = 10.0\n", "lat_deg = 45.003\nlon_deg = 10.0\n");
+    let close = DEMO.replace(
+        "lat_deg = 45.03\nlon_deg = 10.0\n",
+        "lat_deg = 45.003\nlon_deg = 10.0\n",
+    );
     let (line, key, msg) = err_of(&close);
-    let wp2_line = close.lines().position(|l| l.starts_with("lat_deg = 45.003")).unwrap();
+    let wp2_line = close
+        .lines()
+        .position(|l| l.starts_with("lat_deg = 45.003"))
+        .unwrap();
     eprintln!("{line}: {key}: {msg}");
     assert_eq!(key, "waypoint");
     assert!(msg.contains("waypoint 2"), "{msg}");
     assert_eq!(line, wp2_line, "{msg}"); // the [[waypoint]] header line precedes it
-    // missing key
+                                         // missing key
     let (_, key, msg) = err_of(&DEMO.replacen("speed_mps = 60.0\n", "", 1));
-    assert!(key.contains("speed_mps") || msg.contains("speed_mps"), "{key}: {msg}");
+    assert!(
+        key.contains("speed_mps") || msg.contains("speed_mps"),
+        "{key}: {msg}"
+    );
     // segments and waypoints mixed
     let mixed = format!("{DEMO}\n[[segment]]\ntype = \"cruise\"\nduration_s = 1.0\n");
     let (_, key, msg) = err_of(&mixed);
@@ -348,23 +397,45 @@ fn bad_routes_are_located_errors() {
     assert_eq!(key, "start");
     assert!(line > DEMO.lines().count(), "{line}");
     // one waypoint only
-    let one = DEMO.split("[[waypoint]]").take(2).collect::<Vec<_>>().join("[[waypoint]]");
+    let one = DEMO
+        .split("[[waypoint]]")
+        .take(2)
+        .collect::<Vec<_>>()
+        .join("[[waypoint]]");
     let (_, key, msg) = err_of(&one);
-    assert!(key == "waypoint" && msg.contains("at least two"), "{key}: {msg}");
+    assert!(
+        key == "waypoint" && msg.contains("at least two"),
+        "{key}: {msg}"
+    );
     // coincident waypoints
-    let same = DEMO.replacen("lat_deg = 45.03\nlon_deg = 10.0\n", "lat_deg = 45.0\nlon_deg = 10.0\n", 1);
+    let same = DEMO.replacen(
+        "lat_deg = 45.03\nlon_deg = 10.0\n",
+        "lat_deg = 45.0\nlon_deg = 10.0\n",
+        1,
+    );
     let (_, _, msg) = err_of(&same);
     assert!(msg.contains("coincides"), "{msg}");
     // NaN and a leg across a pole
     let (_, key, _) = err_of(&DEMO.replacen("h_m = 300.0", "h_m = nan", 1));
     assert_eq!(key, "waypoint.h_m");
     let polar = DEMO
-        .replacen("lat_deg = 45.03\nlon_deg = 10.09", "lat_deg = 89.0\nlon_deg = 190.0", 1)
-        .replacen("lat_deg = 45.0\nlon_deg = 10.11", "lat_deg = 88.0\nlon_deg = 10.11", 1);
+        .replacen(
+            "lat_deg = 45.03\nlon_deg = 10.09",
+            "lat_deg = 89.0\nlon_deg = 190.0",
+            1,
+        )
+        .replacen(
+            "lat_deg = 45.0\nlon_deg = 10.11",
+            "lat_deg = 88.0\nlon_deg = 10.11",
+            1,
+        );
     let (_, _, msg) = err_of(&polar);
     eprintln!("polar: {msg}");
     assert!(msg.contains("89.5") || msg.contains("latitude"), "{msg}");
     // bad limits
-    let (_, key, _) = err_of(&DEMO.replace("bank_limit_deg = 25.0", "bank_limit_deg = 25.0\nturn_rate_limit_dps = 3.0"));
+    let (_, key, _) = err_of(&DEMO.replace(
+        "bank_limit_deg = 25.0",
+        "bank_limit_deg = 25.0\nturn_rate_limit_dps = 3.0",
+    ));
     assert_eq!(key, "route.turn_rate_limit_dps");
 }
