@@ -1208,11 +1208,19 @@ impl Scenario {
                     .iter()
                     .position(|d| d.span() == span)
                     .map_or(i, |p| p + 1);
-                let msg = e.to_string().replacen(
-                    &format!("segment {i} (1-based)"),
-                    &format!("[[segment]] number {which}"),
-                    1,
-                );
+                let what = match &route_report {
+                    // a route's motion i belongs to a waypoint's turn or leg
+                    Some(r) => format!(
+                        "route motion {i} (the turn or leg of [[waypoint]] number {})",
+                        r.motion_waypoint
+                            .get(i.saturating_sub(1))
+                            .map_or(0, |w| w + 1)
+                    ),
+                    None => format!("[[segment]] number {which}"),
+                };
+                let msg = e
+                    .to_string()
+                    .replacen(&format!("segment {i} (1-based)"), &what, 1);
                 return cx.err(span, "segment", msg);
             }
         };

@@ -439,3 +439,21 @@ fn bad_routes_are_located_errors() {
     ));
     assert_eq!(key, "route.turn_rate_limit_dps");
 }
+
+#[test]
+fn car_routes_keep_the_non_holonomic_constraint_and_aircraft_are_refused() {
+    let car = DEMO.replacen("\n[imu]", "vehicle = \"car\"\n\n[imu]", 1);
+    let scn = Scenario::from_toml(&car, "car").unwrap();
+    let mut worst = 0.0_f64;
+    for s in TruthGenerator::new(&scn.trajectory, scn.truth_config()).step_by(50) {
+        let v_b = s.c_b_n.transpose() * s.v_n_mps;
+        worst = worst.max(v_b.y.abs()).max(v_b.z.abs());
+    }
+    eprintln!("car route: max |v_y^b|, |v_z^b| {worst:e} m/s");
+    assert!(worst <= 1e-12, "{worst:e}");
+    // aircraft: the geodesic heading's ψ̈ (≈1e-10 rad/s²) steps at the turn joints, which
+    // the aircraft joint rule (jerk continuous to 1e-9) refuses, naming the waypoint
+    let air = DEMO.replacen("\n[imu]", "vehicle = \"aircraft\"\n\n[imu]", 1);
+    let (_, _, msg) = err_of(&air);
+    assert!(msg.contains("[[waypoint]] number"), "{msg}");
+}
