@@ -457,3 +457,30 @@ fn car_routes_keep_the_non_holonomic_constraint_and_aircraft_are_refused() {
     let (_, _, msg) = err_of(&air);
     assert!(msg.contains("[[waypoint]] number"), "{msg}");
 }
+
+#[test]
+fn holds_rest_at_the_first_and_last_waypoints() {
+    let mut route = demo_route();
+    route.waypoints[0].hold_s = 10.0;
+    route.waypoints[3].hold_s = 5.0;
+    route.limits.accel_mps2 = 3.0;
+    let dt = 0.01;
+    let c = compile(&route, E, dt).unwrap();
+    let tr = traj(&c);
+    assert_eq!(c.start_speed_mps, 0.0);
+    for t in [0.0, 5.0, 10.0, tr.duration_s - 5.0, tr.duration_s] {
+        assert_eq!(tr.kinematics(t, t).v_n_mps.norm(), 0.0, "at {t} s");
+    }
+    let s = truth(&route, &c, dt);
+    let end = (ecef_s(s.last().unwrap()) - ecef_w(&route.waypoints[3])).norm();
+    eprintln!(
+        "hold: rest at the last waypoint {end} m from it, report {:?}",
+        c.report[3]
+    );
+    // the stop is flown as the last leg piece: along-track miss ≤ V dt/2
+    assert!(end <= 0.5 * 60.0 * dt + 1e-3, "{end}");
+    // an interior hold is refused, naming the waypoint
+    route.waypoints[1].hold_s = 1.0;
+    let e = compile(&route, E, dt).unwrap_err().to_string();
+    assert!(e.contains("waypoint 2") && e.contains("hold_s"), "{e}");
+}
