@@ -200,10 +200,17 @@ pub fn write_run_toml(dir: &Path, fields: toml::Table) -> Result<(), CliError> {
     crate::output::write_string(&dir.join("run.toml"), &text)
 }
 
-/// Print what each `random_vibration` overlay realised and dropped (stderr).
+/// Print what each `random_vibration` overlay realised and dropped, and a route's
+/// per-waypoint report (stderr).
 pub fn print_vibration(scn: &sdins_sim::scenario::Scenario) {
     for r in &scn.vibration {
         eprintln!("{}", r.summary());
+    }
+    // and a route's per-waypoint report
+    if let Some(r) = &scn.route {
+        for line in r.summary() {
+            eprintln!("{line}");
+        }
     }
 }
 

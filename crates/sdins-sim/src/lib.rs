@@ -70,6 +70,7 @@ pub mod pipeline;
 pub mod random_vibration;
 pub mod reference;
 pub mod reference_file;
+pub mod route;
 pub mod run_setup;
 pub mod scenario;
 pub mod smoother;

@@ -473,6 +473,7 @@ pub fn scenario_from_reference(
         ),
         mounting: Mounting::default(),
         vibration: Vec::new(),
+        route: None,
     };
     Ok((scn, summary))
 }

@@ -71,6 +71,23 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "calibration",
             "body_motion",
             "command",
+            "waypoint",
+            "route",
+        ],
+    ),
+    (
+        "waypoint",
+        &["lat_deg", "lon_deg", "h_m", "speed_mps", "hold_s"],
+    ),
+    (
+        "route",
+        &[
+            "legs",
+            "turn_rate_limit_dps",
+            "bank_limit_deg",
+            "roll_rate_limit_dps",
+            "climb_rate_limit_mps",
+            "accel_limit_mps2",
         ],
     ),
     BODY_MOTION_KEYS,
@@ -233,7 +250,7 @@ type S<T> = Spanned<T>;
 struct FileDoc {
     name: Option<String>,
     description: Option<String>,
-    start: S<StartDoc>,
+    start: Option<S<StartDoc>>,
     imu: S<ImuDoc>,
     nav: Option<NavDoc>,
     #[serde(default)]
@@ -249,6 +266,30 @@ struct FileDoc {
     body_motion: Option<S<BodyMotionDoc>>,
     #[serde(default)]
     command: Vec<S<CommandDoc>>,
+    #[serde(default)]
+    waypoint: Vec<S<WaypointDoc>>,
+    route: Option<S<RouteDoc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WaypointDoc {
+    lat_deg: S<f64>,
+    lon_deg: S<f64>,
+    h_m: Option<S<f64>>,
+    speed_mps: S<f64>,
+    hold_s: Option<S<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RouteDoc {
+    legs: Option<S<String>>,
+    turn_rate_limit_dps: Option<S<f64>>,
+    bank_limit_deg: Option<S<f64>>,
+    roll_rate_limit_dps: Option<S<f64>>,
+    climb_rate_limit_mps: Option<S<f64>>,
+    accel_limit_mps2: Option<S<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -460,6 +501,8 @@ pub struct Scenario {
     pub mounting: Mounting,
     /// per `random_vibration` overlay (in order): the power realised and dropped
     pub vibration: Vec<crate::random_vibration::VibrationReport>,
+    /// the compiled route (`[[waypoint]]` scenarios): its motions and per-waypoint report
+    pub route: Option<crate::route::CompiledRoute>,
 }
 
 struct Ctx<'a> {
@@ -629,7 +672,41 @@ impl Scenario {
     pub fn from_toml(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
         let doc: FileDoc = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;
         let cx = Ctx { file, text };
-        let st = doc.start.get_ref();
+        let start_from_route;
+        let start_doc: &S<StartDoc> = match (&doc.start, doc.waypoint.first()) {
+            (Some(s), None) => s,
+            (Some(s), Some(_)) => {
+                return cx.err(s.span(), "start", "a route's first [[waypoint]] is its start position (and its heading and speed come from the route): leave [start] out");
+            }
+            (None, Some(w)) => {
+                let wd = w.get_ref();
+                start_from_route = S::new(
+                    w.span(),
+                    StartDoc {
+                        lat_deg: wd.lat_deg.clone(),
+                        lon_deg: wd.lon_deg.clone(),
+                        h_m: wd.h_m.clone(),
+                        speed_mps: None,
+                        climb_rate_mps: None,
+                        roll_deg: None,
+                        pitch_deg: None,
+                        yaw_deg: None,
+                    },
+                );
+                &start_from_route
+            }
+            (None, None) => {
+                return Err(ScenarioError::Invalid {
+                    file: file.into(),
+                    line: 1,
+                    key: "start".into(),
+                    message:
+                        "missing required key (a [start] table, or a route of [[waypoint]] tables)"
+                            .into(),
+                });
+            }
+        };
+        let st = start_doc.get_ref();
         let lat = cx.range(
             &st.lat_deg,
             "start.lat_deg",
@@ -707,7 +784,7 @@ impl Scenario {
             v_n_mps: sdins_core::math::Vec3::new(speed, 0.0, -climb),
             c_b_n: sdins_core::math::c_b_n_from_euler(&euler),
         }) {
-            return cx.err(doc.start.span(), "start", e.to_string());
+            return cx.err(start_doc.span(), "start", e.to_string());
         }
 
         let im = doc.imu.get_ref();
@@ -766,7 +843,7 @@ impl Scenario {
             }
         }
         let calibration = parse_calibration(&cx, &doc, speed, climb, vehicle, 1.0 / rate_hz)?;
-        let body = parse_body_motion(&cx, &doc, euler, vehicle, dt)?;
+        let body = parse_body_motion(&cx, &doc, start_doc.get_ref(), euler, vehicle, dt)?;
         let mut motions = Vec::new();
         // the [[segment]] of each motion (a coordinated turn is three motions)
         let mut seg_of_motion: Vec<std::ops::Range<usize>> = Vec::new();
@@ -995,6 +1072,26 @@ impl Scenario {
             motions.push((motion, (n.round()) * dt));
             seg_of_motion.push(s.span());
         }
+        let mut route_report = None;
+        let (mut speed, mut euler, mut start) = (speed, euler, start);
+        if !doc.waypoint.is_empty() || doc.route.is_some() {
+            if let Some(sg) = doc.segment.first() {
+                return cx.err(sg.span(), "segment", "a scenario takes either [[segment]] tables or a route of [[waypoint]] tables, not both");
+            }
+            if let Some(c) = &doc.calibration {
+                return cx.err(c.span(), "calibration", "a [calibration] schedule cannot be combined with a route of [[waypoint]] tables");
+            }
+            let compiled = parse_route(&cx, &doc, nav.earth.model(), dt)?;
+            for &w in &compiled.motion_waypoint {
+                seg_of_motion.push(doc.waypoint.get(w).map_or(0..0, |x| x.span()));
+            }
+            motions = compiled.motions.clone();
+            speed = compiled.start_speed_mps;
+            euler.yaw_rad = compiled.start_heading_rad;
+            start.speed_mps = speed;
+            start.euler = euler;
+            route_report = Some(compiled);
+        }
         if let Some(sched) = &calibration {
             motions.push((Motion::Static, sched.duration_s));
             seg_of_motion.push(doc.calibration.as_ref().map_or(0..0, |c| c.span()));
@@ -1194,11 +1291,19 @@ impl Scenario {
                     .iter()
                     .position(|d| d.span() == span)
                     .map_or(i, |p| p + 1);
-                let msg = e.to_string().replacen(
-                    &format!("segment {i} (1-based)"),
-                    &format!("[[segment]] number {which}"),
-                    1,
-                );
+                let what = match &route_report {
+                    // a route's motion i belongs to a waypoint's turn or leg
+                    Some(r) => format!(
+                        "route motion {i} (the turn or leg of [[waypoint]] number {})",
+                        r.motion_waypoint
+                            .get(i.saturating_sub(1))
+                            .map_or(0, |w| w + 1)
+                    ),
+                    None => format!("[[segment]] number {which}"),
+                };
+                let msg = e
+                    .to_string()
+                    .replacen(&format!("segment {i} (1-based)"), &what, 1);
                 return cx.err(span, "segment", msg);
             }
         };
@@ -1215,7 +1320,7 @@ impl Scenario {
             // gives three)
             let span = match e.segment().and_then(|k| seg_of_motion.get(k)) {
                 Some(span) => span.clone(),
-                None => doc.start.span(),
+                None => start_doc.span(),
             };
             return cx.err(span, "segment", e.to_string());
         }
@@ -1250,6 +1355,7 @@ impl Scenario {
             source_toml: text.to_string(),
             mounting,
             vibration: vib_reports,
+            route: route_report,
         })
     }
 
@@ -1327,6 +1433,192 @@ impl Scenario {
     pub fn duration_s(&self) -> f64 {
         self.trajectory.duration_s
     }
+}
+
+/// `[[waypoint]]` and `[route]`: the route, compiled ([`crate::route::compile`]); its
+/// errors located at the waypoint they name.
+fn parse_route(
+    cx: &Ctx<'_>,
+    doc: &FileDoc,
+    earth: EarthModel,
+    dt: f64,
+) -> Result<crate::route::CompiledRoute, ScenarioError> {
+    use crate::route::{LegKind, Route, RouteError, RouteLimits, TurnLimit, Waypoint};
+    let route_span = doc.route.as_ref().map_or(0..0, |r| r.span());
+    if doc.waypoint.len() < 2 {
+        let span = doc.waypoint.first().map_or(route_span, |w| w.span());
+        return cx.err(
+            span,
+            "waypoint",
+            format!(
+                "a route needs at least two [[waypoint]] tables (got {})",
+                doc.waypoint.len()
+            ),
+        );
+    }
+    let mut wps = Vec::with_capacity(doc.waypoint.len());
+    for w in &doc.waypoint {
+        let wd = w.get_ref();
+        let lat = cx.range(
+            &wd.lat_deg,
+            "waypoint.lat_deg",
+            -89.5,
+            89.5,
+            "latitude in [-89.5, 89.5] deg",
+        )?;
+        let lon = cx.range(
+            &wd.lon_deg,
+            "waypoint.lon_deg",
+            -180.0,
+            360.0,
+            "longitude in [-180, 360] deg",
+        )?;
+        let h = match &wd.h_m {
+            Some(v) => cx.range(
+                v,
+                "waypoint.h_m",
+                -1000.0,
+                100_000.0,
+                "height in [-1000, 100000] m",
+            )?,
+            None => 0.0,
+        };
+        let v = cx.range(
+            &wd.speed_mps,
+            "waypoint.speed_mps",
+            0.0,
+            3000.0,
+            "speed in (0, 3000] m/s",
+        )?;
+        if v <= 0.0 {
+            return cx.err(
+                wd.speed_mps.span(),
+                "waypoint.speed_mps",
+                "a route's speed must be > 0 (use hold_s for time at rest)",
+            );
+        }
+        let hold = match &wd.hold_s {
+            Some(x) => cx.range(
+                x,
+                "waypoint.hold_s",
+                0.0,
+                MAX_SEGMENT_S,
+                "a time at rest in [0, 1e7] s",
+            )?,
+            None => 0.0,
+        };
+        wps.push(Waypoint {
+            lat_rad: lat * D2R,
+            lon_rad: lon * D2R,
+            h_m: h,
+            speed_mps: v,
+            hold_s: hold,
+        });
+    }
+    let mut limits = RouteLimits::default();
+    let mut legs = LegKind::GreatCircle;
+    if let Some(r) = &doc.route {
+        let rd = r.get_ref();
+        if let Some(l) = &rd.legs {
+            legs = match l.get_ref().as_str() {
+                "great_circle" => LegKind::GreatCircle,
+                "rhumb" => LegKind::Rhumb,
+                other => {
+                    return cx.err(
+                        l.span(),
+                        "route.legs",
+                        format!("unknown leg kind `{other}`: expected great_circle or rhumb"),
+                    )
+                }
+            };
+        }
+        match (&rd.turn_rate_limit_dps, &rd.bank_limit_deg) {
+            (Some(a), Some(_)) => {
+                return cx.err(
+                    a.span(),
+                    "route.turn_rate_limit_dps",
+                    "give either turn_rate_limit_dps or bank_limit_deg, not both",
+                )
+            }
+            (Some(a), None) => {
+                limits.turn = TurnLimit::Rate(
+                    cx.range(
+                        a,
+                        "route.turn_rate_limit_dps",
+                        1e-3,
+                        360.0,
+                        "a turn-rate limit in [0.001, 360] deg/s",
+                    )? * D2R,
+                )
+            }
+            (None, Some(b)) => {
+                limits.turn = TurnLimit::Bank(
+                    cx.range(
+                        b,
+                        "route.bank_limit_deg",
+                        0.1,
+                        80.0,
+                        "a bank limit in [0.1, 80] deg",
+                    )? * D2R,
+                )
+            }
+            (None, None) => {}
+        }
+        if let Some(x) = &rd.roll_rate_limit_dps {
+            limits.roll_rate_rps = cx.range(
+                x,
+                "route.roll_rate_limit_dps",
+                0.01,
+                360.0,
+                "a roll-rate limit in [0.01, 360] deg/s",
+            )? * D2R;
+        }
+        if let Some(x) = &rd.climb_rate_limit_mps {
+            limits.climb_rate_mps = cx.range(
+                x,
+                "route.climb_rate_limit_mps",
+                1e-3,
+                500.0,
+                "a climb-rate limit in [0.001, 500] m/s",
+            )?;
+        }
+        if let Some(x) = &rd.accel_limit_mps2 {
+            limits.accel_mps2 = cx.range(
+                x,
+                "route.accel_limit_mps2",
+                1e-3,
+                100.0,
+                "an acceleration limit in [0.001, 100] m/s²",
+            )?;
+        }
+    }
+    let route = Route {
+        waypoints: wps,
+        legs,
+        limits,
+    };
+    crate::route::compile(&route, earth, dt).map_err(|e| {
+        let wp = match &e {
+            RouteError::Value { waypoint, .. }
+            | RouteError::Coincident { waypoint, .. }
+            | RouteError::Pole { waypoint, .. }
+            | RouteError::TooShort { waypoint, .. }
+            | RouteError::Turn { waypoint, .. }
+            | RouteError::Solve { waypoint, .. } => Some(*waypoint),
+            _ => None,
+        };
+        let span = match wp.and_then(|i| doc.waypoint.get(i.saturating_sub(1))) {
+            Some(w) => w.span(),
+            None => route_span.clone(),
+        };
+        let key = if wp.is_some() { "waypoint" } else { "route" };
+        ScenarioError::Invalid {
+            file: cx.file.to_string(),
+            line: cx.line_of(span.start),
+            key: key.to_string(),
+            message: format!("[[waypoint]] route: {e}"),
+        }
+    })
 }
 
 /// `[calibration]`: a standard turntable schedule (crate::calibration::schedule) in
@@ -1841,6 +2133,7 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "moored-ship", summary: "disturbed base: moored ship at 40N, roll/pitch sway ±5 deg, 0.5 m heave, 0.2 m surge, marine grade", toml: include_str!("../scenarios/moored-ship.toml") },
     Builtin { name: "rocking-car", summary: "disturbed base: parked car rocking ±0.8/0.5 deg at 1.373/1.827 Hz with 1 cm heave, aviation grade", toml: include_str!("../scenarios/rocking-car.toml") },
     Builtin { name: "calibration", summary: "12-position turntable calibration: 300 s dwells, 10 s rotations, tactical grade, 100 Hz (sdins calibrate)", toml: include_str!("../scenarios/calibration.toml") },
+    Builtin { name: "route-demo", summary: "route through 4 waypoints at 45N 10E: two fly-by turns, 50 to 60 m/s, 200 m climb, geodesic legs (230 s, 100 Hz)", toml: include_str!("../scenarios/route-demo.toml") },
 ];
 
 /// Look up a built-in scenario by name.
@@ -1860,6 +2153,7 @@ type ChannelKeys<'a> = [(&'a Option<S<f64>>, &'static str); 6];
 fn parse_body_motion(
     cx: &Ctx<'_>,
     doc: &FileDoc,
+    st: &StartDoc,
     euler: Euler,
     vehicle: Vehicle,
     dt: f64,
@@ -1897,7 +2191,13 @@ fn parse_body_motion(
             "[[command]] motion sets the body velocity directly: it needs vehicle = \"free\"",
         );
     }
-    let st = doc.start.get_ref();
+    if let Some(w) = doc.waypoint.first() {
+        return cx.err(
+            w.span(),
+            "waypoint",
+            "[[command]] tables and [[waypoint]] routes exclude each other: use one or the other",
+        );
+    }
     for (v, key) in [
         (&st.speed_mps, "start.speed_mps"),
         (&st.climb_rate_mps, "start.climb_rate_mps"),

@@ -76,6 +76,47 @@ pub enum Motion {
         /// yaw rate at the end \[rad/s\]
         to_rps: f64,
     },
+    /// a route leg piece ([`crate::route`]): heading from a Chebyshev interpolant of a
+    /// converged solution of the geodesic heading equation `ψ̇ = v_E tan L/(R_N + h)`
+    /// (docs/theory/routes.md), `ψ = ψ0 + p(x) − p(0)`, `p(x) = Σ c_k T_k(2x − 1)`,
+    /// `x = τ/T`, value and derivatives from the same polynomial (all `c_k = 0`: constant
+    /// heading, a rhumb line); with smooth speed and down-velocity changes
+    /// `s = s0 + Δs·S(x)`, `v_D = v_D0 + Δv_D·S(x)` (the smooth step of
+    /// [`Motion::AccelerateSmooth`])
+    Geodesic {
+        /// Chebyshev coefficients of the heading \[rad\]
+        heading_cheb: [f64; GEO_CHEB_N],
+        /// speed change Δs \[m/s\]
+        delta_speed_mps: f64,
+        /// down-velocity change Δv_D \[m/s\]
+        delta_v_d_mps: f64,
+    },
+}
+
+/// Number of Chebyshev coefficients of a [`Motion::Geodesic`] heading.
+pub const GEO_CHEB_N: usize = 12;
+
+/// `(p(x), p'(x), p''(x))` of `p(x) = Σ c_k T_k(u)`, `u = 2x − 1` (derivatives in `x`),
+/// by the three-term recurrences of `T_k`, `T_k'`, `T_k''`.
+pub(crate) fn cheb_eval(c: &[f64; GEO_CHEB_N], x: f64) -> (f64, f64, f64) {
+    let u = 2.0 * x - 1.0;
+    // T_k, T_k' = dT/du, T_k'' : T_{k+1} = 2u T_k − T_{k−1}, T' and T'' by differentiation
+    let (mut t0, mut t1) = (1.0, u);
+    let (mut d0, mut d1) = (0.0, 1.0);
+    let (mut e0, mut e1) = (0.0, 0.0);
+    let mut p = c[0] + c[1] * u;
+    let mut dp = c[1];
+    let mut ep = 0.0;
+    for ck in c.iter().skip(2) {
+        let t2 = 2.0 * u * t1 - t0;
+        let d2 = 2.0 * t1 + 2.0 * u * d1 - d0;
+        let e2 = 4.0 * d1 + 2.0 * u * e1 - e0;
+        p += ck * t2;
+        dp += ck * d2;
+        ep += ck * e2;
+        (t0, t1, d0, d1, e0, e1) = (t1, t2, d1, d2, e1, e2);
+    }
+    (p, 2.0 * dp, 4.0 * ep)
 }
 
 /// The smooth step `S(x) = x − sin(2πx)/(2π)` and its first two derivatives in `x`,
@@ -358,7 +399,8 @@ impl KinConsts {
                 Motion::TurnRate { .. }
                 | Motion::TurnSmooth { .. }
                 | Motion::STurn { .. }
-                | Motion::TurnRamp { .. } => None,
+                | Motion::TurnRamp { .. }
+                | Motion::Geodesic { .. } => None,
             })
             .collect();
         Self {
@@ -458,8 +500,50 @@ impl Segment {
                 n.heading_dot = from_rps + d * st;
                 n.heading_ddot = d / big_t * st1;
             }
+            Motion::Geodesic {
+                heading_cheb,
+                delta_speed_mps,
+                delta_v_d_mps,
+            } => {
+                let x = (tau / big_t).clamp(0.0, 1.0);
+                let (p, dp, ddp) = cheb_eval(&heading_cheb, x);
+                let (p0, _, _) = cheb_eval(&heading_cheb, 0.0);
+                n.heading = self.heading0 + (p - p0);
+                n.heading_dot = dp / big_t;
+                n.heading_ddot = ddp / (big_t * big_t);
+                let (st, st1, st2) = smooth_step(x);
+                n.speed = self.speed0 + delta_speed_mps * st;
+                n.speed_dot = delta_speed_mps / big_t * st1;
+                n.speed_ddot = delta_speed_mps / (big_t * big_t) * st2;
+                n.v_d = self.v_d0 + delta_v_d_mps * st;
+                n.v_d_dot = delta_v_d_mps / big_t * st1;
+                n.v_d_ddot = delta_v_d_mps / (big_t * big_t) * st2;
+            }
         }
         n
+    }
+
+    /// A segment with its start state (for [`crate::route`], which integrates motions
+    /// before the trajectory exists).
+    pub(crate) fn with_start(
+        motion: Motion,
+        t0_s: f64,
+        duration_s: f64,
+        (speed0, heading0, v_d0): (f64, f64, f64),
+    ) -> Self {
+        Segment {
+            motion,
+            t0_s,
+            duration_s,
+            speed0,
+            heading0,
+            v_d0,
+        }
+    }
+
+    /// `(speed, heading, v_D)` at the segment end (as [`Trajectory::new`] chains them).
+    pub(crate) fn end(&self) -> (f64, f64, f64) {
+        self.end_state()
     }
 
     fn end_state(&self) -> (f64, f64, f64) {
@@ -706,7 +790,8 @@ impl Trajectory {
             | Motion::STurn { .. }
             | Motion::AccelerateSmooth { .. }
             | Motion::ClimbSmooth { .. }
-            | Motion::TurnRamp { .. } => 2.0 * PI / s.duration_s,
+            | Motion::TurnRamp { .. }
+            | Motion::Geodesic { .. } => 2.0 * PI / s.duration_s,
             _ => 0.0,
         });
         let ov = self.overlays.iter().map(|o| match o.kind {
