@@ -117,6 +117,11 @@ const RULES: &[Rule] = &[
         Replace(" motion_def-3d.csv", " ../shared/data/gnss_ins_sim/motion_def-3d.csv"),
     ),
     rule("gnss_ins_sim/", NeedsData("gnss_ins_sim/motion_def-3d.csv")),
+    // the NaveGo reference of `sdins truth --help`
+    rule(
+        "--from-reference ref.csv",
+        Replace(" ref.csv", " ../shared/data/csv/navego/ref.csv"),
+    ),
     // the NaveGo example of `sdins fuse --help`
     rule(
         "imu1_params.txt",
