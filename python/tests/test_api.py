@@ -131,3 +131,34 @@ def test_montecarlo_shards_merge_exactly_in_process():
     with pytest.raises(sdins.SdinsError, match="blocks missing"):
         sdins.merge(shards[:2])
     assert sdins.merge(shards[:2], allow_partial=True).runs < 10
+
+
+def test_scenario_from_reference(tmp_path):
+    # a gentle 4 s turn at 10 Hz rows from reference time 100 s, in a CSV of its own
+    rows = ["time,lat,lon,alt,r,p,y"]
+    for i in range(41):
+        t = 0.1 * i
+        rows.append(f"{100 + t!r},{45 + 1e-5 * t!r},{7 + 1e-5 * t * (1 + 0.01 * t)!r},100,0.5,1.0,{30 + 2 * t!r}")
+    f = tmp_path / "log.csv"
+    f.write_text("\n".join(rows) + "\n")
+    cols = "t_s=time,lat_deg=lat,lon_deg=lon,h_m=alt,roll_deg=r,pitch_deg=p,yaw_deg=y"
+    s = sdins.Scenario.from_reference(f, rate_hz=50.0, columns=cols)
+    assert s.duration_s == pytest.approx(4.0) and s.dt_s == 1.0 / 50.0
+    t = sdins.truth(s)
+    assert t.dtheta_rad.shape == (200, 3)
+    # the interpolant passes through the rows: at truth time 2 s (row 20) yaw is 34 deg
+    k = int(np.argmin(np.abs(t.t_s - 2.0)))
+    assert t.t_s[k] == pytest.approx(2.0)
+    assert math.degrees(t.euler_rad[k, 2]) == pytest.approx(34.0, abs=1e-9)
+    assert math.degrees(t.lat_rad[k]) == pytest.approx(45 + 2e-5, abs=1e-12)
+    # picklable (Dask): the same truth again
+    u = sdins.truth(pickle.loads(pickle.dumps(s)))
+    assert np.array_equal(u.dv_mps, t.dv_mps)
+    rows[6] = rows[5]
+    f.write_text("\n".join(rows) + "\n")
+    with pytest.raises(sdins.SdinsError, match=r"log\.csv:7: time: .* does not increase"):
+        sdins.Scenario.from_reference(f, columns=cols)
+    with pytest.raises(sdins.SdinsError, match="--columns: missing `lat_deg"):
+        sdins.Scenario.from_reference(f, columns="t_s=time")
+    with pytest.raises(sdins.SdinsError, match="earth: `flat`"):
+        sdins.Scenario.from_reference(f, columns=cols, earth="flat")

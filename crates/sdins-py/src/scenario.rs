@@ -12,6 +12,8 @@ pub struct Scenario {
     pub(crate) scn: Scn,
     text: String,
     label: String,
+    /// the `from_reference` arguments, for pickling a recorded-trajectory scenario
+    reference: Option<(std::path::PathBuf, f64, Option<String>, String)>,
 }
 
 impl Scenario {
@@ -20,6 +22,7 @@ impl Scenario {
             scn: Scn::from_toml(text, label).map_err(err)?,
             text: text.to_string(),
             label: label.to_string(),
+            reference: None,
         })
     }
 }
@@ -65,6 +68,51 @@ impl Scenario {
             scn,
             text,
             label: path.display().to_string(),
+            reference: None,
+        })
+    }
+
+    /// A recorded trajectory as a scenario (docs/scenarios.md §"Recorded trajectories"):
+    /// an sdins truth.csv, a PSINS avp CSV or NaveGo's ref.csv (told apart by the header),
+    /// or any CSV with `columns` = "t_s=COL,lat_deg=COL,lon_deg=COL,h_m=COL,roll_deg=COL,
+    /// pitch_deg=COL,yaw_deg=COL"; its C² interpolant is the truth, with an ideal IMU at
+    /// `rate_hz` under `earth` ("wgs84" or "psins"). Truth time 0 is the first row.
+    #[staticmethod]
+    #[pyo3(signature = (path, rate_hz=100.0, columns=None, earth="wgs84"))]
+    fn from_reference(
+        path: std::path::PathBuf,
+        rate_hz: f64,
+        columns: Option<String>,
+        earth: &str,
+    ) -> PyResult<Self> {
+        use sdins_sim::reference_file::{
+            scenario_from_reference, ColumnMap, ReferenceFormat, ReferenceOptions,
+        };
+        use sdins_sim::scenario::EarthChoice;
+        let earth_choice = match earth {
+            "wgs84" => EarthChoice::Wgs84,
+            "psins" => EarthChoice::Psins,
+            other => {
+                return Err(err(format!(
+                    "earth: `{other}`: expected wgs84 or psins (a recorded trajectory needs an ellipsoid)"
+                )))
+            }
+        };
+        let format = match &columns {
+            Some(m) => ReferenceFormat::Generic(Box::new(ColumnMap::parse(m).map_err(err)?)),
+            None => ReferenceFormat::Auto,
+        };
+        let opts = ReferenceOptions {
+            format,
+            rate_hz,
+            earth: earth_choice,
+        };
+        let (scn, _) = scenario_from_reference(Path::new(&path), &opts).map_err(err)?;
+        Ok(Scenario {
+            text: scn.source_toml.clone(),
+            label: path.display().to_string(),
+            scn,
+            reference: Some((path, rate_hz, columns, earth.to_string())),
         })
     }
 
@@ -119,8 +167,23 @@ impl Scenario {
         )
     }
 
-    fn __getnewargs__(&self) -> (String, String) {
-        (self.text.clone(), self.label.clone())
+    /// Pickling: the TOML text, or the `from_reference` arguments.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>)> {
+        let py = slf.py();
+        let me = slf.get();
+        let cls = py.get_type::<Scenario>();
+        match &me.reference {
+            Some((p, r, c, e)) => Ok((
+                cls.getattr("from_reference")?,
+                (p.clone(), *r, c.clone(), e.clone()).into_pyobject(py)?,
+            )),
+            None => Ok((
+                cls.into_any(),
+                (me.text.clone(), me.label.clone()).into_pyobject(py)?,
+            )),
+        }
     }
 
     fn __repr__(&self) -> String {
