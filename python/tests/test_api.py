@@ -162,3 +162,15 @@ def test_scenario_from_reference(tmp_path):
         sdins.Scenario.from_reference(f, columns="t_s=time")
     with pytest.raises(sdins.SdinsError, match="earth: `flat`"):
         sdins.Scenario.from_reference(f, columns=cols, earth="flat")
+
+
+def test_gnss_ins_sim_motion_file_as_scenario(shared_data):
+    f = shared_data / "gnss_ins_sim" / "motion_def-3d.csv"
+    s = sdins.Scenario.from_file(f)
+    assert s.duration_s == pytest.approx(140.0)
+    # the imported TOML is the scenario's text, so it pickles and parses back
+    u = pickle.loads(pickle.dumps(s))
+    assert u.to_toml() == s.to_toml() and "[[command]]" in s.to_toml()
+    a = sdins.truth(s, until_s=2.0)
+    b = sdins.truth(u, until_s=2.0)
+    assert np.array_equal(a.dv_mps, b.dv_mps)

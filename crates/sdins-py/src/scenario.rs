@@ -59,11 +59,13 @@ impl Scenario {
         Scenario::parse(text, file.unwrap_or("<string>"))
     }
 
-    /// Read a scenario file (errors name `path:line:column`).
+    /// Read a scenario file, or a gnss-ins-sim motion CSV (imported with the default
+    /// options); errors name `path:line:column`.
     #[staticmethod]
     fn from_file(path: std::path::PathBuf) -> PyResult<Self> {
         let scn = Scn::from_file(Path::new(&path)).map_err(err)?;
-        let text = std::fs::read_to_string(&path).map_err(err)?;
+        // the TOML the scenario was parsed from: the file's text, or a motion CSV's import
+        let text = scn.source_toml.clone();
         Ok(Scenario {
             scn,
             text,
