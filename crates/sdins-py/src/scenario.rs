@@ -87,28 +87,8 @@ impl Scenario {
         columns: Option<String>,
         earth: &str,
     ) -> PyResult<Self> {
-        use sdins_sim::reference_file::{
-            scenario_from_reference, ColumnMap, ReferenceFormat, ReferenceOptions,
-        };
-        use sdins_sim::scenario::EarthChoice;
-        let earth_choice = match earth {
-            "wgs84" => EarthChoice::Wgs84,
-            "psins" => EarthChoice::Psins,
-            other => {
-                return Err(err(format!(
-                    "earth: `{other}`: expected wgs84 or psins (a recorded trajectory needs an ellipsoid)"
-                )))
-            }
-        };
-        let format = match &columns {
-            Some(m) => ReferenceFormat::Generic(Box::new(ColumnMap::parse(m).map_err(err)?)),
-            None => ReferenceFormat::Auto,
-        };
-        let opts = ReferenceOptions {
-            format,
-            rate_hz,
-            earth: earth_choice,
-        };
+        use sdins_sim::reference_file::{scenario_from_reference, ReferenceOptions};
+        let opts = ReferenceOptions::from_names(rate_hz, columns.as_deref(), earth).map_err(err)?;
         let (scn, _) = scenario_from_reference(Path::new(&path), &opts).map_err(err)?;
         Ok(Scenario {
             text: scn.source_toml.clone(),

@@ -403,15 +403,6 @@ impl ReferenceTrack {
             },
         }
     }
-
-    /// The attitude of row `k` as the interpolant holds it (for tests).
-    pub fn euler_at_knot(&self, k: usize) -> Option<Euler> {
-        Some(Euler::new(
-            *self.roll.f.get(k)?,
-            *self.pitch.f.get(k)?,
-            *self.yaw.f.get(k)?,
-        ))
-    }
 }
 
 #[cfg(test)]

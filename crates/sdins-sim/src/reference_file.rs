@@ -119,18 +119,6 @@ pub enum ReferenceFileError {
     /// A reader of a known format failed.
     #[error(transparent)]
     File(#[from] TruthFileError),
-    /// A generic file's content.
-    #[error("{}:{line}: {field}: {message}", file.display())]
-    Invalid {
-        /// the file
-        file: PathBuf,
-        /// 1-based line
-        line: usize,
-        /// column
-        field: String,
-        /// what is wrong
-        message: String,
-    },
     /// The column map.
     #[error("--columns: {message}")]
     Columns {
@@ -175,11 +163,13 @@ pub fn parse_generic(
         .trim(csv::Trim::All)
         .flexible(true)
         .from_reader(text.as_bytes());
-    let bad = |line: u64, field: &str, message: String| ReferenceFileError::Invalid {
-        file: path.into(),
-        line: line as usize,
-        field: field.into(),
-        message,
+    let bad = |line: u64, field: &str, message: String| {
+        ReferenceFileError::File(TruthFileError::Invalid {
+            file: path.into(),
+            line: line as usize,
+            field: field.into(),
+            message,
+        })
     };
     let header = rd
         .headers()
@@ -344,6 +334,37 @@ pub struct ReferenceOptions {
     pub rate_hz: f64,
     /// earth model of truth and navigation
     pub earth: EarthChoice,
+}
+
+impl ReferenceOptions {
+    /// Options from their command-line / Python spellings: `columns` the text form of a
+    /// [`ColumnMap`] (`None`: a known format told apart by the header), `earth` `wgs84` or
+    /// `psins` (a recorded trajectory needs an ellipsoid).
+    pub fn from_names(
+        rate_hz: f64,
+        columns: Option<&str>,
+        earth: &str,
+    ) -> Result<Self, ReferenceFileError> {
+        let earth = match earth {
+            "wgs84" => EarthChoice::Wgs84,
+            "psins" => EarthChoice::Psins,
+            other => return Err(ReferenceFileError::Option {
+                option: "--earth",
+                message: format!(
+                    "`{other}`: expected wgs84 or psins (a recorded trajectory needs an ellipsoid)"
+                ),
+            }),
+        };
+        let format = match columns {
+            Some(m) => ReferenceFormat::Generic(Box::new(ColumnMap::parse(m)?)),
+            None => ReferenceFormat::Auto,
+        };
+        Ok(Self {
+            format,
+            rate_hz,
+            earth,
+        })
+    }
 }
 
 impl Default for ReferenceOptions {

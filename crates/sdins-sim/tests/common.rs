@@ -6,6 +6,25 @@ use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AttitudeMode};
 use sdins_sim::pipeline::{run, NavError, RunOptions, RunSummary};
 use sdins_sim::scenario::Scenario;
 
+/// `rel` under `../shared/data` (read in place), or `None` with the printed reason when
+/// that folder is absent (a user's clone); in CI it is present and the tests run.
+pub fn shared_data(rel: &str) -> Option<std::path::PathBuf> {
+    let p = std::path::PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/"
+    ))
+    .join(rel);
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!(
+            "skipped: {} not present (../shared/data is absent in this checkout)",
+            p.display()
+        );
+        None
+    }
+}
+
 pub fn spec(kind: AlgorithmKind, n: usize) -> AlgorithmSpec {
     AlgorithmSpec::new(kind, n)
 }

@@ -12,22 +12,8 @@ use sdins_sim::pipeline::{nav_error, navigate_recorded, NavError};
 use sdins_sim::truth_file::{c_b_n_from_psins, read_psins_avp};
 use std::path::PathBuf;
 
-fn data(rel: &str) -> Option<PathBuf> {
-    let p = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/"
-    ))
-    .join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!(
-            "skipped: {} not present (../shared/data is absent in this checkout)",
-            p.display()
-        );
-        None
-    }
-}
+mod common;
+use common::shared_data as data;
 
 const ARCSEC: f64 = std::f64::consts::PI / 180.0 / 3600.0;
 

@@ -56,12 +56,8 @@ fn rate_for(mf: &MotionFile) -> f64 {
 
 fn cfg(scn: &Scenario, substeps: usize) -> TruthConfig {
     TruthConfig {
-        earth: scn.nav.earth.model(),
-        dt_s: scn.imu.dt_s(),
-        lat0_rad: scn.start.lat_rad,
-        lon0_rad: scn.start.lon_rad,
-        h0_m: scn.start.h_m,
         substeps,
+        ..scn.truth_config()
     }
 }
 

@@ -2,41 +2,14 @@
 //! trajectories (docs/validation.md §"Recorded trajectories").
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+use common::shared_data as data;
+
 use sdins_core::math::Vec3;
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
 use sdins_sim::pipeline::{run, NavError, RunOptions};
 use sdins_sim::reference_file::{scenario_from_reference, ReferenceOptions};
-use sdins_sim::scenario::Scenario;
 use sdins_sim::truth::{lon_diff, TruthConfig, TruthGenerator};
-use std::path::PathBuf;
-
-fn data(rel: &str) -> Option<PathBuf> {
-    let p = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/"
-    ))
-    .join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!(
-            "skipped: {} not present (../shared/data is absent in this checkout)",
-            p.display()
-        );
-        None
-    }
-}
-
-fn cfg(scn: &Scenario) -> TruthConfig {
-    TruthConfig {
-        earth: scn.nav.earth.model(),
-        dt_s: scn.imu.dt_s(),
-        lat0_rad: scn.start.lat_rad,
-        lon0_rad: scn.start.lon_rad,
-        h0_m: scn.start.h_m,
-        substeps: scn.nav.substeps,
-    }
-}
 
 struct RoundTrip {
     /// truth generator's position against the interpolant's at the samples [m]
@@ -65,7 +38,7 @@ fn round_trip(file: &std::path::Path, rate_hz: f64) -> RoundTrip {
     let tr = scn.trajectory.reference().unwrap();
     let earth = scn.nav.earth.model();
     let mut worst = 0.0_f64;
-    for s in TruthGenerator::new(&scn.trajectory, cfg(&scn)) {
+    for s in TruthGenerator::new(&scn.trajectory, scn.truth_config()) {
         let p = tr.at(s.t_s, s.t_s - 1e-9);
         let le = earth.radii(s.lat_rad);
         let d = Vec3::new(
@@ -164,7 +137,7 @@ fn gauss_matches_rk4_on_a_reference() {
         },
     )
     .unwrap();
-    let c1 = cfg(&scn);
+    let c1 = scn.truth_config();
     // RK4 is Simpson's rule per substep: its error h⁴·f⁽⁴⁾/2880 is large where the
     // interpolant turns a rate step within one row (3.5e-12 rad at 32 substeps at 59.0 s),
     // so the reference runs at 2048 substeps, (1/64)⁴ of that
@@ -216,7 +189,7 @@ fn navego_imu2_one_second_means() {
     // ours: Σ Δθ, Σ Δv over the samples ending in (k, k+1] s
     let n_s = scn.trajectory.duration_s.floor() as usize;
     let mut ours = vec![[0.0; 6]; n_s];
-    for s in TruthGenerator::new(&scn.trajectory, cfg(&scn)) {
+    for s in TruthGenerator::new(&scn.trajectory, scn.truth_config()) {
         let k = ((s.t_s - 1e-9).floor()) as usize;
         if k < n_s {
             let (a, b) = (s.inc.dtheta_b_rad, s.inc.dv_b_mps);

@@ -6,7 +6,7 @@ use crate::output::AtomicFile;
 use crate::progress::Progress;
 use sdins_core::math::{euler_from_c_b_n, Mat3, Quat, Vec3};
 use sdins_sim::scenario::Scenario;
-use sdins_sim::truth::{TruthConfig, TruthGenerator};
+use sdins_sim::truth::TruthGenerator;
 use sdins_sim::truth_file::SDINS_TRUTH_HEADER as TRUTH_HEADER;
 use std::path::PathBuf;
 
@@ -61,15 +61,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .out
         .unwrap_or_else(|| crate::output::default_dir("truth-", &scn.name));
     crate::output::claim(&out)?;
-    let cfg = TruthConfig {
-        earth: scn.nav.earth.model(),
-        dt_s: scn.imu.dt_s(),
-        lat0_rad: scn.start.lat_rad,
-        lon0_rad: scn.start.lon_rad,
-        h0_m: scn.start.h_m,
-        substeps: scn.nav.substeps,
-    };
-    let mut gen = TruthGenerator::new(&scn.trajectory, cfg);
+    let mut gen = TruthGenerator::new(&scn.trajectory, scn.truth_config());
     // truth.csv stays at the vehicle reference point; imu.csv is sensed at the IMU
     let init = gen.initial_state();
     if let Some(m) = scn.mounting.imu {
@@ -169,30 +161,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
 /// The scenario of `--from-reference` and the reference time of its first row.
 fn from_reference(file: &std::path::Path, args: &Args) -> Result<(Scenario, f64), CliError> {
-    use sdins_sim::reference_file::{
-        scenario_from_reference, ColumnMap, ReferenceFormat, ReferenceOptions,
-    };
-    use sdins_sim::scenario::EarthChoice;
-    let earth = match args.earth.as_str() {
-        "wgs84" => EarthChoice::Wgs84,
-        "psins" => EarthChoice::Psins,
-        other => {
-            return Err(CliError::bad(format!(
-                "--earth: `{other}`: expected wgs84 or psins (a recorded trajectory needs an ellipsoid)"
-            )))
-        }
-    };
-    let format = match &args.columns {
-        Some(m) => ReferenceFormat::Generic(Box::new(
-            ColumnMap::parse(m).map_err(|e| CliError::bad(e.to_string()))?,
-        )),
-        None => ReferenceFormat::Auto,
-    };
-    let opts = ReferenceOptions {
-        format,
-        rate_hz: args.rate_hz,
-        earth,
-    };
+    use sdins_sim::reference_file::{scenario_from_reference, ReferenceOptions};
+    let opts = ReferenceOptions::from_names(args.rate_hz, args.columns.as_deref(), &args.earth)
+        .map_err(|e| CliError::bad(e.to_string()))?;
     let (scn, sum) =
         scenario_from_reference(file, &opts).map_err(|e| CliError::bad(e.to_string()))?;
     eprintln!(
