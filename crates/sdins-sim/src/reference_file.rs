@@ -348,12 +348,13 @@ impl ReferenceOptions {
         let earth = match earth {
             "wgs84" => EarthChoice::Wgs84,
             "psins" => EarthChoice::Psins,
-            other => return Err(ReferenceFileError::Option {
-                option: "--earth",
-                message: format!(
-                    "`{other}`: expected wgs84 or psins (a recorded trajectory needs an ellipsoid)"
-                ),
-            }),
+            other => {
+                let message = format!("`{other}`: expected wgs84 or psins (an ellipsoid)");
+                return Err(ReferenceFileError::Option {
+                    option: "--earth",
+                    message,
+                });
+            }
         };
         let format = match columns {
             Some(m) => ReferenceFormat::Generic(Box::new(ColumnMap::parse(m)?)),
