@@ -1,9 +1,9 @@
 //! NaveGo gnss.csv reader with parameters from gnss_params.txt text (the input is `params` + a line `---` + `data`): never panics; accepted fixes have increasing finite times, |lat| <= 90°, heights in range, PD covariances.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use sdins_sim::gnss_file::{parse_gnss_str, GnssFormat, GnssReadOptions, H_RANGE_M};
+use sdins_sim::io::gnss_file::{parse_gnss_str, GnssFormat, GnssReadOptions, H_RANGE_M};
 use std::path::Path;
-use sdins_sim::navego_params::parse_navego_gnss_params;
+use sdins_sim::io::navego_params::parse_navego_gnss_params;
 
 fuzz_target!(|data: &[u8]| {
     let all = String::from_utf8_lossy(data);

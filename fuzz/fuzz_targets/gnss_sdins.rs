@@ -1,7 +1,7 @@
 //! sdins GNSS CSV reader: never panics; accepted fixes have increasing finite times, |lat| <= 90°, heights in range, PD covariances.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use sdins_sim::gnss_file::{parse_gnss_str, GnssFormat, GnssReadOptions, H_RANGE_M};
+use sdins_sim::io::gnss_file::{parse_gnss_str, GnssFormat, GnssReadOptions, H_RANGE_M};
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {

@@ -2,7 +2,7 @@
 //! has a finite positive sample interval and finite increments within the stated limits.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use sdins_sim::imu_file::{parse_imu_str, ImuFormat, MAX_DTHETA_RAD};
+use sdins_sim::io::imu_file::{parse_imu_str, ImuFormat, MAX_DTHETA_RAD};
 use std::path::Path;
 
 const FORMATS: [ImuFormat; 6] = [

@@ -1,7 +1,7 @@
 //! `sdins nav --init` value list: never panics; an accepted state is finite and in range.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use sdins_sim::initial::parse_initial_state;
+use sdins_sim::io::initial::parse_initial_state;
 
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);

@@ -2,7 +2,7 @@
 //! accepted values are finite, σ and densities >= 0, correlation times > 0.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use sdins_sim::navego_params::{parse_navego_gnss_params, parse_navego_imu_params};
+use sdins_sim::io::navego_params::{parse_navego_gnss_params, parse_navego_imu_params};
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {

@@ -5,14 +5,14 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use sdins_core::nav::AlgorithmKind;
-use sdins_sim::envelope::Envelope;
-use sdins_sim::pipeline::{self, RunOptions};
-use sdins_sim::run_setup::{algorithms, AlgoChoice};
+use sdins_sim::truth::envelope::Envelope;
+use sdins_sim::nav::pipeline::{self, RunOptions};
+use sdins_sim::nav::options::{algorithms, AlgoChoice};
 use sdins_sim::scenario::Scenario;
 
 /// Relative slack on the envelope limits for the truth samples: the envelope check samples
 /// the kinematics on a grid and integrates position with the trapezoidal rule
-/// (src/envelope.rs), the truth generator integrates with its own substeps.
+/// (src/truth/envelope.rs), the truth generator integrates with its own substeps.
 const SLACK: f64 = 1e-3;
 
 fuzz_target!(|data: &[u8]| {

@@ -2,7 +2,7 @@
 //! rows are finite, in range and strictly increasing in time.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use sdins_sim::truth_file::parse_truth_str;
+use sdins_sim::io::truth_file::parse_truth_str;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {

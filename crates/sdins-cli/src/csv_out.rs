@@ -69,7 +69,7 @@ impl<'a> CsvOut<'a> {
 
 /// Header of the navigation tables `nav_<algo>.csv` of `sdins nav` and `sdins run`: the
 /// columns of an sdins truth.csv, so either file reads back as a reference trajectory.
-pub const NAV_HEADER: [&str; 10] = sdins_sim::truth_file::SDINS_TRUTH_COLUMNS;
+pub const NAV_HEADER: [&str; 10] = sdins_sim::io::truth_file::SDINS_TRUTH_COLUMNS;
 
 /// Header of `err_<algo>.csv`: `sdins run` writes all 14 columns, `sdins nav` (errors
 /// against a truth file) the first 10.

@@ -45,10 +45,10 @@ impl From<sdins_sim::cancel::Cancelled> for CliError {
     }
 }
 
-impl From<sdins_sim::pipeline::PipelineError> for CliError {
-    fn from(e: sdins_sim::pipeline::PipelineError) -> Self {
+impl From<sdins_sim::nav::pipeline::PipelineError> for CliError {
+    fn from(e: sdins_sim::nav::pipeline::PipelineError) -> Self {
         match e {
-            sdins_sim::pipeline::PipelineError::Cancelled(_) => CliError::Interrupted,
+            sdins_sim::nav::pipeline::PipelineError::Cancelled(_) => CliError::Interrupted,
             other => CliError::BadInput(other.to_string()),
         }
     }

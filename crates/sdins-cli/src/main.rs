@@ -13,6 +13,7 @@ mod error;
 mod output;
 mod plot;
 mod progress;
+mod provenance;
 mod report;
 
 use clap::{Parser, Subcommand};

@@ -335,8 +335,8 @@ fn commit_one(s: &Stage) -> Result<(), CliError> {
     } else {
         let mut t = toml::Table::new();
         t.insert("sdins_version".into(), env!("CARGO_PKG_VERSION").into());
-        t.insert("git_commit".into(), crate::report::git_commit().into());
-        t.insert("command".into(), crate::report::command_line().into());
+        t.insert("git_commit".into(), crate::provenance::git_commit().into());
+        t.insert("command".into(), crate::provenance::command_line().into());
         toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?
     };
     text.push_str(&manifest_text(&files));

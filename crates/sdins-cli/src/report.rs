@@ -168,33 +168,14 @@ pub fn external_resources(html: &str) -> Vec<String> {
     found
 }
 
-/// The git commit sdins was built from, if known at build time.
-pub fn git_commit() -> &'static str {
-    option_env!("SDINS_GIT_COMMIT").unwrap_or("unknown")
-}
-
-/// The command line of this process, space-separated.
-pub fn command_line() -> String {
-    std::env::args().collect::<Vec<_>>().join(" ")
-}
-
-/// The text of a scenario as given on the command line: a built-in scenario's TOML, or
-/// the file's content (empty if it cannot be read any more).
-pub fn scenario_text(name_or_file: &str) -> String {
-    match sdins_sim::scenario::builtin(name_or_file) {
-        Some(b) => b.toml.to_string(),
-        None => std::fs::read_to_string(name_or_file).unwrap_or_default(),
-    }
-}
-
 /// Write `dir/run.toml` atomically: `sdins_version`, `git_commit` and `command` first,
 /// then the command's own `fields` (scenario, seed, method, ...), everything needed to
 /// reproduce the outputs of the folder.
 pub fn write_run_toml(dir: &Path, fields: toml::Table) -> Result<(), CliError> {
     let mut t = toml::Table::new();
     t.insert("sdins_version".into(), env!("CARGO_PKG_VERSION").into());
-    t.insert("git_commit".into(), git_commit().into());
-    t.insert("command".into(), command_line().into());
+    t.insert("git_commit".into(), crate::provenance::git_commit().into());
+    t.insert("command".into(), crate::provenance::command_line().into());
     t.extend(fields);
     let text = toml::to_string(&t).map_err(|e| CliError::Other(e.to_string()))?;
     crate::output::write_string(&dir.join("run.toml"), &text)
@@ -231,7 +212,7 @@ pub fn vibration_toml(scn: &sdins_sim::scenario::Scenario) -> Option<toml::Value
             for (name, p) in [("accel", &r.accel), ("gyro", &r.gyro)] {
                 let Some(p) = p else { continue };
                 let mut q = toml::Table::new();
-                let arr = |f: &dyn Fn(&sdins_sim::random_vibration::AxisPower) -> f64| {
+                let arr = |f: &dyn Fn(&sdins_sim::truth::random_vibration::AxisPower) -> f64| {
                     toml::Value::Array(p.iter().map(|a| toml::Value::from(f(a))).collect())
                 };
                 q.insert("specified".into(), arr(&|a| a.specified));

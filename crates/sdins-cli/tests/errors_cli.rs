@@ -1,8 +1,8 @@
 //! `sdins errors` end to end: the JSON is the library's report (`errors_run::errors`)
 //! to the last bit, the Schuler-share table likewise, bad input exits 2.
 #![allow(clippy::unwrap_used)]
+use sdins_sim::analysis::errors_run::{errors, ErrorsOptions};
 use sdins_sim::cancel::CancelToken;
-use sdins_sim::errors_run::{errors, ErrorsOptions};
 use std::process::Command;
 
 fn sdins(args: &[&str]) -> (i32, String, String) {
@@ -63,7 +63,7 @@ fn errors_json_is_the_library_report() {
     assert_eq!(
         out.trim_end(),
         serde_json::to_string_pretty(
-            &sdins_sim::error_analysis::schuler_share::schuler_share_table_p2()
+            &sdins_sim::analysis::error_analysis::schuler_share::schuler_share_table_p2()
         )
         .unwrap()
     );

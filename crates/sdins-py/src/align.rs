@@ -1,5 +1,5 @@
-//! `sdins.align` and `sdins.errors`: initial alignment (`sdins_sim::align_run::align`)
-//! and stationary error analysis (`sdins_sim::errors_run::errors`), the library calls of
+//! `sdins.align` and `sdins.errors`: initial alignment (`sdins_sim::align::run::align`)
+//! and stationary error analysis (`sdins_sim::analysis::errors_run::errors`), the library calls of
 //! `sdins align` and `sdins errors`.
 
 use crate::arrays::{matrix, vector};
@@ -9,13 +9,13 @@ use crate::scenario::Scenario;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sdins_core::math::Vec3;
-use sdins_sim::align_run::{
+use sdins_sim::align::run::{
     align as align_run, AlignInput, AlignMethod, AlignOptions, AlignRunError, FineStart,
     MultiheadingAlg,
 };
-use sdins_sim::errors_run::{errors as errors_run, ErrorsError, ErrorsOptions};
-use sdins_sim::imu_error::{DPH, UG};
-use sdins_sim::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::analysis::errors_run::{errors as errors_run, ErrorsError, ErrorsOptions};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::sensors::imu_error::{DPH, UG};
 use std::path::PathBuf;
 
 fn v3(v: &Vec3, unit: f64) -> Vec<f64> {
@@ -91,7 +91,7 @@ pub fn align<'py>(
         vrw_ug_per_sqrt_hz,
         arw_deg_per_sqrt_h,
     };
-    sdins_sim::align_run::check_options(&opts).map_err(run_err)?;
+    sdins_sim::align::run::check_options(&opts).map_err(run_err)?;
     let fmt: ImuFormat = format.unwrap_or("auto").parse().map_err(err)?;
     let scn = scenario.map(|s| s.scn.clone());
     let (inp, res) = interrupt::run(py, |tok| -> Result<_, PyErr> {
@@ -144,10 +144,10 @@ pub fn align<'py>(
     if res.has_history {
         let h = &res.history;
         let n = h.len();
-        let col = |f: &dyn Fn(&sdins_sim::align_run::AlignHistoryRow) -> f64| {
+        let col = |f: &dyn Fn(&sdins_sim::align::run::AlignHistoryRow) -> f64| {
             h.iter().map(f).collect::<Vec<f64>>()
         };
-        let mat = |f: &dyn Fn(&sdins_sim::align_run::AlignHistoryRow) -> Vec3, unit: f64| {
+        let mat = |f: &dyn Fn(&sdins_sim::align::run::AlignHistoryRow) -> Vec3, unit: f64| {
             let mut v = Vec::with_capacity(3 * n);
             for r in h {
                 v.extend(v3(&f(r), unit));
@@ -253,6 +253,8 @@ pub fn errors<'py>(
 /// The Schuler-share table (`sdins errors --schuler-share --json`) as JSON text.
 #[pyfunction]
 pub fn schuler_share_json() -> PyResult<String> {
-    serde_json::to_string(&sdins_sim::error_analysis::schuler_share::schuler_share_table_p2())
-        .map_err(err)
+    serde_json::to_string(
+        &sdins_sim::analysis::error_analysis::schuler_share::schuler_share_table_p2(),
+    )
+    .map_err(err)
 }

@@ -1,5 +1,5 @@
 //! `sdins.fuse`: the loosely coupled INS/GNSS filter on a scenario
-//! (`sdins_sim::fuse::fuse_scenario`, the library call of `sdins fuse`).
+//! (`sdins_sim::fusion::simulated::fuse_scenario`, the library call of `sdins fuse`).
 
 use crate::arrays::{matrix, vector};
 use crate::error::err;
@@ -10,7 +10,7 @@ use pyo3::types::PyDict;
 use sdins_core::aiding::ekf::MeasKind;
 use sdins_core::aiding::error_model::{I_ATT, I_POS, I_VEL};
 use sdins_core::nav::AlgorithmSpec;
-use sdins_sim::fuse::{fuse_scenario, FuseError, FuseEvent, FuseOptions};
+use sdins_sim::fusion::simulated::{fuse_scenario, FuseError, FuseEvent, FuseOptions};
 
 /// Number of filter states.
 const NX: usize = 15;
@@ -74,12 +74,12 @@ pub fn fuse<'py>(
         until_s,
         smooth: smooth.unwrap_or(d.smooth),
         in_motion: match in_motion {
-            Some(true) => Some(sdins_sim::fuse::InMotionInit::default()),
+            Some(true) => Some(sdins_sim::fusion::simulated::InMotionInit::default()),
             Some(false) => None,
             None => d.in_motion,
         },
         scale_factors: scale_factors_ppm
-            .map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior::uniform(a, g)),
+            .map(|(a, g)| sdins_sim::fusion::simulated::ScaleFactorPrior::uniform(a, g)),
         ..d
     };
     let gnss = scn.gnss.clone().unwrap_or_default();
@@ -97,7 +97,7 @@ pub fn fuse<'py>(
         sf_sigma: Vec<f64>,
     }
     impl Ep {
-        fn push(&mut self, e: &sdins_sim::fuse::FuseEpoch) {
+        fn push(&mut self, e: &sdins_sim::fusion::simulated::FuseEpoch) {
             self.t.push(e.t_s);
             self.err.extend(e.err.iter());
             self.pos_m.extend(e.nav.pos_err_ned_m);
@@ -219,7 +219,7 @@ struct Track {
 }
 
 impl Track {
-    fn push(&mut self, p: &sdins_sim::fuse_records::RecordPoint) {
+    fn push(&mut self, p: &sdins_sim::fusion::records::RecordPoint) {
         let s = &p.state;
         let e = s.euler();
         self.t.push(p.t_s);
@@ -253,7 +253,7 @@ impl Track {
     }
 }
 
-/// `sdins fuse --imu FILE --gnss FILE` (`sdins_sim::fuse_files::fuse_files`); see the
+/// `sdins fuse --imu FILE --gnss FILE` (`sdins_sim::fusion::files::fuse_files`); see the
 /// Python wrapper for parameters and the returned dict.
 #[pyfunction]
 #[pyo3(signature = (imu, gnss, imu_format=None, gnss_format=None, grade=None,
@@ -284,10 +284,10 @@ pub fn fuse_files<'py>(
     gnss_offset_s: Option<f64>,
     scale_factors_ppm: Option<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use sdins_sim::fuse_files::{FilesError, FilesInput, InitSource, SensorModelSource};
-    use sdins_sim::fuse_records::{RecordEvent, RecordOptions};
-    use sdins_sim::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
-    use sdins_sim::imu_file::ImuFormat;
+    use sdins_sim::fusion::files::{FilesError, FilesInput, InitSource, SensorModelSource};
+    use sdins_sim::fusion::records::{RecordEvent, RecordOptions};
+    use sdins_sim::io::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
+    use sdins_sim::io::imu_file::ImuFormat;
     let d = RecordOptions::default();
     let samples = samples.unwrap_or(d.algo.samples);
     if !(1..=4).contains(&samples) {
@@ -344,7 +344,7 @@ pub fn fuse_files<'py>(
         nhc_sigma_mps,
         smooth: smooth.unwrap_or(d.smooth),
         scale_factors: scale_factors_ppm
-            .map(|(a, g)| sdins_sim::fuse::ScaleFactorPrior::uniform(a, g)),
+            .map(|(a, g)| sdins_sim::fusion::simulated::ScaleFactorPrior::uniform(a, g)),
         ..d
     };
     #[derive(Default)]
@@ -359,7 +359,7 @@ pub fn fuse_files<'py>(
     let (acc, r) = interrupt::run(py, |tok| {
         let mut a = Acc::default();
         let mut t0 = None;
-        let r = sdins_sim::fuse_files::fuse_files(&input, &opts, tok, |ev, _| match ev {
+        let r = sdins_sim::fusion::files::fuse_files(&input, &opts, tok, |ev, _| match ev {
             RecordEvent::Forward(p) => {
                 t0.get_or_insert(p.t_s - p.state.t_s);
                 a.fwd.push(p)

@@ -7,8 +7,8 @@ use crate::interrupt;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use sdins_sim::imu_error::ImuErrorModel;
-use sdins_sim::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::sensors::imu_error::ImuErrorModel;
 use std::path::PathBuf;
 
 /// A Python value of an `errors=` dict as TOML (numbers, strings, lists of numbers).
@@ -83,8 +83,10 @@ pub fn corrupt<'py>(
     let m = model(grade, errors)?;
     let incs = increments(&dtheta, &dv)?;
     let (seed, run) = (seed.unwrap_or(1), run.unwrap_or(0));
-    let out = interrupt::run(py, |_| sdins_sim::align::corrupt(&incs, dt, &m, seed, run))?
-        .map_err(err)?;
+    let out = interrupt::run(py, |_| {
+        sdins_sim::align::experiment::corrupt(&incs, dt, &m, seed, run)
+    })?
+    .map_err(err)?;
     from_increments(py, &out)
 }
 
@@ -135,7 +137,7 @@ pub fn allan<'py>(
         )));
     }
     let incs = increments(&dtheta, &dv)?;
-    let rep = interrupt::run(py, |_| sdins_sim::allan::analyse(&incs, dt))?;
+    let rep = interrupt::run(py, |_| sdins_sim::analysis::allan::analyse(&incs, dt))?;
     let d = PyDict::new(py);
     let tau = rep
         .curves

@@ -9,8 +9,9 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use sdins_sim::montecarlo::{run_shard, McState as State, Shard, CHANNELS};
-use sdins_sim::run_setup::{self, McChoice};
+use sdins_sim::analysis::montecarlo::{mc_options, McChoice};
+use sdins_sim::analysis::montecarlo::{run_shard, McState as State, Shard, CHANNELS};
+use sdins_sim::nav::options;
 
 /// Accumulator state of a Monte Carlo job or shard (picklable).
 #[pyclass(module = "sdins", frozen)]
@@ -92,7 +93,7 @@ impl McState {
             j.algo,
             j.runs,
             self.state.blocks.len(),
-            sdins_sim::montecarlo::plan::block_count(j.runs, j.block)
+            sdins_sim::analysis::montecarlo::plan::block_count(j.runs, j.block)
         )
     }
 }
@@ -147,9 +148,9 @@ pub fn montecarlo(
 ) -> PyResult<McState> {
     let mut scn = scenario.scn.clone();
     if let Some(g) = &grade {
-        run_setup::apply_grade(&mut scn, g).map_err(err)?;
+        options::apply_grade(&mut scn, g).map_err(err)?;
     }
-    let opts = run_setup::mc_options(
+    let opts = mc_options(
         &scn,
         &McChoice {
             runs,
@@ -205,7 +206,7 @@ pub fn merge<'py>(
         return Err(err(format!(
             "{} of {} blocks missing (first missing block {}; runs {}..): give every shard, or allow_partial=True",
             missing.len(),
-            sdins_sim::montecarlo::plan::block_count(merged.job.runs, merged.job.block),
+            sdins_sim::analysis::montecarlo::plan::block_count(merged.job.runs, merged.job.block),
             missing[0],
             missing[0] * merged.job.block
         )));

@@ -9,9 +9,9 @@ use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sdins_core::nav::{InitialState, NavState};
-use sdins_sim::nav_recorded;
-use sdins_sim::pipeline::{run_cancellable, NavError, RunOptions};
-use sdins_sim::run_setup::{self, AlgoChoice};
+use sdins_sim::nav::options::{self, AlgoChoice};
+use sdins_sim::nav::pipeline::{run_cancellable, NavError, RunOptions};
+use sdins_sim::nav::recorded;
 
 /// Navigation-state columns.
 #[derive(Default)]
@@ -62,7 +62,7 @@ impl States {
     }
 }
 
-/// Error columns (pipeline.rs `NavError`, docs/conventions.md §"Errors").
+/// Error columns (`sdins_sim::nav::pipeline::NavError`, docs/conventions.md §"Errors").
 #[derive(Default)]
 struct Errors {
     t_s: Vec<f64>,
@@ -119,7 +119,7 @@ fn initial(init: &Bound<'_, PyAny>) -> PyResult<InitialState> {
                 .join(",")
         }
     };
-    sdins_sim::initial::parse_initial_state(&text).map_err(err)
+    sdins_sim::io::initial::parse_initial_state(&text).map_err(err)
 }
 
 /// Navigate recorded increments with one algorithm (see the Python wrapper's docstring).
@@ -148,22 +148,22 @@ pub fn navigate<'py>(
     if !t0.is_finite() {
         return Err(err(format!("t0_s {t0}: expected a finite time")));
     }
-    if run_setup::vertical_hold(vertical, false).map_err(err)? {
+    if options::vertical_hold(vertical, false).map_err(err)? {
         return Err(err(
             "vertical hold: recorded navigation has no reference height; use sdins.run (scenario truth) for a held vertical channel",
         ));
     }
-    let earth = run_setup::earth_by_name(earth.unwrap_or("wgs84")).map_err(err)?;
+    let earth = options::earth_by_name(earth.unwrap_or("wgs84")).map_err(err)?;
     let init = initial(init)?;
     // the recorded-navigation defaults of `sdins nav`: songlee-complete, N = 1
-    let nav = run_setup::recorded_nav_defaults();
+    let nav = options::recorded_nav_defaults();
     let choice = AlgoChoice {
         algos: Some(algo.unwrap_or_else(|| "songlee-complete".into())),
         samples: Some(samples.unwrap_or(1)),
         coning,
         ..AlgoChoice::default()
     };
-    let specs = run_setup::algorithms(&choice, &nav).map_err(err)?;
+    let specs = options::algorithms(&choice, &nav).map_err(err)?;
     let spec = match specs.as_slice() {
         [s] => *s,
         [] => return Err(err("--algo: no algorithm given")),
@@ -172,7 +172,7 @@ pub fn navigate<'py>(
     let incs = increments(&dtheta, &dv)?;
     let (st, rec) = interrupt::run(py, |tok| {
         let mut st = States::with_capacity(incs.len() / spec.samples.max(1));
-        let r = nav_recorded::navigate(&spec, earth, dt, t0, &init, &incs, None, tok, |t, s| {
+        let r = recorded::navigate(&spec, earth, dt, t0, &init, &incs, None, tok, |t, s| {
             st.push(t, s)
         });
         (st, r)
@@ -227,14 +227,14 @@ pub fn run<'py>(
         rotvec,
         rot3: rot3.unwrap_or(false),
     };
-    let specs = run_setup::algorithms(&choice, &scn.nav).map_err(err)?;
+    let specs = options::algorithms(&choice, &scn.nav).map_err(err)?;
     if specs.is_empty() {
         return Err(err("--algo: no algorithm given"));
     }
-    let hold = run_setup::vertical_hold(vertical, scn.nav.vertical_hold).map_err(err)?;
+    let hold = options::vertical_hold(vertical, scn.nav.vertical_hold).map_err(err)?;
     let dt_u = scn.imu.dt_s() * specs[0].samples as f64;
-    let every = run_setup::every_updates(every_s.unwrap_or(run_setup::DEFAULT_EVERY_S), dt_u)
-        .map_err(err)?;
+    let every =
+        options::every_updates(every_s.unwrap_or(options::DEFAULT_EVERY_S), dt_u).map_err(err)?;
     if let Some(u) = until_s {
         if !(u.is_finite() && u > 0.0) {
             return Err(err(format!("--until-s {u}: expected > 0")));

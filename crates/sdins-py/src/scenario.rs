@@ -87,7 +87,7 @@ impl Scenario {
         columns: Option<String>,
         earth: &str,
     ) -> PyResult<Self> {
-        use sdins_sim::reference_file::{scenario_from_reference, ReferenceOptions};
+        use sdins_sim::scenario::from_reference::{scenario_from_reference, ReferenceOptions};
         let opts = ReferenceOptions::from_names(rate_hz, columns.as_deref(), earth).map_err(err)?;
         let (scn, _) = scenario_from_reference(Path::new(&path), &opts).map_err(err)?;
         Ok(Scenario {

@@ -10,12 +10,12 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode};
 use sdins_sim::cancel::CancelToken;
-use sdins_sim::fuse::InitSigma;
-use sdins_sim::fuse_records::{
+use sdins_sim::fusion::records::{
     fuse_records, record_from_scenario, RecordEvent, RecordInit, RecordModel, RecordOptions,
 };
-use sdins_sim::gnss::GnssConfig;
+use sdins_sim::fusion::simulated::InitSigma;
 use sdins_sim::scenario::Scenario;
+use sdins_sim::sensors::gnss::GnssConfig;
 use std::io::Write;
 use std::time::Duration;
 
@@ -42,7 +42,7 @@ fn fuse(c: &mut Criterion) {
         .sample_size(10)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(10));
-    let sf = sdins_sim::fuse::ScaleFactorPrior {
+    let sf = sdins_sim::fusion::simulated::ScaleFactorPrior {
         accel_ppm: [300.0; 3],
         gyro_ppm: [300.0; 3],
     };
@@ -119,7 +119,7 @@ fn fuse(c: &mut Criterion) {
     g.sample_size(10).measurement_time(Duration::from_secs(10));
     g.bench_function("sdins_imu_csv_720k_rows", |b| {
         b.iter(|| {
-            sdins_sim::imu_file::read_imu_file(&path, sdins_sim::imu_file::ImuFormat::Sdins)
+            sdins_sim::io::imu_file::read_imu_file(&path, sdins_sim::io::imu_file::ImuFormat::Sdins)
                 .unwrap()
                 .increments
                 .len()

@@ -11,7 +11,7 @@ mod common;
 use common::{record, scenario, truth_config, Recorded};
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AnyMechanization, Mechanization};
-use sdins_sim::imu_error::{ImuErrorModel, ImuErrorState};
+use sdins_sim::sensors::imu_error::{ImuErrorModel, ImuErrorState};
 use sdins_sim::truth::TruthGenerator;
 use std::time::{Duration, Instant};
 

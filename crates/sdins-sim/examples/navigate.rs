@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p sdins-sim --example navigate`
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
-use sdins_sim::pipeline::{run, RunOptions};
+use sdins_sim::nav::pipeline::{run, RunOptions};
 use sdins_sim::scenario::Scenario;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

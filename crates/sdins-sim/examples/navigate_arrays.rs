@@ -9,7 +9,7 @@ use sdins_core::coning::Increment;
 use sdins_core::math::Vec3;
 use sdins_core::nav::AlgorithmSpec;
 use sdins_sim::cancel::CancelToken;
-use sdins_sim::nav_recorded::navigate;
+use sdins_sim::nav::recorded::navigate;
 use sdins_sim::scenario::Scenario;
 use sdins_sim::truth::{TruthConfig, TruthGenerator};
 use std::time::Instant;

@@ -37,7 +37,7 @@ mod tests {
         f.set_len(MAX_INPUT_BYTES + 1).unwrap();
         let e = read_capped(&p).unwrap_err().to_string();
         assert!(e.contains("input cap of 4 GiB"), "{e}");
-        let e = crate::imu_file::read_imu_file(&p, crate::imu_file::ImuFormat::Auto)
+        let e = crate::io::imu_file::read_imu_file(&p, crate::io::imu_file::ImuFormat::Auto)
             .unwrap_err()
             .to_string();
         assert!(

@@ -7,14 +7,14 @@
 //! ## Quick start: scenario → run → errors
 //!
 //! A [`scenario::Scenario`] (built in or a TOML file, docs/scenarios.md) defines the
-//! trajectory and the IMU; [`pipeline::run`] generates the exact truth and its IMU
+//! trajectory and the IMU; [`nav::pipeline::run`] generates the exact truth and its IMU
 //! increments once and navigates every algorithm on them, calling the observer at each
 //! output epoch with the errors against the truth (position δN, δE, δD in metres,
 //! velocity in m/s, attitude ε in rad; docs/conventions.md).
 //!
 //! ```
 //! use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
-//! use sdins_sim::pipeline::{run, RunOptions};
+//! use sdins_sim::nav::pipeline::{run, RunOptions};
 //! use sdins_sim::scenario::Scenario;
 //!
 //! let scn = Scenario::load("turn-90dps")?; // Mach 1 east, 90°/s turn from 6 to 8 s
@@ -44,37 +44,12 @@
 //! `cargo run --release -p sdins-sim --example navigate` is the same tour at full length.
 
 pub mod align;
-pub mod align_run;
-pub mod allan;
-pub mod body_motion;
-pub mod calibration;
+pub mod analysis;
 pub mod cancel;
-pub mod envelope;
-pub mod error_analysis;
-pub mod errors_run;
-pub mod fuse;
-pub mod fuse_files;
-pub mod fuse_records;
-pub mod gnss;
-pub mod gnss_file;
-pub mod gnss_fix;
-pub mod gnss_ins_sim;
-pub mod imu_error;
-pub mod imu_file;
-pub mod initial;
+pub mod fusion;
 pub mod input;
-pub mod montecarlo;
-pub mod nav_recorded;
-pub mod navego_params;
-pub mod pipeline;
-pub mod random_vibration;
-pub mod reference;
-pub mod reference_file;
-pub mod route;
-pub mod run_setup;
+pub mod io;
+pub mod nav;
 pub mod scenario;
-pub mod smoother;
-pub mod trajectory;
+pub mod sensors;
 pub mod truth;
-pub mod truth_file;
-pub mod vehicle;

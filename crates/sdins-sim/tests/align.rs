@@ -18,13 +18,13 @@ use sdins_core::align::model::{
 use sdins_core::align::Site;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{attitude_error, dcm_from_rotvec, Euler, Mat3, Vec3};
-use sdins_sim::align::{
+use sdins_sim::align::experiment::{
     algorithm_a, algorithm_b, coarse_window, corrupt, multiheading_trajectory, run_fine,
     truth_record, TruthRecord,
 };
 use sdins_sim::cancel::CancelToken;
-use sdins_sim::imu_error::{ImuErrorModel, DPH, DPSH, UG};
 use sdins_sim::scenario::Scenario;
+use sdins_sim::sensors::imu_error::{ImuErrorModel, DPH, DPSH, UG};
 use std::sync::OnceLock;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
@@ -607,7 +607,7 @@ fn mh_cfg_nf(s: Site) -> FineConfig {
 
 /// Errors of a multi-heading result: (b_a err \[μg\], b_g err \[°/h\], φ \[μrad\]).
 fn mh_errors(
-    r: &sdins_sim::align::MultiHeadingResult,
+    r: &sdins_sim::align::experiment::MultiHeadingResult,
     tr: &TruthRecord,
     ba: &Vec3,
     bg: &Vec3,
@@ -791,7 +791,8 @@ fn lasergyro_real_data_alignment() {
         return;
     }
     let data =
-        sdins_sim::imu_file::read_imu_file(&path, sdins_sim::imu_file::ImuFormat::Psins).unwrap();
+        sdins_sim::io::imu_file::read_imu_file(&path, sdins_sim::io::imu_file::ImuFormat::Psins)
+            .unwrap();
     let hdr = data.psins.clone().unwrap();
     let site = Site::from_earth(&EarthModel::PSINS, hdr.lat_deg * D2R, hdr.h_m);
     let dt = data.dt_s;

@@ -7,12 +7,12 @@ use sdins_core::align::coarse::CoarseMethod;
 use sdins_core::align::Site;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::euler_from_c_b_n;
-use sdins_sim::align::{coarse_window, i0_window};
+use sdins_sim::align::experiment::{coarse_window, i0_window};
 use sdins_sim::cancel::CancelToken;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
 
-fn lasergyro() -> Option<(sdins_sim::imu_file::ImuData, Site)> {
+fn lasergyro() -> Option<(sdins_sim::io::imu_file::ImuData, Site)> {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/psins");
     if !std::path::Path::new(dir).exists() {
         println!("skipped: {dir} is absent");
@@ -20,7 +20,8 @@ fn lasergyro() -> Option<(sdins_sim::imu_file::ImuData, Site)> {
     }
     let path = std::path::Path::new(dir).join("lasergyro.imu");
     let data =
-        sdins_sim::imu_file::read_imu_file(&path, sdins_sim::imu_file::ImuFormat::Psins).unwrap();
+        sdins_sim::io::imu_file::read_imu_file(&path, sdins_sim::io::imu_file::ImuFormat::Psins)
+            .unwrap();
     let hdr = data.psins.clone().unwrap();
     let site = Site::from_earth(&EarthModel::PSINS, hdr.lat_deg * D2R, hdr.h_m);
     Some((data, site))
@@ -74,8 +75,8 @@ fn disturbed_mc(scenario: &str, grade: &str, window_s: f64, runs: u64) -> (Vec<(
     use rayon::prelude::*;
     use sdins_core::align::i0::{heading_floor_rad, heading_sigma_rad};
     use sdins_core::math::{attitude_error, Mat3};
-    use sdins_sim::align::{corrupt, truth_record};
-    use sdins_sim::imu_error::{presets, ImuErrorState, DPSH, UG};
+    use sdins_sim::align::experiment::{corrupt, truth_record};
+    use sdins_sim::sensors::imu_error::{presets, ImuErrorState, DPSH, UG};
     let scn = sdins_sim::scenario::Scenario::load(scenario).unwrap();
     let dt = scn.imu.dt_s();
     let n = (window_s / dt).round() as usize;
@@ -171,7 +172,7 @@ fn i0_rocking_car_monte_carlo() {
 #[test]
 fn i0_error_free_disturbed_base() {
     use sdins_core::math::attitude_error;
-    use sdins_sim::align::truth_record;
+    use sdins_sim::align::experiment::truth_record;
     for (name, window_s) in [("moored-ship", 300.0), ("rocking-car", 300.0)] {
         let scn = sdins_sim::scenario::Scenario::load(name).unwrap();
         let dt = scn.imu.dt_s();
@@ -212,8 +213,8 @@ fn i0_error_free_disturbed_base() {
 #[test]
 fn lasergyro_fine_from_i0_is_start_independent() {
     use sdins_core::align::fine::reference_config;
-    use sdins_sim::align::fine_from_i0;
-    use sdins_sim::imu_error::{DPSH, UG};
+    use sdins_sim::align::experiment::fine_from_i0;
+    use sdins_sim::sensors::imu_error::{DPSH, UG};
     let Some((data, site)) = lasergyro() else {
         return;
     };
@@ -257,8 +258,8 @@ fn fine_from_i0_moored_ship_nees() {
     use rayon::prelude::*;
     use sdins_core::align::fine::reference_config;
     use sdins_core::math::attitude_error;
-    use sdins_sim::align::{corrupt, fine_from_i0, truth_record};
-    use sdins_sim::imu_error::{presets, DPH, DPSH, UG};
+    use sdins_sim::align::experiment::{corrupt, fine_from_i0, truth_record};
+    use sdins_sim::sensors::imu_error::{presets, DPH, DPSH, UG};
     let scn = sdins_sim::scenario::Scenario::load("moored-ship").unwrap();
     let dt = scn.imu.dt_s();
     let n_all = (600.0 / dt).round() as usize;

@@ -2,7 +2,7 @@
 //! and speed) and only warn on an input without truth; i0 accepts the disturbed-base
 //! built-ins.
 #![allow(clippy::unwrap_used)]
-use sdins_sim::align_run::{align, AlignInput, AlignMethod, AlignOptions, AlignRunError};
+use sdins_sim::align::run::{align, AlignInput, AlignMethod, AlignOptions, AlignRunError};
 use sdins_sim::cancel::CancelToken;
 use sdins_sim::scenario::Scenario;
 

@@ -2,14 +2,14 @@
 //! (NEES) over Monte Carlo runs, and located errors for bad schedule keys.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use sdins_sim::calibration::run::{
+use sdins_sim::align::calibration::run::{
     calibrate_scenario, group_errors, monte_carlo, run_on_truth, truth_increments,
 };
-use sdins_sim::calibration::{DrawSpec, N_PARAMS};
+use sdins_sim::align::calibration::{DrawSpec, N_PARAMS};
 use sdins_sim::cancel::CancelToken;
-use sdins_sim::imu_error::{presets, DPH, MRAD, PPM, UG};
 use sdins_sim::scenario::{Scenario, ScenarioError};
-use sdins_sim::trajectory::OverlayKind;
+use sdins_sim::sensors::imu_error::{presets, DPH, MRAD, PPM, UG};
+use sdins_sim::truth::trajectory::OverlayKind;
 
 fn scenario(schedule: &str, dwell_s: f64, rate_hz: f64, imu_extra: &str) -> Scenario {
     scenario_seeded(schedule, dwell_s, rate_hz, imu_extra, 7)
@@ -79,9 +79,9 @@ fn rotation_truth_matches_the_analytic_angle() {
         earth_int *= h / 3.0;
         let mut want = earth_int;
         let idx = match axis {
-            sdins_sim::trajectory::Axis::X => 0,
-            sdins_sim::trajectory::Axis::Y => 1,
-            sdins_sim::trajectory::Axis::Z => 2,
+            sdins_sim::truth::trajectory::Axis::X => 0,
+            sdins_sim::truth::trajectory::Axis::Y => 1,
+            sdins_sim::truth::trajectory::Axis::Z => 2,
         };
         want[idx] += angle_rad;
         let tol = (k1 - k0) as f64 * f64::EPSILON * angle_rad.abs() / 2.0;
@@ -121,13 +121,19 @@ fn noise_free_recovery_is_exact() {
     // A⁻¹ at unit density: rerun the estimator on the same data with densities √δt
     let meas: Vec<_> = {
         let m = DrawSpec::DEFAULT.apply(&scn.imu.model, scn.imu.seed, 3);
-        let mut st = sdins_sim::imu_error::ImuErrorState::new(&m, scn.imu.seed, 3).unwrap();
+        let mut st =
+            sdins_sim::sensors::imu_error::ImuErrorState::new(&m, scn.imu.seed, 3).unwrap();
         exact.iter().map(|x| st.apply(x, dt)).collect()
     };
     let unit = sdins_core::math::Vec3::repeat(dt.sqrt());
-    let (g1, a1) =
-        sdins_sim::calibration::run::estimate(&exact, &meas, dt, (Some(unit), Some(unit)), &cancel)
-            .unwrap();
+    let (g1, a1) = sdins_sim::align::calibration::run::estimate(
+        &exact,
+        &meas,
+        dt,
+        (Some(unit), Some(unit)),
+        &cancel,
+    )
+    .unwrap();
     assert_eq!(g1.k, r.gyro.k);
     assert_eq!(a1.bias, r.accel.bias);
     let eps = f64::EPSILON;
@@ -206,7 +212,7 @@ fn mc_row(
     dwell_s: f64,
     runs: usize,
     seed: u64,
-) -> sdins_sim::calibration::MonteCarloSummary {
+) -> sdins_sim::align::calibration::MonteCarloSummary {
     let scn = scenario_seeded("12-position", dwell_s, 100.0, &grade_lines(grade), seed);
     let t0 = std::time::Instant::now();
     let (all, s) = monte_carlo(&scn, Some(&DrawSpec::DEFAULT), runs, &CancelToken::new()).unwrap();

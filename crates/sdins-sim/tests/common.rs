@@ -3,7 +3,7 @@
 
 use sdins_core::coning::ConingSet;
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, AttitudeMode};
-use sdins_sim::pipeline::{run, NavError, RunOptions, RunSummary};
+use sdins_sim::nav::pipeline::{run, NavError, RunOptions, RunSummary};
 use sdins_sim::scenario::Scenario;
 
 /// `rel` under `../shared/data` (read in place), or `None` with the printed reason when

@@ -23,10 +23,10 @@ fn imu_errors_doc_has_the_generated_tables() {
         &replace_between(
             &doc,
             "grades",
-            &sdins_sim::imu_error::presets::markdown_table(),
+            &sdins_sim::sensors::imu_error::presets::markdown_table(),
         ),
         "keys",
-        &sdins_sim::imu_error::keys_markdown(),
+        &sdins_sim::sensors::imu_error::keys_markdown(),
     );
     if std::env::var_os("SDINS_WRITE_DOCS").is_some() {
         std::fs::write(path, &want).unwrap();
@@ -39,8 +39,8 @@ fn imu_errors_doc_has_the_generated_tables() {
 
 #[test]
 fn the_error_analysis_reads_the_one_grade_table() {
-    use sdins_sim::error_analysis::grades::grade_by_name;
-    use sdins_sim::imu_error::presets::{preset, GRADES};
+    use sdins_sim::analysis::error_analysis::grades::grade_by_name;
+    use sdins_sim::sensors::imu_error::presets::{preset, GRADES};
     for g in &GRADES {
         let m = preset(g.name).unwrap();
         let e = grade_by_name(g.name).unwrap();

@@ -4,9 +4,9 @@
 #![allow(clippy::unwrap_used)]
 use proptest::prelude::*;
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
-use sdins_sim::envelope::Envelope;
-use sdins_sim::pipeline::{run, RunOptions};
+use sdins_sim::nav::pipeline::{run, RunOptions};
 use sdins_sim::scenario::{Scenario, ScenarioError};
+use sdins_sim::truth::envelope::Envelope;
 use sdins_sim::truth::{TruthConfig, TruthGenerator};
 
 fn scenario(start: &str, segments: &str) -> Result<Scenario, ScenarioError> {

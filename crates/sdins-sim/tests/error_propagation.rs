@@ -7,16 +7,16 @@
 
 use sdins_core::nav::AlgorithmSpec;
 use sdins_core::Vec3;
-use sdins_sim::error_analysis::linear_model::{
+use sdins_sim::analysis::error_analysis::linear_model::{
     propagate, EnvelopePoint, ModelEarth, ModelOptions, ProcessNoise, StateMat, VerticalChannel,
 };
-use sdins_sim::error_analysis::nonlinear::NonlinearRun;
-use sdins_sim::error_analysis::periods::SchulerParams;
-use sdins_sim::error_analysis::reference::{model_statistics, samples_from_scenario};
-use sdins_sim::error_analysis::stationary::{StationaryClosedForm, StationaryErrors};
-use sdins_sim::error_analysis::{DEG_PER_HOUR, MICRO_G};
-use sdins_sim::montecarlo::{run_shard, McOptions, Shard, DEFAULT_BLOCK};
-use sdins_sim::pipeline::{run as run_pipeline, NavError, RunOptions};
+use sdins_sim::analysis::error_analysis::nonlinear::NonlinearRun;
+use sdins_sim::analysis::error_analysis::periods::SchulerParams;
+use sdins_sim::analysis::error_analysis::reference::{model_statistics, samples_from_scenario};
+use sdins_sim::analysis::error_analysis::stationary::{StationaryClosedForm, StationaryErrors};
+use sdins_sim::analysis::error_analysis::{DEG_PER_HOUR, MICRO_G};
+use sdins_sim::analysis::montecarlo::{run_shard, McOptions, Shard, DEFAULT_BLOCK};
+use sdins_sim::nav::pipeline::{run as run_pipeline, NavError, RunOptions};
 use sdins_sim::scenario::Scenario;
 
 const D2R: f64 = core::f64::consts::PI / 180.0;

@@ -7,9 +7,9 @@ use sdins_core::coning::{ConingSet, Increment};
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{attitude_error, c_b_n_from_euler, Euler, Quat, Vec3};
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec, InitialState};
-use sdins_sim::imu_file::{read_imu_file, ImuFormat};
-use sdins_sim::pipeline::{nav_error, navigate_recorded, NavError};
-use sdins_sim::truth_file::{c_b_n_from_psins, read_psins_avp};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::io::truth_file::{c_b_n_from_psins, read_psins_avp};
+use sdins_sim::nav::pipeline::{nav_error, navigate_recorded, NavError};
 use std::path::PathBuf;
 
 mod common;

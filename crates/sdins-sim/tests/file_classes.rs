@@ -2,8 +2,8 @@
 //! `auto` used to read as FRD, absurd time steps and byte-order marks in truth files.
 #![allow(clippy::unwrap_used)]
 
-use sdins_sim::imu_file::{read_imu_file, ImuFormat};
-use sdins_sim::truth_file::{parse_truth_str, MAX_TRUTH_STEP_S};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::io::truth_file::{parse_truth_str, MAX_TRUTH_STEP_S};
 use std::path::Path;
 
 #[test]

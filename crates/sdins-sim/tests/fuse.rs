@@ -6,9 +6,9 @@ use sdins_core::aiding::ekf::MeasKind;
 use sdins_core::aiding::error_model::{I_ATT, I_BA, I_POS, I_VEL};
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
 use sdins_sim::cancel::CancelToken;
-use sdins_sim::fuse::{fuse_scenario, FuseEvent, FuseOptions};
-use sdins_sim::gnss::GnssConfig;
+use sdins_sim::fusion::simulated::{fuse_scenario, FuseEvent, FuseOptions};
 use sdins_sim::scenario::Scenario;
+use sdins_sim::sensors::gnss::GnssConfig;
 
 /// A maneuvering car-like scenario: accelerate, turns both ways, decelerate, cruise.
 fn maneuver_toml(grade: &str, rate_hz: f64, minutes: u32) -> String {
@@ -91,7 +91,7 @@ fn short_run_every_algorithm_stays_consistent() {
 // ---------------------------------------------------------------------------------------
 
 use rayon::prelude::*;
-use sdins_sim::fuse::{fuse_scenario_with, scenario_truth, FuseEpoch, FuseSummary};
+use sdins_sim::fusion::simulated::{fuse_scenario_with, scenario_truth, FuseEpoch, FuseSummary};
 
 /// Wilson–Hilferty quantile of the mean of `runs` χ²(dof) variables (χ²(runs·dof)/runs).
 fn chi2_mean_quantile(dof: f64, runs: f64, z: f64) -> f64 {
@@ -658,7 +658,7 @@ fn gnss_scenario_section_parses_and_bad_values_name_the_key() {
 #[test]
 #[ignore]
 fn mc_in_motion_alignment_from_unknown_heading() {
-    use sdins_sim::fuse::InMotionInit;
+    use sdins_sim::fusion::simulated::InMotionInit;
     let runs = 200u64;
     let opts = FuseOptions {
         in_motion: Some(InMotionInit::default()),
@@ -783,7 +783,7 @@ fn mounting_gnss_arm_is_used_and_imu_mounting_is_refused() {
         .to_string();
     assert!(e.contains("mounting"), "{e}");
     let scn = Scenario::from_toml(&imu_arm, "m.toml").unwrap();
-    let mc = sdins_sim::montecarlo::McOptions {
+    let mc = sdins_sim::analysis::montecarlo::McOptions {
         runs: 16,
         seed: 1,
         algo: AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 2),
@@ -792,7 +792,7 @@ fn mounting_gnss_arm_is_used_and_imu_mounting_is_refused() {
         block: 16,
         vertical_hold: true,
     };
-    let e = sdins_sim::montecarlo::runner::job(&scn, &mc)
+    let e = sdins_sim::analysis::montecarlo::runner::job(&scn, &mc)
         .unwrap_err()
         .to_string();
     assert!(e.contains("[mounting]"), "{e}");
@@ -803,7 +803,7 @@ fn mounting_gnss_arm_is_used_and_imu_mounting_is_refused() {
 // ---------------------------------------------------------------------------------------
 
 use sdins_core::aiding::error_model::N_STATES;
-use sdins_sim::fuse::ScaleFactorPrior;
+use sdins_sim::fusion::simulated::ScaleFactorPrior;
 
 /// Loops in one direction (a 360° and a 180° turn at 9 °/s per minute, with speed
 /// changes between): a heading error from the z-gyro scale factor accumulates instead of

@@ -5,12 +5,12 @@
 #![allow(clippy::unwrap_used)]
 
 use sdins_sim::cancel::CancelToken;
-use sdins_sim::fuse::InitSigma;
-use sdins_sim::fuse_records::{
+use sdins_sim::fusion::records::{
     fuse_records, record_from_scenario, RecordEvent, RecordInit, RecordModel, RecordOptions,
 };
-use sdins_sim::gnss::GnssConfig;
+use sdins_sim::fusion::simulated::InitSigma;
 use sdins_sim::scenario::Scenario;
+use sdins_sim::sensors::gnss::GnssConfig;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 

@@ -2,12 +2,12 @@
 //! (skipped with a printed reason when the folder is absent).
 #![allow(clippy::unwrap_used)]
 
-use sdins_sim::gnss_file::{
+use sdins_sim::io::gnss_file::{
     clip_to_imu_span, imu_span_s, read_gnss_file, to_imu_time, GnssFormat, GnssReadOptions,
     ImuClock, TimeBase,
 };
-use sdins_sim::imu_file::{read_imu_file, ImuFormat};
-use sdins_sim::navego_params::{read_navego_gnss_params, read_navego_imu_params};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::io::navego_params::{read_navego_gnss_params, read_navego_imu_params};
 use std::path::{Path, PathBuf};
 
 fn data(sub: &str) -> Option<PathBuf> {

@@ -4,12 +4,12 @@
 #![allow(clippy::unwrap_used)]
 use sdins_core::math::{euler_from_c_b_n, Vec3};
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
-use sdins_sim::body_motion::{BodyCommand, BodyMotion, CommandKind, MotionLimits};
-use sdins_sim::gnss_ins_sim::{
+use sdins_sim::io::gnss_ins_sim::{
     outages, parse_motion_def, read_motion_def, to_scenario_toml, ImportOptions, MotionFile,
 };
-use sdins_sim::pipeline::{run, RunOptions};
+use sdins_sim::nav::pipeline::{run, RunOptions};
 use sdins_sim::scenario::Scenario;
+use sdins_sim::truth::body_motion::{BodyCommand, BodyMotion, CommandKind, MotionLimits};
 use sdins_sim::truth::{TruthConfig, TruthGenerator};
 use std::path::{Path, PathBuf};
 

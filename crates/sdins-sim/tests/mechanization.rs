@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use sdins_core::coning::ConingSet;
 use sdins_core::nav::{AlgorithmKind as K, AttitudeMode, RotVector};
-use sdins_sim::pipeline::NavError;
+use sdins_sim::nav::pipeline::NavError;
 use sdins_sim::scenario::Scenario;
 
 fn norm(v: [f64; 3]) -> f64 {

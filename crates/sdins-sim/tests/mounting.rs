@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used)]
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Vec3};
-use sdins_sim::trajectory::{Motion, Trajectory};
+use sdins_sim::truth::trajectory::{Motion, Trajectory};
 use sdins_sim::truth::{ImuMount, TruthConfig, TruthGenerator};
 
 const DT: f64 = 0.01;

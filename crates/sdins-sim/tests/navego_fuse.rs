@@ -6,10 +6,10 @@
 
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
 use sdins_sim::cancel::CancelToken;
-use sdins_sim::fuse_files::{fuse_files, FilesInput, InitSource, SensorModelSource};
-use sdins_sim::fuse_records::{RecordOptions, COMPARISON_AXES};
-use sdins_sim::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
-use sdins_sim::imu_file::ImuFormat;
+use sdins_sim::fusion::files::{fuse_files, FilesInput, InitSource, SensorModelSource};
+use sdins_sim::fusion::records::{RecordOptions, COMPARISON_AXES};
+use sdins_sim::io::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
+use sdins_sim::io::imu_file::ImuFormat;
 use std::path::{Path, PathBuf};
 
 fn data() -> Option<PathBuf> {

@@ -3,8 +3,8 @@
 //! specific force and angular rate against the specified PSD.
 #![allow(clippy::unwrap_used)]
 use sdins_core::math::Vec3;
-use sdins_sim::random_vibration::{PsdTable, RandomVibration, RandomVibrationSpec};
 use sdins_sim::scenario::{Scenario, ScenarioError};
+use sdins_sim::truth::random_vibration::{PsdTable, RandomVibration, RandomVibrationSpec};
 use sdins_sim::truth::{TruthGenerator, TruthSample};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};

@@ -7,8 +7,8 @@ use common::shared_data as data;
 
 use sdins_core::math::Vec3;
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
-use sdins_sim::pipeline::{run, NavError, RunOptions};
-use sdins_sim::reference_file::{scenario_from_reference, ReferenceOptions};
+use sdins_sim::nav::pipeline::{run, NavError, RunOptions};
+use sdins_sim::scenario::from_reference::{scenario_from_reference, ReferenceOptions};
 use sdins_sim::truth::{lon_diff, TruthConfig, TruthGenerator};
 
 struct RoundTrip {

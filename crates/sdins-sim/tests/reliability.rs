@@ -6,9 +6,9 @@ use common::*;
 use proptest::prelude::*;
 use sdins_core::math::Mat3;
 use sdins_core::nav::AlgorithmKind as K;
-use sdins_sim::error_analysis::periods::SchulerParams;
-use sdins_sim::error_analysis::stationary::{StationaryClosedForm, StationaryErrors};
-use sdins_sim::pipeline::{run, NavError, RunOptions};
+use sdins_sim::analysis::error_analysis::periods::SchulerParams;
+use sdins_sim::analysis::error_analysis::stationary::{StationaryClosedForm, StationaryErrors};
+use sdins_sim::nav::pipeline::{run, NavError, RunOptions};
 use sdins_sim::scenario::Scenario;
 
 const ALL: [K; 4] = [K::Savage, K::SongLee, K::SongLeeComplete, K::DualQuat];

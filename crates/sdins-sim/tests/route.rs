@@ -4,10 +4,10 @@
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Vec3};
 use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
-use sdins_sim::pipeline::{run, RunOptions};
-use sdins_sim::route::{compile, CompiledRoute, LegKind, Route, RouteLimits, Waypoint};
+use sdins_sim::nav::pipeline::{run, RunOptions};
 use sdins_sim::scenario::{Scenario, ScenarioError};
-use sdins_sim::trajectory::Trajectory;
+use sdins_sim::truth::route::{compile, CompiledRoute, LegKind, Route, RouteLimits, Waypoint};
+use sdins_sim::truth::trajectory::Trajectory;
 use sdins_sim::truth::{TruthConfig, TruthGenerator, TruthSample};
 
 const D2R: f64 = std::f64::consts::PI / 180.0;

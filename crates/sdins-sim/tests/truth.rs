@@ -3,7 +3,7 @@
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Vec3};
 use sdins_sim::scenario::Scenario;
-use sdins_sim::trajectory::{Axis, Motion, Overlay, OverlayKind, Trajectory};
+use sdins_sim::truth::trajectory::{Axis, Motion, Overlay, OverlayKind, Trajectory};
 use sdins_sim::truth::{TruthConfig, TruthGenerator};
 
 const D2R: f64 = std::f64::consts::PI / 180.0;

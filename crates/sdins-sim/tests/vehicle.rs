@@ -3,9 +3,9 @@
 #![allow(clippy::unwrap_used)]
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{Euler, Vec3};
-use sdins_sim::trajectory::{Motion, Trajectory};
+use sdins_sim::truth::trajectory::{Motion, Trajectory};
+use sdins_sim::truth::vehicle::{coordinated_turn, Vehicle, VehicleError};
 use sdins_sim::truth::{TruthConfig, TruthGenerator};
-use sdins_sim::vehicle::{coordinated_turn, Vehicle, VehicleError};
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
 const LAT0: f64 = 45.0 * D2R;
@@ -388,16 +388,16 @@ fn scenario_vehicle_errors_are_located() {
     );
 }
 
-fn nav_max(scn: &sdins_sim::scenario::Scenario) -> sdins_sim::pipeline::NavError {
+fn nav_max(scn: &sdins_sim::scenario::Scenario) -> sdins_sim::nav::pipeline::NavError {
     use sdins_core::nav::{AlgorithmKind, AlgorithmSpec};
-    let opts = sdins_sim::pipeline::RunOptions {
+    let opts = sdins_sim::nav::pipeline::RunOptions {
         algos: vec![AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 3)],
         vertical_hold: false,
         every: 1,
         until_s: None,
         sensor_run: None,
     };
-    let r = sdins_sim::pipeline::run(scn, &opts, |_, _, _, _| {}, |_, _| {}).unwrap();
+    let r = sdins_sim::nav::pipeline::run(scn, &opts, |_, _, _, _| {}, |_, _| {}).unwrap();
     r[0].max_abs
 }
 

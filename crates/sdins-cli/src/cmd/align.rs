@@ -22,13 +22,13 @@ use sdins_core::align::observability::{analyze, scale12, scale9};
 use sdins_core::align::Site;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::{c_b_n_from_euler, Euler, Mat3, Vec3};
-use sdins_sim::align_run::{
+use sdins_sim::align::run::{
     align, check_options, check_site, AlignInput, AlignMethod, AlignOptions, AlignOutcome,
     AlignRunError, FineStart, MultiheadingAlg,
 };
-use sdins_sim::imu_error::{DPH, DPSH, UG};
-use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use sdins_sim::scenario::Scenario;
+use sdins_sim::sensors::imu_error::{DPH, DPSH, UG};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -474,7 +474,10 @@ fn write_align_toml(
     let mut t = toml::Table::new();
     if let Some(name) = &args.scenario {
         t.insert("scenario_name".into(), inp.name.clone().into());
-        t.insert("scenario".into(), crate::report::scenario_text(name).into());
+        t.insert(
+            "scenario".into(),
+            crate::provenance::scenario_text(name).into(),
+        );
         t.insert("run".into(), args.run.to_string().into());
     }
     if let Some(seed) = inp.seed {

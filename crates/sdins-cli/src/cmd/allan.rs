@@ -1,5 +1,5 @@
 //! `sdins allan`: overlapping Allan deviation of the six channels of an IMU file with
-//! the IEEE Std 952 noise fits (see `sdins_sim::allan`).
+//! the IEEE Std 952 noise fits (see `sdins_sim::analysis::allan`).
 //!
 //! Outputs (in `--out`, default the current folder): `allan.csv` (τ and the six
 //! deviations: gyro in °/h, accelerometer in μg), `allan.svg` and `allan.png`
@@ -10,11 +10,11 @@
 
 use crate::error::CliError;
 use crate::output::write_string;
-use sdins_sim::allan::{AllanCurve, AllanFit};
-use sdins_sim::imu_error::{
+use sdins_sim::analysis::allan::{AllanCurve, AllanFit};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use sdins_sim::sensors::imu_error::{
     ARCSEC, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H, UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ,
 };
-use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -47,7 +47,7 @@ pub const CHANNELS: [&str; 6] = [
     "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
 ];
 
-pub use sdins_sim::allan::{analyse, AllanReport};
+pub use sdins_sim::analysis::allan::{analyse, AllanReport};
 
 fn file_error(e: ImuFileError) -> CliError {
     match e {
@@ -269,7 +269,7 @@ fn fit_lines(c: &AllanCurve, f: &AllanFit, unit: f64) -> Vec<Vec<(f64, f64)>> {
         out.push(line(r, &|t| n / t.sqrt()));
     }
     if let (Some(b), Some(r)) = (f.bias_instability, f.bias_instability_range_s) {
-        out.push(line(r, &|_| sdins_sim::allan::FLICKER_FLOOR * b));
+        out.push(line(r, &|_| sdins_sim::analysis::allan::FLICKER_FLOOR * b));
     }
     if let (Some(k), Some(r)) = (f.rate_random_walk, f.rrw_tau_s) {
         out.push(line(r, &|t| k * (t / 3.0).sqrt()));
@@ -347,7 +347,7 @@ pub fn plot_png(r: &AllanReport, dest: &Path) -> Result<(), CliError> {
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
-    use sdins_sim::imu_error::{ImuErrorModel, ImuErrorState};
+    use sdins_sim::sensors::imu_error::{ImuErrorModel, ImuErrorState};
 
     #[test]
     fn end_to_end_on_a_simulated_file() {

@@ -12,16 +12,16 @@
 
 use crate::error::CliError;
 use crate::output::write_string;
-use sdins_sim::calibration::run::calibrate_recorded;
-use sdins_sim::calibration::run::{
+use sdins_sim::align::calibration::run::calibrate_recorded;
+use sdins_sim::align::calibration::run::{
     calibrate_scenario, group_errors, monte_carlo, CalibrationError, CalibrationRun, GroupMax,
     MonteCarloSummary,
 };
-use sdins_sim::calibration::table::{rows, triad_rows, ParamRow};
-use sdins_sim::calibration::DrawSpec;
-use sdins_sim::imu_error::{DPH, UG};
-use sdins_sim::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use sdins_sim::align::calibration::table::{rows, triad_rows, ParamRow};
+use sdins_sim::align::calibration::DrawSpec;
+use sdins_sim::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use sdins_sim::scenario::Scenario;
+use sdins_sim::sensors::imu_error::{DPH, UG};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -181,7 +181,7 @@ fn summary_json(scn: &Scenario, o: &Outcome<'_>) -> serde_json::Value {
         "dt_s": scn.imu.dt_s(),
         "run": o.first.map(|f| f.run),
         "nees": o.first.map(|f| f.nees),
-        "nees_dof": sdins_sim::calibration::N_PARAMS,
+        "nees_dof": sdins_sim::align::calibration::N_PARAMS,
         "unmodelled_terms": o.first.map_or(Vec::new(), |f| f.unmodelled.clone()),
         "parameters": params,
     });
@@ -272,8 +272,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         };
         let note = format!(
             "residual noise densities: gyro {} °/√h, accelerometer {} μg/√Hz (the 1σ uses {})",
-            resid(g.density_residual, sdins_sim::imu_error::DPSH),
-            resid(a.density_residual, sdins_sim::imu_error::UG_PER_SQRT_HZ),
+            resid(g.density_residual, sdins_sim::sensors::imu_error::DPSH),
+            resid(
+                a.density_residual,
+                sdins_sim::sensors::imu_error::UG_PER_SQRT_HZ
+            ),
             if g.density == g.density_residual {
                 "these"
             } else {
@@ -347,7 +350,7 @@ fn finish(args: &Args, scn: &Scenario, o: &Outcome<'_>, note: &str) -> Result<()
         t.insert("scenario_name".into(), scn.name.clone().into());
         t.insert(
             "scenario".into(),
-            crate::report::scenario_text(&args.scenario).into(),
+            crate::provenance::scenario_text(&args.scenario).into(),
         );
         t.insert("seed".into(), scn.imu.seed.to_string().into());
         if let Some(p) = &args.imu {

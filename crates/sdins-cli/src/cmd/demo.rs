@@ -8,7 +8,7 @@ use super::run::{
 use crate::error::CliError;
 use crate::plot::Bars;
 use crate::report::Report;
-use sdins_sim::error_analysis::schuler_share::schuler_share_table_p2;
+use sdins_sim::analysis::error_analysis::schuler_share::schuler_share_table_p2;
 use std::path::PathBuf;
 
 /// Arguments of `sdins demo`.
@@ -48,7 +48,7 @@ pub fn run_args(scenario: &str, algo: &str, out: PathBuf, quiet: bool) -> RunArg
 
 const ALL: &str = "savage,songlee,songlee-complete,dualquat";
 
-fn find<'a>(o: &'a Outcome, algo: &str) -> Option<&'a sdins_sim::pipeline::RunSummary> {
+fn find<'a>(o: &'a Outcome, algo: &str) -> Option<&'a sdins_sim::nav::pipeline::RunSummary> {
     o.sums.iter().find(|s| s.algo == algo)
 }
 
@@ -272,7 +272,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         println!("  {timing}");
     }
     let hrow = |name: &str,
-                s: Option<&sdins_sim::pipeline::RunSummary>,
+                s: Option<&sdins_sim::nav::pipeline::RunSummary>,
                 spec_h: &str,
                 spec_vd: &str|
      -> Vec<String> {
@@ -384,8 +384,8 @@ fn alignment_summary() -> Result<Vec<Vec<String>>, CliError> {
     use sdins_core::align::coarse::CoarseMethod;
     use sdins_core::align::fine::{reference_config, FineAlign};
     use sdins_core::math::attitude_error;
-    use sdins_sim::align::{coarse_window, corrupt, truth_record};
-    use sdins_sim::imu_error::{DPSH, UG};
+    use sdins_sim::align::experiment::{coarse_window, corrupt, truth_record};
+    use sdins_sim::sensors::imu_error::{DPSH, UG};
     let scn = sdins_sim::scenario::Scenario::load("alignment")?;
     let dt = scn.imu.dt_s();
     let tr = truth_record(

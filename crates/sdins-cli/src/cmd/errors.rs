@@ -14,11 +14,15 @@
 //! ```
 
 use crate::error::CliError;
-use sdins_sim::error_analysis::grades::grade_by_name;
-use sdins_sim::error_analysis::linear_model::EnvelopePoint;
-use sdins_sim::error_analysis::schuler_share::{schuler_share_table_p2, ShareRow, T_STAR_S};
-use sdins_sim::error_analysis::stationary::{StationaryClosedForm, StationarySolution};
-use sdins_sim::errors_run::{errors, BudgetRow, ErrorsError, ErrorsOptions, ErrorsReport};
+use sdins_sim::analysis::error_analysis::grades::grade_by_name;
+use sdins_sim::analysis::error_analysis::linear_model::EnvelopePoint;
+use sdins_sim::analysis::error_analysis::schuler_share::{
+    schuler_share_table_p2, ShareRow, T_STAR_S,
+};
+use sdins_sim::analysis::error_analysis::stationary::{StationaryClosedForm, StationarySolution};
+use sdins_sim::analysis::errors_run::{
+    errors, BudgetRow, ErrorsError, ErrorsOptions, ErrorsReport,
+};
 
 /// Arguments of `sdins errors`.
 #[derive(clap::Args, Debug)]
@@ -301,7 +305,7 @@ fn print_table(r: &ErrorsReport) {
         "1σ φD"
     );
     for e in &r.epochs {
-        let nl = |f: &dyn Fn(&sdins_sim::errors_run::NonlinearPoint) -> String| {
+        let nl = |f: &dyn Fn(&sdins_sim::analysis::errors_run::NonlinearPoint) -> String| {
             e.nonlinear
                 .as_ref()
                 .map(f)

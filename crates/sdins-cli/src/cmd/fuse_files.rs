@@ -1,19 +1,19 @@
 //! `sdins fuse --imu FILE --gnss FILE`: the filter (and smoother) on recorded data. The
-//! work is `sdins_sim::fuse_files::fuse_files`; this parses, writes the CSVs, the report
+//! work is `sdins_sim::fusion::files::fuse_files`; this parses, writes the CSVs, the report
 //! and prints.
 
-use super::fuse::Args;
+use super::fuse_args::Args;
 use super::fuse_report::{ErrRow, FuseReportData, Thin};
 use crate::csv_out::{innovation_row, nav_row, CsvOut, INNOVATION_HEADER, NAV_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
 use sdins_core::nav::AlgorithmSpec;
-use sdins_sim::fuse::FuseError;
-use sdins_sim::fuse_files::{fuse_files, FilesError, FilesInput, InitSource, SensorModelSource};
-use sdins_sim::fuse_records::{RecordEvent, RecordOptions, RecordPoint, COMPARISON_AXES};
-use sdins_sim::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
-use sdins_sim::imu_file::ImuFormat;
+use sdins_sim::fusion::files::{fuse_files, FilesError, FilesInput, InitSource, SensorModelSource};
+use sdins_sim::fusion::records::{RecordEvent, RecordOptions, RecordPoint, COMPARISON_AXES};
+use sdins_sim::fusion::simulated::FuseError;
+use sdins_sim::io::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
+use sdins_sim::io::imu_file::ImuFormat;
 use std::path::PathBuf;
 
 fn triple(name: &str, s: &str) -> Result<[f64; 3], CliError> {
@@ -160,7 +160,7 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         scale_factors: args
             .scale_factors_ppm
             .as_deref()
-            .map(super::fuse::scale_factor_prior)
+            .map(super::fuse_args::scale_factor_prior)
             .transpose()?,
         ..RecordOptions::default()
     };
@@ -260,7 +260,7 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         f.commit()?;
     }
     let v3 = |v: &sdins_core::math::Vec3| [v.x, v.y, v.z];
-    let cmp = |c: &Option<sdins_sim::fuse_records::TruthComparison>| {
+    let cmp = |c: &Option<sdins_sim::fusion::records::TruthComparison>| {
         c.as_ref().map(|c| {
             let rmse = c.rmse();
             let inside = c.inside_3sigma();
@@ -311,7 +311,7 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
     fields.insert("cov_rate_hz".into(), args.cov_rate_hz.into());
     fields.insert("gate".into(), (!args.no_gate).into());
     fields.insert("smooth".into(), args.smooth.into());
-    let rm = |c: &Option<sdins_sim::fuse_records::TruthComparison>, name: &str| {
+    let rm = |c: &Option<sdins_sim::fusion::records::TruthComparison>, name: &str| {
         c.as_ref().map(|c| {
             let v = c.rmse();
             (

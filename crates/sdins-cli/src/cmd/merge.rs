@@ -1,11 +1,11 @@
 //! `sdins merge`: combine the shard states written by `sdins montecarlo --shard i/n` into
 //! the statistics of the whole job, bit-identical to a single unsharded run (the block
 //! results are kept per block and folded in block order, see
-//! `sdins_sim::montecarlo::plan`).
+//! `sdins_sim::analysis::montecarlo::plan`).
 
 use super::montecarlo::{mc_err, print_summary, summary_json, write_outputs};
 use crate::error::CliError;
-use sdins_sim::montecarlo::McState;
+use sdins_sim::analysis::montecarlo::McState;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `sdins merge`.
@@ -62,7 +62,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let msg = format!(
             "{} of {} blocks missing (first missing block {}; runs {}..): give every shard",
             missing.len(),
-            sdins_sim::montecarlo::plan::block_count(merged.job.runs, merged.job.block),
+            sdins_sim::analysis::montecarlo::plan::block_count(merged.job.runs, merged.job.block),
             missing[0],
             missing[0] * merged.job.block
         );

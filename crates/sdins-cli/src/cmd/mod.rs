@@ -7,6 +7,7 @@ pub mod calibrate;
 pub mod demo;
 pub mod errors;
 pub mod fuse;
+pub mod fuse_args;
 pub mod fuse_files;
 pub mod fuse_report;
 pub mod merge;

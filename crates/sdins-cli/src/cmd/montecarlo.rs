@@ -3,7 +3,7 @@
 //!
 //! Writes into `--out DIR`:
 //! * `mc_stats.csv` — `t_s` and, per channel (position/velocity/attitude error N, E, D),
-//!   mean, σ, p05, p50, p95 (see `sdins_sim::montecarlo::stats`);
+//!   mean, σ, p05, p50, p95 (see `sdins_sim::analysis::montecarlo::stats`);
 //! * `mc_state.json` — the raw accumulator state (every f64 as its IEEE bit pattern), the
 //!   input of `sdins merge`.
 //!
@@ -13,11 +13,12 @@
 use crate::error::CliError;
 use crate::output::write_string;
 use crate::progress::Progress;
-use sdins_sim::imu_error::ImuErrorModel;
-use sdins_sim::montecarlo::runner::shard_runs;
-use sdins_sim::montecarlo::{run_shard, McError, McState, McStats, Shard};
-use sdins_sim::run_setup;
+use sdins_sim::analysis::montecarlo;
+use sdins_sim::analysis::montecarlo::runner::shard_runs;
+use sdins_sim::analysis::montecarlo::{run_shard, McError, McState, McStats, Shard};
+use sdins_sim::nav::options;
 use sdins_sim::scenario::Scenario;
+use sdins_sim::sensors::imu_error::ImuErrorModel;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -51,7 +52,7 @@ pub struct Args {
     #[arg(long)]
     pub shard: Option<String>,
     /// output epoch spacing [s]
-    #[arg(long, default_value_t = run_setup::DEFAULT_MC_EVERY_S)]
+    #[arg(long, default_value_t = montecarlo::DEFAULT_MC_EVERY_S)]
     pub every_s: f64,
     /// stop after this time [s] (default: whole scenario)
     #[arg(long)]
@@ -60,7 +61,7 @@ pub struct Args {
     #[arg(long, default_value = "hold")]
     pub vertical: String,
     /// runs per block K (all shards must use the same K)
-    #[arg(long, default_value_t = sdins_sim::montecarlo::DEFAULT_BLOCK)]
+    #[arg(long, default_value_t = sdins_sim::analysis::montecarlo::DEFAULT_BLOCK)]
     pub block: u64,
     /// worker threads (default: all cores)
     #[arg(long)]
@@ -159,7 +160,7 @@ fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliE
         if job.vertical_hold { "held" } else { "free" }
     ));
     if let (Some(t), Some(row)) = (stats.times_s.last(), stats.cells.last()) {
-        let rows: Vec<Vec<String>> = sdins_sim::montecarlo::CHANNELS
+        let rows: Vec<Vec<String>> = sdins_sim::analysis::montecarlo::CHANNELS
             .iter()
             .zip(row.iter())
             .map(|(n, c)| {
@@ -203,7 +204,7 @@ pub fn summary_json(state: &McState, stats: &McStats, out: &Path) -> serde_json:
         "epochs": stats.times_s.len(),
         "final_t_s": stats.times_s.last(),
         "final": last.map(|row| {
-            sdins_sim::montecarlo::CHANNELS
+            sdins_sim::analysis::montecarlo::CHANNELS
                 .iter()
                 .zip(row.iter())
                 .map(|(c, s)| (c.to_string(), serde_json::json!(s)))
@@ -236,7 +237,10 @@ pub fn print_summary(state: &McState, stats: &McStats, out: &Path) {
             "{:>10} {:>12} {:>12} {:>12} {:>12} {:>12}",
             "channel", "mean", "sigma", "p05", "p50", "p95"
         );
-        for (c, s) in sdins_sim::montecarlo::CHANNELS.iter().zip(row.iter()) {
+        for (c, s) in sdins_sim::analysis::montecarlo::CHANNELS
+            .iter()
+            .zip(row.iter())
+        {
             println!(
                 "{c:>10} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e}",
                 s.mean, s.sigma, s.p05, s.p50, s.p95
@@ -249,9 +253,9 @@ pub fn print_summary(state: &McState, stats: &McStats, out: &Path) {
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let mut scn = Scenario::load(&args.scenario)?;
-    let bad = |e: run_setup::OptionError| CliError::BadInput(e.to_string());
+    let bad = |e: options::OptionError| CliError::BadInput(e.to_string());
     if let Some(g) = &args.grade {
-        run_setup::apply_grade(&mut scn, g).map_err(bad)?;
+        options::apply_grade(&mut scn, g).map_err(bad)?;
     }
     if scn.imu.model == ImuErrorModel::ideal() && !args.quiet {
         eprintln!(
@@ -259,9 +263,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             scn.name
         );
     }
-    let opts = run_setup::mc_options(
+    let opts = montecarlo::mc_options(
         &scn,
-        &run_setup::McChoice {
+        &montecarlo::McChoice {
             runs: args.runs,
             seed: args.seed,
             algo: Some(args.algo.clone()),

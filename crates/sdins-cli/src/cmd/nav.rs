@@ -3,10 +3,10 @@
 use crate::csv_out::{nav_row, CsvOut, ERR_HEADER, NAV_HEADER};
 use crate::error::CliError;
 use crate::output::AtomicFile;
-use sdins_sim::imu_file::{read_imu_file, ImuFormat};
-use sdins_sim::nav_recorded;
-use sdins_sim::run_setup::{self, algorithms, earth_by_name, AlgoChoice};
-use sdins_sim::truth_file::read_truth;
+use sdins_sim::io::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::io::truth_file::read_truth;
+use sdins_sim::nav::options::{self, algorithms, earth_by_name, AlgoChoice};
+use sdins_sim::nav::recorded;
 use std::path::PathBuf;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
@@ -52,7 +52,7 @@ pub struct Args {
 }
 
 /// Fail unless a reference time falls on an update epoch (see
-/// [`sdins_sim::nav_recorded::check_time_bases`]).
+/// [`sdins_sim::nav::recorded::check_time_bases`]).
 pub fn check_time_bases(
     truth: &[sdins_sim::truth::TruthSample],
     truth_path: &std::path::Path,
@@ -62,7 +62,7 @@ pub fn check_time_bases(
     samples: usize,
     n_samples: usize,
 ) -> Result<(), CliError> {
-    nav_recorded::check_time_bases(truth, truth_path, imu_path, t0, dt, samples, n_samples)
+    recorded::check_time_bases(truth, truth_path, imu_path, t0, dt, samples, n_samples)
         .map_err(|e| CliError::BadInput(e.to_string()))
 }
 
@@ -75,7 +75,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(p) => Some(read_truth(p).map_err(|e| CliError::BadInput(e.to_string()))?),
         None => None,
     };
-    let init = nav_recorded::initial_state(
+    let init = recorded::initial_state(
         args.init.as_deref(),
         match (&args.truth, &truth) {
             (Some(p), Some(t)) => Some((p.as_path(), t.as_slice())),
@@ -91,7 +91,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         coning: args.coning.clone(),
         ..AlgoChoice::default()
     };
-    let specs = algorithms(&choice, &run_setup::recorded_nav_defaults())
+    let specs = algorithms(&choice, &options::recorded_nav_defaults())
         .map_err(|e| CliError::BadInput(e.to_string()))?;
     let Some(spec) = specs.first().copied() else {
         return Err(CliError::bad("--algo: no algorithm given"));
@@ -140,7 +140,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         spec.coning.name(),
         args.earth
     );
-    let rec = nav_recorded::navigate(
+    let rec = recorded::navigate(
         &spec,
         earth,
         data.dt_s,

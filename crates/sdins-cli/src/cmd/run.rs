@@ -6,8 +6,8 @@ use crate::output::AtomicFile;
 use crate::plot::PlotScale;
 use crate::progress::Progress;
 use sdins_core::nav::{AlgorithmSpec, NavState};
-use sdins_sim::pipeline::{run_cancellable as run_pipeline, NavError, RunOptions, RunSummary};
-use sdins_sim::run_setup::{self, AlgoChoice};
+use sdins_sim::nav::options::{self, AlgoChoice};
+use sdins_sim::nav::pipeline::{run_cancellable as run_pipeline, NavError, RunOptions, RunSummary};
 use sdins_sim::scenario::Scenario;
 use std::path::PathBuf;
 
@@ -49,7 +49,7 @@ pub struct Args {
     #[arg(long)]
     pub until_s: Option<f64>,
     /// output epoch spacing in seconds for the CSV files (default 1 s)
-    #[arg(long, default_value_t = run_setup::DEFAULT_EVERY_S)]
+    #[arg(long, default_value_t = options::DEFAULT_EVERY_S)]
     pub every_s: f64,
     /// ignore the scenario's IMU error model (ideal sensors)
     #[arg(long)]
@@ -78,7 +78,7 @@ pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, Cli
         rotvec: args.rotvec.clone(),
         rot3: args.rot3,
     };
-    run_setup::algorithms(&choice, &scn.nav).map_err(|e| CliError::BadInput(e.to_string()))
+    options::algorithms(&choice, &scn.nav).map_err(|e| CliError::BadInput(e.to_string()))
 }
 
 /// Error-norm time series of one algorithm, at the output epochs:
@@ -199,9 +199,9 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
     if algos.is_empty() {
         return Err(CliError::bad("--algo: no algorithm given"));
     }
-    let bad = |e: run_setup::OptionError| CliError::BadInput(e.to_string());
+    let bad = |e: options::OptionError| CliError::BadInput(e.to_string());
     let hold =
-        run_setup::vertical_hold(args.vertical.as_deref(), scn.nav.vertical_hold).map_err(bad)?;
+        options::vertical_hold(args.vertical.as_deref(), scn.nav.vertical_hold).map_err(bad)?;
     if let Some(t) = args.until_s {
         if !(t.is_finite() && t > 0.0) {
             return Err(CliError::bad(format!(
@@ -214,7 +214,7 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
         .map_or(scn.duration_s(), |t| t.min(scn.duration_s()));
     let n = algos[0].samples;
     let dt_u = scn.imu.dt_s() * n as f64;
-    let every = run_setup::every_updates(args.every_s, dt_u).map_err(bad)?;
+    let every = options::every_updates(args.every_s, dt_u).map_err(bad)?;
     let out = args
         .out
         .clone()

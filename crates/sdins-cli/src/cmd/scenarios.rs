@@ -25,7 +25,7 @@ pub struct Args {
 }
 
 fn import(args: &Args) -> Result<(), CliError> {
-    use sdins_sim::gnss_ins_sim::{import_file, limits_from_mode, ImportOptions};
+    use sdins_sim::io::gnss_ins_sim::{import_file, limits_from_mode, ImportOptions};
     let Some(file) = &args.file else {
         return Err(CliError::bad(
             "scenarios import: give the motion-definition file: sdins scenarios import FILE",

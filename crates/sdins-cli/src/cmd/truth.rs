@@ -5,9 +5,9 @@ use crate::error::CliError;
 use crate::output::AtomicFile;
 use crate::progress::Progress;
 use sdins_core::math::{euler_from_c_b_n, Mat3, Quat, Vec3};
+use sdins_sim::io::truth_file::SDINS_TRUTH_HEADER as TRUTH_HEADER;
 use sdins_sim::scenario::Scenario;
 use sdins_sim::truth::TruthGenerator;
-use sdins_sim::truth_file::SDINS_TRUTH_HEADER as TRUTH_HEADER;
 use std::path::PathBuf;
 
 /// Arguments of `sdins truth`.
@@ -84,7 +84,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut truth = AtomicFile::create(&out.join("truth.csv"))?;
     let mut imu = AtomicFile::create(&out.join("imu.csv"))?;
     let mut truth_csv = CsvOut::new(&mut truth, &TRUTH_HEADER)?;
-    let mut imu_csv = CsvOut::new(&mut imu, &sdins_sim::imu_file::SDINS_INCREMENT_HEADER)?;
+    let mut imu_csv = CsvOut::new(&mut imu, &sdins_sim::io::imu_file::SDINS_INCREMENT_HEADER)?;
     let d = 180.0 / std::f64::consts::PI;
     let truth_row = |t_s: f64, lat: f64, lon: f64, h: f64, v: &Vec3, c: &Mat3| {
         let e = euler_from_c_b_n(c);
@@ -161,7 +161,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
 /// The scenario of `--from-reference` and the reference time of its first row.
 fn from_reference(file: &std::path::Path, args: &Args) -> Result<(Scenario, f64), CliError> {
-    use sdins_sim::reference_file::{scenario_from_reference, ReferenceOptions};
+    use sdins_sim::scenario::from_reference::{scenario_from_reference, ReferenceOptions};
     let opts = ReferenceOptions::from_names(args.rate_hz, args.columns.as_deref(), &args.earth)
         .map_err(|e| CliError::bad(e.to_string()))?;
     let (scn, sum) =

@@ -76,13 +76,13 @@ pub fn record(scn: &Scenario, n: usize, max_samples: Option<usize>) -> Recorded 
 pub fn full_run(
     rec: &Recorded,
     spec: &sdins_core::nav::AlgorithmSpec,
-) -> sdins_sim::pipeline::NavError {
+) -> sdins_sim::nav::pipeline::NavError {
     use sdins_core::nav::{AnyMechanization, Mechanization};
     let mut m = AnyMechanization::new(spec, rec.earth, rec.dt_s, &rec.init);
-    let mut max = sdins_sim::pipeline::NavError::default();
+    let mut max = sdins_sim::nav::pipeline::NavError::default();
     for (chunk, end) in rec.incs.chunks_exact(rec.n).zip(&rec.ends) {
         m.update(chunk);
-        let e = sdins_sim::pipeline::nav_error(&rec.earth, &m.state(), end);
+        let e = sdins_sim::nav::pipeline::nav_error(&rec.earth, &m.state(), end);
         max = max.max_abs(&e);
     }
     max

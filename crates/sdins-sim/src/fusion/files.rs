@@ -1,0 +1,265 @@
+//! `sdins fuse --imu FILE --gnss FILE` as one library function: read the IMU record, the
+//! GNSS fixes (mapped to the IMU clock and clipped to its span, the dropped ones
+//! counted), the filter's sensor model and the initial state, run
+//! [`crate::fusion::records::fuse_records`] and, with a reference trajectory, compare the
+//! forward and smoothed solutions with it.
+
+use crate::cancel::CancelToken;
+use crate::fusion::records::{
+    fuse_records, RecordEvent, RecordInit, RecordModel, RecordOptions, RecordSummary,
+    TruthComparison,
+};
+use crate::fusion::simulated::{FuseError, InitSigma};
+use crate::io::gnss_file::{
+    clip_to_imu_span, imu_span_s, read_gnss_file, to_imu_time, GnssFileError, GnssFormat,
+    GnssReadOptions, GnssReadReport, ImuClock,
+};
+use crate::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use crate::io::navego_params::{read_navego_imu_params, NavegoImuParams, ParamsError};
+use crate::io::truth_file::{read_truth, TruthFileError};
+use crate::sensors::imu_error::ImuErrorModel;
+use sdins_core::nav::InitialState;
+use std::path::{Path, PathBuf};
+
+/// Where the filter's sensor model comes from.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum SensorModelSource {
+    /// an sdins IMU error model (a grade preset or `[imu]` keys)
+    Model(Box<ImuErrorModel>),
+    /// a NaveGo `imuN_params.txt`
+    NavegoParams(PathBuf),
+}
+
+/// Where the initial state comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum InitSource {
+    /// a full state and its σ
+    Given(InitialState, InitSigma),
+    /// the first fix and an attitude (roll, pitch, yaw) with σ \[rad\]
+    FirstFix([f64; 3], [f64; 3]),
+    /// the first fix and NaveGo's `ini_align` with σ `ini_align_err` (needs
+    /// [`SensorModelSource::NavegoParams`])
+    FirstFixNavegoAttitude,
+    /// at rest for the given seconds: coarse alignment
+    StaticCoarse(f64),
+}
+
+impl SensorModelSource {
+    /// From the two user options (a grade preset name, a NaveGo parameter file): exactly
+    /// one must be given. The message names the option (`--grade`, `--navego-params`).
+    pub fn from_options(grade: Option<&str>, navego_params: Option<&Path>) -> Result<Self, String> {
+        match (grade, navego_params) {
+            (Some(_), Some(_)) => Err("give either --grade or --navego-params, not both".into()),
+            (None, Some(p)) => Ok(SensorModelSource::NavegoParams(p.to_path_buf())),
+            (Some(g), None) => crate::sensors::imu_error::presets::preset(g)
+                .map(|m| SensorModelSource::Model(Box::new(m)))
+                .map_err(|e| format!("--grade: {e}")),
+            (None, None) => Err(
+                "the filter needs the IMU's error model: give --grade NAME or --navego-params FILE"
+                    .into(),
+            ),
+        }
+    }
+}
+
+impl InitSource {
+    /// From the user options (at most one of `init` (the `--init` text), `attitude_deg`
+    /// with its optional σ (default 1, 1, 2°), `static_s`); none given: NaveGo's
+    /// `ini_align` when `navego` is true, else an error. Messages name the options.
+    pub fn from_options(
+        init: Option<&str>,
+        attitude_deg: Option<[f64; 3]>,
+        attitude_sigma_deg: Option<[f64; 3]>,
+        static_s: Option<f64>,
+        navego: bool,
+    ) -> Result<Self, String> {
+        match (init, attitude_deg, static_s) {
+            (Some(s), None, None) => crate::io::initial::parse_initial_state(s)
+                .map(|st| InitSource::Given(st, InitSigma::default()))
+                .map_err(|e| format!("--init: {e}")),
+            (None, Some(a), None) => {
+                let sig = attitude_sigma_deg.unwrap_or([1.0, 1.0, 2.0]);
+                if sig.iter().any(|x| !(x.is_finite() && *x > 0.0 && *x <= 10.0)) {
+                    return Err("--attitude-sigma-deg: each σ must be in (0, 10] deg (the linearised filter's limit)".into());
+                }
+                if a.iter().any(|x| !x.is_finite()) || a[1].abs() >= 90.0 {
+                    return Err("--attitude-deg: roll, pitch, yaw must be finite and |pitch| < 90°".into());
+                }
+                Ok(InitSource::FirstFix(
+                    a.map(f64::to_radians),
+                    sig.map(f64::to_radians),
+                ))
+            }
+            (None, None, Some(w)) => {
+                if !(w.is_finite() && w > 0.0 && w <= 3600.0) {
+                    return Err(format!("--static-s: must be in (0, 3600] s, got {w}"));
+                }
+                Ok(InitSource::StaticCoarse(w))
+            }
+            (None, None, None) if navego => Ok(InitSource::FirstFixNavegoAttitude),
+            (None, None, None) => Err("the initial state: give --init, --attitude-deg (position and velocity from the first fix) or --static-s (coarse alignment at rest)".into()),
+            _ => Err("give only one of --init, --attitude-deg, --static-s".into()),
+        }
+    }
+}
+
+/// The inputs of a fused run on files.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilesInput {
+    /// IMU file and format
+    pub imu: (PathBuf, ImuFormat),
+    /// GNSS file and format
+    pub gnss: (PathBuf, GnssFormat),
+    /// reader options of the GNSS file
+    pub gnss_options: GnssReadOptions,
+    /// clock relation of the two files
+    pub clock: ImuClock,
+    /// the filter's sensor model
+    pub sensor: SensorModelSource,
+    /// initial state
+    pub init: InitSource,
+    /// optional reference trajectory (sdins truth.csv, PSINS avp, NaveGo ref.csv)
+    pub truth: Option<PathBuf>,
+    /// compare with the reference after this many seconds from the navigation start
+    /// (the ±3σ fractions) \[s\]
+    pub check_after_s: f64,
+}
+
+/// Why a fused run on files failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FilesError {
+    /// the IMU file
+    #[error(transparent)]
+    Imu(#[from] ImuFileError),
+    /// the GNSS file
+    #[error(transparent)]
+    Gnss(#[from] GnssFileError),
+    /// the NaveGo parameters
+    #[error(transparent)]
+    Params(#[from] ParamsError),
+    /// the reference trajectory
+    #[error(transparent)]
+    Truth(#[from] TruthFileError),
+    /// the filter or an option
+    #[error(transparent)]
+    Fuse(#[from] FuseError),
+}
+
+/// What a fused run on files did.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct FilesResult {
+    /// the filter run
+    pub summary: RecordSummary,
+    /// IMU format read, samples, interval \[s\]
+    pub imu_format: ImuFormat,
+    /// IMU samples
+    pub imu_samples: usize,
+    /// IMU sample interval \[s\]
+    pub imu_dt_s: f64,
+    /// IMU reader warnings
+    pub imu_warnings: Vec<String>,
+    /// GNSS format read
+    pub gnss_format: GnssFormat,
+    /// GNSS reader report
+    pub gnss_report: GnssReadReport,
+    /// fixes inside the IMU record
+    pub fixes_in_span: usize,
+    /// fixes dropped before / after the IMU record
+    pub fixes_outside: (usize, usize),
+    /// comparison of the forward solution with the reference
+    pub forward: Option<TruthComparison>,
+    /// comparison of the smoothed solution with the reference
+    pub smoothed: Option<TruthComparison>,
+}
+
+/// Run it; `observe` sees every forward and smoothed point and every update, with the
+/// point's errors against the reference (roll, pitch, yaw \[rad\], v_N, v_E, v_D \[m/s\],
+/// N, E, D \[m\]) when one is given and matches the point's time.
+pub fn fuse_files(
+    input: &FilesInput,
+    opts: &RecordOptions,
+    cancel: &CancelToken,
+    mut observe: impl FnMut(RecordEvent<'_>, Option<&[f64; 9]>),
+) -> Result<FilesResult, FilesError> {
+    let imu = read_imu_file(&input.imu.0, input.imu.1)?;
+    let gnss = read_gnss_file(&input.gnss.0, input.gnss.1, &input.gnss_options)?;
+    let on_imu = to_imu_time(&input.gnss.0, &gnss, input.clock)?;
+    let (first, last) = imu_span_s(&imu);
+    let clip = clip_to_imu_span(&input.gnss.0, &on_imu, first, last)?;
+    let mut navego: Option<NavegoImuParams> = None;
+    let model = match &input.sensor {
+        SensorModelSource::Model(m) => RecordModel::from_error_model(m),
+        SensorModelSource::NavegoParams(p) => {
+            let prm = read_navego_imu_params(p)?;
+            let m = RecordModel::from_navego(&prm);
+            navego = Some(prm);
+            m
+        }
+    };
+    let init = match input.init {
+        InitSource::Given(state, sigma) => RecordInit::Given { state, sigma },
+        InitSource::FirstFix(rpy_rad, rpy_sigma_rad) => RecordInit::FirstFix {
+            rpy_rad,
+            rpy_sigma_rad,
+        },
+        InitSource::FirstFixNavegoAttitude => {
+            let Some(p) = &navego else {
+                return Err(FuseError::Option(
+                    "init",
+                    "NaveGo's ini_align needs NaveGo IMU parameters (--navego-params)".into(),
+                )
+                .into());
+            };
+            RecordInit::FirstFix {
+                rpy_rad: p.ini_align_rpy_rad,
+                rpy_sigma_rad: p.ini_align_err_rpy_rad,
+            }
+        }
+        InitSource::StaticCoarse(w) => RecordInit::StaticCoarse { window_s: w },
+    };
+    let truth = match &input.truth {
+        Some(p) => Some(read_truth(p)?),
+        None => None,
+    };
+    // the comparison starts counting ±3σ after the navigation start + check_after_s;
+    // the start is known only inside fuse_records: use the later of the first fix and
+    // the record start (the two possible starts)
+    let t0 = match init {
+        RecordInit::FirstFix { .. } => clip.fixes.first().map_or(first, |f| f.t_s.max(first)),
+        _ => first,
+    };
+    let t_check = t0 + input.check_after_s;
+    let mut fwd = truth
+        .clone()
+        .map(|t| TruthComparison::new(opts.earth, t, t_check));
+    let mut smo = if opts.smooth {
+        truth.map(|t| TruthComparison::new(opts.earth, t, t_check))
+    } else {
+        None
+    };
+    let summary = fuse_records(&imu, &clip.fixes, &model, &init, opts, cancel, |ev| {
+        let err = match ev {
+            RecordEvent::Forward(p) => fwd.as_mut().and_then(|c| c.add(p)),
+            RecordEvent::Smoothed(p) => smo.as_mut().and_then(|c| c.add(p)),
+            _ => None,
+        };
+        observe(ev, err.as_ref());
+    })?;
+    Ok(FilesResult {
+        summary,
+        imu_format: imu.format,
+        imu_samples: imu.increments.len(),
+        imu_dt_s: imu.dt_s,
+        imu_warnings: imu.warnings,
+        gnss_format: gnss.format,
+        gnss_report: gnss.report,
+        fixes_in_span: clip.fixes.len(),
+        fixes_outside: (clip.before, clip.after),
+        forward: fwd,
+        smoothed: smo,
+    })
+}

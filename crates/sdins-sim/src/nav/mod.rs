@@ -1,0 +1,7 @@
+//! Navigation runs: the streaming truth → navigation → errors pipeline over scenarios
+//! ([`pipeline`]), navigation over recorded increments ([`recorded`]) and the typed run
+//! options every front end shares ([`options`]).
+
+pub mod options;
+pub mod pipeline;
+pub mod recorded;

@@ -1,0 +1,9 @@
+//! Sensor models: the IMU error models and grades ([`imu_error`]), the GNSS receiver
+//! simulator ([`gnss`]) and the GNSS fix it produces ([`gnss_fix`], the datum the readers
+//! and the filter share).
+
+pub mod gnss;
+pub mod gnss_fix;
+pub mod imu_error;
+
+pub use gnss_fix::GnssFix;
