@@ -165,6 +165,7 @@ def run(
     until_s: Optional[float] = None,
     ideal: Optional[bool] = None,
     run: Optional[int] = None,
+    grade: Optional[str] = None,
 ) -> RunResult:
     """Run the scenario's exact truth through algorithms side by side (``sdins run``).
 
@@ -173,13 +174,16 @@ def run(
     ``rotvec`` (theta, phi), ``rot3``: as the CLI options; ``vertical``: free or hold
     (default: the scenario's); ``every_s``: output epoch spacing [s] (default 1);
     ``until_s``: stop time [s]; ``ideal``: ignore the scenario's IMU error model;
-    ``run``: sensor-error realisation (default 0). Returns a dict algo → AlgorithmRun
+    ``run``: sensor-error realisation (default 0); ``grade``: an IMU grade preset
+    replacing the scenario's error model (marine, aviation, intermediate, tactical,
+    consumer). Output rows are the updates nearest to 0, every_s, 2·every_s, … s (with
+    their own times) and the last update. Returns a dict algo → AlgorithmRun
     with the errors against the truth at the output epochs (the CLI's err_*.csv) and
     the final and maximum errors (its ``--json``).
     """
     d = _sdins.run(
         _scenario(scenario), algos, samples, coning, attitude, rotvec, rot3,
-        vertical, every_s, until_s, ideal, run,
+        vertical, every_s, until_s, ideal, run, grade,
     )
     return RunResult((k, AlgorithmRun(v)) for k, v in d.items())
 

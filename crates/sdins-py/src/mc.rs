@@ -71,7 +71,7 @@ impl McState {
         d.set_item("runs", j.runs)?;
         d.set_item("seed", j.seed)?;
         d.set_item("block", j.block)?;
-        d.set_item("every", j.every)?;
+        d.set_item("every_s", j.every_s)?;
         d.set_item("until_s", j.until_s)?;
         d.set_item("vertical_hold", j.vertical_hold)?;
         Ok(d)

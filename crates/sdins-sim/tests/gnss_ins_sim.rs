@@ -107,7 +107,7 @@ fn check_file(path: &Path) {
     let opts = RunOptions {
         algos: vec![AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 2)],
         vertical_hold: false,
-        every: 1,
+        every_s: None,
         until_s: None,
         sensor_run: None,
     };

@@ -51,7 +51,7 @@ fn round_trip(file: &std::path::Path, rate_hz: f64) -> RoundTrip {
     let ro = RunOptions {
         algos: vec![AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 3)],
         vertical_hold: false,
-        every: 1,
+        every_s: None,
         until_s: None,
         sensor_run: None,
     };

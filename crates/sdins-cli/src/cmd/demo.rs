@@ -39,6 +39,7 @@ pub fn run_args(scenario: &str, algo: &str, out: PathBuf, quiet: bool) -> RunArg
         until_s: None,
         every_s: 1.0,
         ideal: false,
+        grade: None,
         run: 0,
         plot_scale: crate::plot::PlotScale::Log,
         json: false,
