@@ -6,6 +6,7 @@
 // doc comments of the clap arguments are the --help text: units in [brackets] stay plain
 #![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 
+mod args;
 mod cmd;
 mod csv_out;
 #[allow(dead_code)]
@@ -73,6 +74,7 @@ fn restore_sigpipe() {
 
 fn main() -> ExitCode {
     restore_sigpipe();
+    args::warn_deprecated(&std::env::args_os().collect::<Vec<_>>());
     let cli = Cli::parse();
     progress::install_signal_handlers();
     let result = match cli.command {

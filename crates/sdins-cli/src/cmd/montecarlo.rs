@@ -10,15 +10,13 @@
 //! With `--shard i/n` only the blocks of shard i are computed (see `docs/montecarlo.md`);
 //! `mc_stats.csv` then covers that shard's runs only.
 
+use crate::args::GradeArg;
 use crate::error::CliError;
 use crate::output::write_string;
 use crate::progress::Progress;
 use sdins_sim::analysis::montecarlo;
-use sdins_sim::analysis::montecarlo::runner::shard_runs;
-use sdins_sim::analysis::montecarlo::{run_shard, McError, McState, McStats, Shard};
-use sdins_sim::nav::options;
+use sdins_sim::analysis::montecarlo::{McError, McRequest, McState, McStats, Shard};
 use sdins_sim::scenario::Scenario;
-use sdins_sim::sensors::imu_error::ImuErrorModel;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -45,9 +43,9 @@ pub struct Args {
     /// IMU samples per navigation update (default: the scenario's)
     #[arg(long)]
     pub samples: Option<usize>,
-    /// IMU grade preset replacing the scenario's error model (marine, aviation, intermediate, tactical, consumer)
-    #[arg(long)]
-    pub grade: Option<String>,
+    /// IMU grade preset replacing the scenario's error model
+    #[command(flatten)]
+    pub grade: GradeArg,
     /// compute shard i of n (0-based, e.g. 2/8); shards are whole blocks of runs
     #[arg(long)]
     pub shard: Option<String>,
@@ -250,22 +248,14 @@ pub fn print_summary(state: &McState, stats: &McStats, out: &Path) {
     println!("files in {}", out.display());
 }
 
-/// Run the command.
-pub fn run(args: Args) -> Result<(), CliError> {
-    let mut scn = Scenario::load(&args.scenario)?;
-    let bad = |e: options::OptionError| CliError::BadInput(e.to_string());
-    if let Some(g) = &args.grade {
-        options::apply_grade(&mut scn, g).map_err(bad)?;
-    }
-    if scn.imu.model == ImuErrorModel::ideal() && !args.quiet {
-        eprintln!(
-            "sdins: warning: scenario {} has ideal sensors (no [imu] grade/errors and no --grade): every run is the same",
-            scn.name
-        );
-    }
-    let opts = montecarlo::mc_options(
-        &scn,
-        &montecarlo::McChoice {
+/// The job as the library takes it.
+fn request(args: &Args) -> Result<McRequest, CliError> {
+    let shard = match &args.shard {
+        None => None,
+        Some(s) => Some(Shard::parse(s).map_err(|e| CliError::bad(format!("--shard: {e}")))?),
+    };
+    Ok(McRequest {
+        choice: montecarlo::McChoice {
             runs: args.runs,
             seed: args.seed,
             algo: Some(args.algo.clone()),
@@ -275,28 +265,30 @@ pub fn run(args: Args) -> Result<(), CliError> {
             vertical: Some(args.vertical.clone()),
             block: Some(args.block),
         },
-    )
-    .map_err(bad)?;
-    let shard = match &args.shard {
-        None => Shard::ALL,
-        Some(s) => Shard::parse(s).map_err(|e| CliError::bad(format!("--shard: {e}")))?,
-    };
+        grade: args.grade.grade.clone(),
+        shard,
+        threads: args.threads,
+    })
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let scn = Scenario::load(&args.scenario)?;
+    let plan =
+        montecarlo::plan(scn, &request(&args)?).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let name = &plan.scenario.name;
+    if plan.ideal_sensors() && !args.quiet {
+        eprintln!(
+            "sdins: warning: scenario {name} has ideal sensors (no [imu] grade/errors and no --grade): every run is the same"
+        );
+    }
     let out = args.out.clone().unwrap_or_else(|| match args.shard {
-        None => crate::output::default_dir("mc-", &scn.name),
-        Some(_) => crate::output::default_dir("mc-", &format!("{}-shard{}", scn.name, shard.index)),
+        None => crate::output::default_dir("mc-", name),
+        Some(_) => crate::output::default_dir("mc-", &format!("{name}-shard{}", plan.shard.index)),
     });
-    crate::output::check_size(
-        "mc_stats.csv",
-        opts.until_s
-            .map_or(scn.duration_s(), |t| t.min(scn.duration_s()))
-            / opts.every_s
-            + 1.0,
-        400.0,
-        "raise --every-s",
-    )?;
+    crate::output::check_size("mc_stats.csv", plan.epochs as f64, 400.0, "raise --every-s")?;
     crate::output::claim(&out)?;
-    let total = shard_runs(&opts, shard);
-    let bar = Mutex::new((Progress::new(total, "runs", args.quiet), 0_u64));
+    let bar = Mutex::new((Progress::new(plan.runs, "runs", args.quiet), 0_u64));
     let on_run = || {
         if let Ok(mut g) = bar.lock() {
             g.1 += 1;
@@ -304,21 +296,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             g.0.set(done);
         }
     };
-    let cancelled = crate::progress::interrupted;
-    let compute = || run_shard(&scn, &opts, shard, &on_run, &cancelled);
-    if let Some(t) = args.threads {
-        if !(1..=1024).contains(&t) {
-            return Err(CliError::bad(format!("--threads {t}: expected 1 … 1024")));
-        }
-    }
-    let result = match args.threads {
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .map_err(|e| CliError::Other(e.to_string()))?
-            .install(compute),
-        None => compute(),
-    };
+    let result = plan.run(&on_run, &crate::progress::interrupted);
     if let Ok(g) = bar.lock() {
         g.0.finish();
     }

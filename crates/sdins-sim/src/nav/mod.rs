@@ -7,3 +7,4 @@ pub mod options;
 pub mod pipeline;
 pub mod recorded;
 pub mod run;
+pub mod truth_rows;

@@ -33,7 +33,7 @@ pub mod state;
 pub mod stats;
 pub mod truth_cache;
 
-pub use options::{mc_options, McChoice, DEFAULT_MC_EVERY_S};
+pub use options::{mc_options, plan, McChoice, McPlan, McRequest, DEFAULT_MC_EVERY_S};
 pub use plan::{Shard, DEFAULT_BLOCK};
 pub use runner::{run_shard, McOptions};
 pub use state::{BlockResult, McJob, McState};
