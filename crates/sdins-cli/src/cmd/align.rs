@@ -299,16 +299,16 @@ fn write_outputs(
 ) -> Result<(), CliError> {
     let (e, phi) = (res.euler, res.phi_true);
     crate::output::claim(dir)?;
-    write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi)?)?;
+    write_string(&dir.join("align_result.csv"), &result_csv(res, &e, phi)?)?;
     let mut svgs = None;
     if res.has_history {
-        write_string(&dir.join("align_history.csv"), &hist)?;
+        write_string(&dir.join("align_history.csv"), hist)?;
         if rows.len() >= 2 {
             let tb = inp.true_bias.map(|(ba, bg)| {
                 let a = |v: Vec3, u: f64| [v.x / u, v.y / u, v.z / u];
                 (a(ba, UG), a(bg, DPH))
             });
-            svgs = Some(write_plots(dir, &rows, tb)?);
+            svgs = Some(write_plots(dir, rows, tb)?);
         } else {
             eprintln!(
                 "note: {} Kalman cycle(s): too short for the alignment plots",
@@ -316,8 +316,8 @@ fn write_outputs(
             );
         }
     }
-    write_report(dir, &args, &inp, &res, &e, phi, svgs.as_ref())?;
-    write_align_toml(dir, &args, &inp, &res.config)?;
+    write_report(dir, args, inp, res, &e, phi, svgs.as_ref())?;
+    write_align_toml(dir, args, inp, &res.config)?;
     Ok(())
 }
 

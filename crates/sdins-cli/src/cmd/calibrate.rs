@@ -10,6 +10,7 @@
 //! `--runs`, the first run), `calibration_runs.csv` (per run: NEES and max errors),
 //! `calibration.json` (the same as `--json`), `report.html` and `run.toml`.
 
+use crate::args::ImuFormatArg;
 use crate::error::CliError;
 use crate::output::write_string;
 use sdins_sim::align::calibration::run::calibrate_recorded;
@@ -19,7 +20,7 @@ use sdins_sim::align::calibration::run::{
 };
 use sdins_sim::align::calibration::table::{rows, triad_rows, ParamRow};
 use sdins_sim::align::calibration::DrawSpec;
-use sdins_sim::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFileError};
 use sdins_sim::scenario::Scenario;
 use sdins_sim::sensors::imu_error::{DPH, UG};
 use std::fmt::Write as _;
@@ -31,7 +32,7 @@ use std::path::PathBuf;
     sdins calibrate calibration --runs 20 --out cal-mc\n  \
     sdins scenarios calibration > my-cal.toml\n  sdins calibrate my-cal.toml --no-draw --json\n  \
     sdins truth calibration --out cal-imu --every 100 --quiet\n  \
-    sdins calibrate calibration --imu cal-imu/imu.csv --format sdins")]
+    sdins calibrate calibration --imu cal-imu/imu.csv --imu-format sdins")]
 pub struct Args {
     /// scenario (built-in name or file), normally with a [calibration] schedule
     pub scenario: String,
@@ -39,9 +40,8 @@ pub struct Args {
     /// sample per truth sample of the scenario, at its rate
     #[arg(long)]
     pub imu: Option<PathBuf>,
-    /// IMU file format: auto, sdins, psins, psins-csv, kfgins, navego
-    #[arg(long, default_value = "auto", value_parser = parse_format)]
-    pub format: ImuFormat,
+    #[command(flatten)]
+    pub imu_format: ImuFormatArg,
     /// error-model run index of a single run
     #[arg(long, default_value_t = 0)]
     pub run: u64,
@@ -64,10 +64,6 @@ pub struct Args {
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
-}
-
-fn parse_format(s: &str) -> Result<ImuFormat, String> {
-    s.parse()
 }
 
 fn file_error(e: ImuFileError) -> CliError {
@@ -252,7 +248,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 "--runs: a recorded IMU file is one calibration (Monte Carlo needs a simulated IMU)",
             ));
         }
-        let data = read_imu_file(path, args.format).map_err(file_error)?;
+        let data = read_imu_file(path, args.imu_format.imu_format).map_err(file_error)?;
         for w in &data.warnings {
             eprintln!("warning: {w}");
         }
@@ -356,7 +352,7 @@ fn finish(args: &Args, scn: &Scenario, o: &Outcome<'_>, note: &str) -> Result<()
         if let Some(p) = &args.imu {
             let abs = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
             t.insert("imu_file".into(), abs.display().to_string().into());
-            t.insert("imu_format".into(), args.format.name().into());
+            t.insert("imu_format".into(), args.imu_format.imu_format.name().into());
         } else {
             t.insert("run".into(), args.run.to_string().into());
             t.insert("runs".into(), args.runs.to_string().into());
