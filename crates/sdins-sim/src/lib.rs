@@ -68,6 +68,7 @@ pub mod nav_recorded;
 pub mod navego_params;
 pub mod pipeline;
 pub mod random_vibration;
+pub mod raw_gnss;
 pub mod reference;
 pub mod reference_file;
 pub mod route;
