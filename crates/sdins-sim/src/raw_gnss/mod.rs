@@ -27,4 +27,6 @@ pub use error::{RinexError, SppRunError};
 pub use rinex_nav::{parse_nav, read_nav, NavFile};
 pub use rinex_obs::{parse_obs, read_obs, ObsCode, ObsEpoch, ObsFile, ObsHeader, ObsValue, SatObs};
 pub use rinex_write::{fmt_d, nav_to_rinex3, obs_to_rinex3};
-pub use spp::{run_spp, SppEpoch, SppFailure, SppMode, SppRun, SppRunOptions, SppSummary};
+pub use spp::{
+    run_spp, SppEpoch, SppFailure, SppMode, SppRun, SppRunOptions, SppSummary, SISRE_GPS_M,
+};

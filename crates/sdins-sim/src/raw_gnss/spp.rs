@@ -14,6 +14,13 @@ use sdins_core::gnss::{
 };
 use sdins_core::math::Vec3;
 
+/// Default signal-in-space range error σ of GPS broadcast orbits and clocks \[m\]: about
+/// 0.7 m RMS in 2013–2015 (Montenbruck, Steigenberger & Hauschild 2015, "Broadcast
+/// versus precise ephemerides: a multi-GNSS perspective", GPS Solutions 19:321–333). The
+/// broadcast URA (2.0 m for index 0) is an upper bound: with it the predicted 95 %
+/// ellipse held every ABPO ionosphere-free epoch (docs/theory/gnss.md).
+pub const SISRE_GPS_M: f64 = 0.7;
+
 /// Pseudorange processing mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SppMode {
@@ -49,11 +56,15 @@ pub struct SppRunOptions {
     pub drift_prior_mps: Option<(f64, f64)>,
     /// ephemeris validity around toe \[s\]
     pub validity_s: f64,
+    /// signal-in-space σ \[m\]: `None` takes each ephemeris's broadcast URA (an upper
+    /// bound, conservative), `Some(σ)` a fixed figure
+    pub sigma_sis_m: Option<f64>,
 }
 
 impl Default for SppRunOptions {
-    /// Ionosphere-free, 10° mask, every epoch, Saastamoinen on, default UERE model,
-    /// Doppler on with σ = 0.05 m/s at the zenith, no drift prior, 2 h validity.
+    /// Ionosphere-free, 10° mask, every epoch, Saastamoinen on, default UERE model with
+    /// σ_sis = [`SISRE_GPS_M`], Doppler on with σ = 0.05 m/s at the zenith, no drift
+    /// prior, 2 h validity.
     fn default() -> Self {
         SppRunOptions {
             mode: SppMode::IonoFree,
@@ -67,6 +78,7 @@ impl Default for SppRunOptions {
             doppler_sigma_zenith_mps: 0.05,
             drift_prior_mps: None,
             validity_s: DEFAULT_VALIDITY_S,
+            sigma_sis_m: Some(SISRE_GPS_M),
         }
     }
 }
@@ -217,7 +229,7 @@ fn satellites(
             r_sat_e_m: st.r_sat_e_m,
             clock_bias_s: clock,
             pseudorange_m: p,
-            sigma_sis_m: eph.sv_accuracy_m,
+            sigma_sis_m: o.sigma_sis_m.unwrap_or(eph.sv_accuracy_m),
         });
         if let Some(d) = c.d1.and_then(val) {
             dop.push(DopplerSatellite {
