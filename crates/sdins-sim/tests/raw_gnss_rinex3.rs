@@ -63,7 +63,7 @@ fn synthetic_obs() -> ObsFile {
                     prn,
                     values: (0..codes.len())
                         .map(|j| {
-                            ((j + prn as usize + k) % 5 != 0).then(|| ObsValue {
+                            ((j + prn as usize + k) % 5 >= 1).then(|| ObsValue {
                                 // values a RINEX F14.3 field holds exactly
                                 value: ((-1.0e6 + 1234.567 * (prn as f64) + 17.125 * j as f64
                                     - 0.001 * k as f64)
