@@ -46,7 +46,9 @@ impl GpsTime {
         }
         let w = libm::floor(self.sow_s / SECONDS_PER_WEEK);
         if w != 0.0 {
-            self.week += w as i32;
+            // saturating: absurd inputs (a corrupted file) give an absurd but valid time,
+            // never an overflow
+            self.week = self.week.saturating_add(w as i32);
             self.sow_s -= w * SECONDS_PER_WEEK;
         }
     }
@@ -97,7 +99,8 @@ impl GpsTime {
 
     /// `self − other` in seconds, across weeks.
     pub fn diff_s(&self, other: &GpsTime) -> f64 {
-        (self.week - other.week) as f64 * SECONDS_PER_WEEK + (self.sow_s - other.sow_s)
+        (self.week as i64 - other.week as i64) as f64 * SECONDS_PER_WEEK
+            + (self.sow_s - other.sow_s)
     }
 
     /// `self + dt_s`, normalised.
@@ -151,5 +154,9 @@ mod tests {
         assert_eq!(crossover_s(302_400.0), 302_400.0);
         let n = GpsTime::new(5, -1.0);
         assert_eq!((n.week, n.sow_s), (4, 604_799.0));
+        // absurd values saturate instead of overflowing
+        let big = GpsTime::new(i32::MAX, 1e95);
+        assert_eq!(big.week, i32::MAX);
+        assert!(big.diff_s(&GpsTime::new(i32::MIN, 0.0)).is_finite());
     }
 }

@@ -264,6 +264,13 @@ fn build(
     if !(0.0..=10_000.0).contains(&week) || week.fract() != 0.0 {
         return Err(ctx.field_err(ln, "GPS Week", format!("{week} (record starting here)")));
     }
+    if !(0.0..604_800.0).contains(&d[11]) {
+        return Err(ctx.field_err(
+            ln,
+            "Toe",
+            format!("{} is not a second of week (record starting here)", d[11]),
+        ));
+    }
     // toe's week: the record's week, moved by a whole week to within half a week of toc
     let mut toe = GpsTime::new(week as i32, d[11]);
     let dt = toe.diff_s(&toc);
@@ -346,6 +353,21 @@ mod tests {
             (49, 0, 2.0, 4.0)
         );
         assert_eq!(n.klobuchar.unwrap().beta[3], 0.1049e7);
+    }
+
+    /// Every single-character corruption and every truncation of a valid file parses or
+    /// fails with a typed error: never a panic.
+    #[test]
+    fn corrupted_files_never_panic() {
+        let b = V2.as_bytes();
+        for i in 0..b.len() {
+            for c in [b'x', b' ', b'9', b'-', b'\n', b'G', 0xd4] {
+                let mut m = b.to_vec();
+                m[i] = c;
+                let _ = parse_nav(&m, "m.n");
+            }
+            let _ = parse_nav(&b[..i], "m.n");
+        }
     }
 
     #[test]

@@ -174,8 +174,6 @@ fn time_field(
 
 struct HeaderOut {
     header: ObsHeader,
-    /// per-system observation types for RINEX 3 (system letter, count)
-    sys_counts: Vec<(u8, usize)>,
     /// RINEX 2 type count
     n_types2: usize,
     body_start: usize,
@@ -192,7 +190,6 @@ fn parse_header(ctx: &Ctx, lines: &[&str]) -> Result<HeaderOut, RinexError> {
         interval_s: None,
         first_obs: None,
     };
-    let mut sys_counts: Vec<(u8, usize)> = Vec::new();
     let mut n_types2 = 0usize;
     let mut types2: Vec<ObsCode> = Vec::new();
     let mut pending3: Option<(u8, usize)> = None;
@@ -243,7 +240,11 @@ fn parse_header(ctx: &Ctx, lines: &[&str]) -> Result<HeaderOut, RinexError> {
                 if col(line, 0, 6).trim().is_empty() {
                     // continuation line
                 } else {
-                    n_types2 = ctx.int(ln, line, 0, 6, "# / TYPES OF OBSERV")? as usize;
+                    let n = ctx.int(ln, line, 0, 6, "# / TYPES OF OBSERV")?;
+                    if !(0..=999).contains(&n) {
+                        return Err(ctx.field_err(ln, "# / TYPES OF OBSERV", format!("{n}")));
+                    }
+                    n_types2 = n as usize;
                 }
                 for k in 0..9 {
                     let t = col(line, 10 + 6 * k, 12 + 6 * k).trim();
@@ -266,9 +267,11 @@ fn parse_header(ctx: &Ctx, lines: &[&str]) -> Result<HeaderOut, RinexError> {
                         }
                     }
                 } else {
-                    let n = ctx.int(ln, line, 3, 6, "SYS / # / OBS TYPES count")? as usize;
-                    sys_counts.push((sys, n));
-                    (sys, n)
+                    let n = ctx.int(ln, line, 3, 6, "SYS / # / OBS TYPES count")?;
+                    if !(0..=999).contains(&n) {
+                        return Err(ctx.field_err(ln, "SYS / # / OBS TYPES count", format!("{n}")));
+                    }
+                    (sys, n as usize)
                 };
                 pending3 = Some((sys, n));
                 if sys == b'G' {
@@ -305,7 +308,6 @@ fn parse_header(ctx: &Ctx, lines: &[&str]) -> Result<HeaderOut, RinexError> {
                 }
                 return Ok(HeaderOut {
                     header: h,
-                    sys_counts,
                     n_types2,
                     body_start: i + 1,
                 });
@@ -527,7 +529,6 @@ fn parse_body3(ctx: &Ctx, lines: &[&str], hd: &HeaderOut) -> Result<Vec<ObsEpoch
             sats,
         });
     }
-    let _ = &hd.sys_counts;
     Ok(out)
 }
 
@@ -568,6 +569,21 @@ TEST                                                        MARKER NAME
         assert_eq!((c1.value, c1.lli, c1.ssi), (25_127_564.975, None, Some(7)));
         assert_eq!(e.sats[1].values[1], None);
         assert_eq!(e.sats[1].values[2].unwrap().value, 300.25);
+    }
+
+    /// Every single-character corruption and every truncation of a valid file parses or
+    /// fails with a typed error: never a panic.
+    #[test]
+    fn corrupted_files_never_panic() {
+        let b = V2.as_bytes();
+        for i in 0..b.len() {
+            for c in [b'x', b' ', b'9', b'-', b'\n', 0xd4] {
+                let mut m = b.to_vec();
+                m[i] = c;
+                let _ = parse_obs(&m, "m.o");
+            }
+            let _ = parse_obs(&b[..i], "m.o");
+        }
     }
 
     #[test]
