@@ -59,6 +59,8 @@ enum Command {
     Fuse(Box<cmd::fuse::Args>),
     /// Merge Monte Carlo shard states exactly into the statistics of the whole job.
     Merge(cmd::merge::Args),
+    /// GNSS single-point positioning and Doppler velocity from RINEX observation and navigation files.
+    Spp(cmd::spp::Args),
 }
 
 /// Die quietly on a closed stdout (`sdins run --json | head -c1`), like other Unix tools:
@@ -90,6 +92,7 @@ fn main() -> ExitCode {
         Command::Montecarlo(a) => cmd::montecarlo::run(a),
         Command::Merge(a) => cmd::merge::run(a),
         Command::Fuse(a) => cmd::fuse::run(*a),
+        Command::Spp(a) => cmd::spp::run(a),
     };
     // a run's outputs all or none: swap the staged files in only if the command succeeded
     let result = output::finish(result);

@@ -352,7 +352,10 @@ fn finish(args: &Args, scn: &Scenario, o: &Outcome<'_>, note: &str) -> Result<()
         if let Some(p) = &args.imu {
             let abs = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
             t.insert("imu_file".into(), abs.display().to_string().into());
-            t.insert("imu_format".into(), args.imu_format.imu_format.name().into());
+            t.insert(
+                "imu_format".into(),
+                args.imu_format.imu_format.name().into(),
+            );
         } else {
             t.insert("run".into(), args.run.to_string().into());
             t.insert("runs".into(), args.runs.to_string().into());
