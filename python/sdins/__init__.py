@@ -33,6 +33,11 @@ from ._sdins import McState, Scenario, SdinsError
 
 __version__: str = _sdins.__version__
 
+
+def __dir__() -> List[str]:
+    """The public names only (PEP 562): ``dir(sdins)`` lists what ``__all__`` exports."""
+    return sorted(__all__ + ["__version__"])
+
 __all__ = [
     "fuse_files",
     "SdinsError",
@@ -188,11 +193,25 @@ def run(
     return RunResult((k, AlgorithmRun(v)) for k, v in d.items())
 
 
-def read_imu(path: Any, format: Optional[str] = "auto") -> ImuRecord:
+def _imu_format(imu_format: Optional[str], format: Optional[str]) -> Optional[str]:
+    """``imu_format``, the one name of the option (``--imu-format``); ``format`` is its
+    deprecated alias."""
+    if format is not None:
+        import warnings
+
+        warnings.warn("format= is deprecated; use imu_format=", DeprecationWarning, stacklevel=3)
+        if imu_format is not None and imu_format != format:
+            raise SdinsError(f"imu_format={imu_format!r} and format={format!r} disagree: give imu_format only")
+        return format
+    return imu_format
+
+
+def read_imu(path: Any, imu_format: Optional[str] = "auto", format: Optional[str] = None) -> ImuRecord:
     """Read an IMU file: sdins CSV, PSINS ``.imu`` (psins) or trj CSV (psins-csv),
-    KF-GINS text (kfgins), NaveGo CSV (navego); ``format="auto"`` detects it
-    (docs/imu-files.md). Increments are converted to body FRD."""
-    return ImuRecord(_sdins.read_imu(str(path), format))
+    KF-GINS text (kfgins), NaveGo CSV (navego); ``imu_format="auto"`` detects it
+    (docs/imu-files.md; ``format=`` is a deprecated alias). Increments are converted to
+    body FRD."""
+    return ImuRecord(_sdins.read_imu(str(path), _imu_format(imu_format, format)))
 
 
 def allan(dtheta: Any, dv: Any, dt: float) -> AllanResult:
@@ -243,7 +262,7 @@ def merge(states: Iterable[McState], allow_partial: Optional[bool] = None) -> Mc
 def align(
     scenario: Optional[Union[Scenario, str]] = None,
     imu: Optional[Any] = None,
-    format: Optional[str] = None,
+    imu_format: Optional[str] = None,
     method: Optional[str] = None,
     alg: Optional[str] = None,
     start: Optional[str] = None,
@@ -255,10 +274,11 @@ def align(
     sigma_z_mps: Optional[float] = None,
     vrw_ug_per_sqrt_hz: Optional[float] = None,
     arw_deg_per_sqrt_h: Optional[float] = None,
+    format: Optional[str] = None,
 ) -> AlignResult:
     """Initial alignment (``sdins align``) of a scenario (with run ``run`` of its IMU
-    error model, default 0) or an IMU file ``imu`` (``format``: auto (default), sdins,
-    psins, psins-csv, kfgins, navego).
+    error model, default 0) or an IMU file ``imu`` (``imu_format``: auto (default), sdins,
+    psins, psins-csv, kfgins, navego; ``format=`` is a deprecated alias).
 
     ``method``: coarse1, coarse2, i0, fine (default) or multiheading; ``alg``: a
     (default) or b (multi-heading); ``start``: i0 (default) or coarse2 (fine filter
@@ -276,7 +296,7 @@ def align(
     scn = None if scenario is None else _scenario(scenario)
     return AlignResult(
         _sdins.align(
-            scn, None if imu is None else str(imu), format, method, alg, start, lat_deg,
+            scn, None if imu is None else str(imu), _imu_format(imu_format, format), method, alg, start, lat_deg,
             h_m, window_s, duration_s, run, sigma_z_mps, vrw_ug_per_sqrt_hz,
             arw_deg_per_sqrt_h,
         )

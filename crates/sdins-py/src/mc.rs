@@ -47,9 +47,13 @@ impl McState {
         serde_json::to_string(&self.state).map_err(err)
     }
 
-    /// Statistics of the blocks present (dict of arrays; see `sdins.merge`).
-    fn statistics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        stats_dict(py, &self.state)
+    /// Statistics of the blocks present: an `sdins.McStatistics`, the type `sdins.merge`
+    /// returns.
+    fn statistics<'py>(slf: &Bound<'py, Self>, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let d = stats_dict(py, &slf.borrow().state)?;
+        py.import("sdins._results")?
+            .getattr("McStatistics")?
+            .call1((d, slf.clone()))
     }
 
     /// Block indices not yet computed.

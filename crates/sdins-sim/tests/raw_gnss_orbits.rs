@@ -30,6 +30,7 @@ fn shared_data(rel: &str) -> Option<PathBuf> {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn every_abpo_ephemeris_matches_rtklib_eph2pos() {
     let Some(nav_path) = shared_data("psins_gnss/abpo0080.15n") else {
         return;

@@ -140,6 +140,7 @@ fn observation_and_navigation_files_survive_a_rinex3_round_trip() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn abpo_survives_a_rinex3_round_trip_exactly() {
     let (Some(o), Some(n)) = (
         shared_data("psins_gnss/abpo0080.15o"),
@@ -161,6 +162,7 @@ fn abpo_survives_a_rinex3_round_trip_exactly() {
 /// RINEX 3.03 written by RTKLIB's convbin from the RINEX 2.11 ABPO file reads back as the
 /// same observations as the original through our 2.11 reader.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn rtklib_convbin_rinex3_reads_like_the_rinex2_original() {
     let Some(o) = shared_data("psins_gnss/abpo0080.15o") else {
         return;
@@ -239,6 +241,7 @@ fn rnx2rtkp_xyz(dir: &Path, obs: &Path, nav: &Path, conf: &str, out: &str) -> Ve
 /// solutions of the first two hours of ABPO from our files equal (to 0.1 mm) its
 /// solutions from the original RINEX 2 files.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn rtklib_reads_our_rinex3_files() {
     let (Some(o), Some(n)) = (
         shared_data("psins_gnss/abpo0080.15o"),

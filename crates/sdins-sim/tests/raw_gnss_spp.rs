@@ -72,6 +72,7 @@ fn abpo_run(
 /// reaches 2.0/3.4/4.2 m (C1/P2) and 1.7/3.0/3.4 m (P1/P2) ionosphere-free and 3.4/5.2 m
 /// on L1 with the same default Klobuchar set (docs/theory/gnss.md).
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn abpo_spp_every_tenth_epoch_against_the_station_position() {
     let Some((obs, nav)) = abpo() else { return };
     assert_eq!(obs.epochs.len(), 2727);
@@ -109,6 +110,7 @@ fn abpo_spp_every_epoch() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn trimble_files_read_despite_their_header_bytes() {
     let (Some(o), Some(n)) = (
         shared_data("psins_gnss/01.15o"),
@@ -156,6 +158,7 @@ const MAX_PDOP: f64 = 6.0;
 /// 06:22:30–06:32:00 GPST: the vehicle starts moving at about 06:05:10 and stops at about
 /// 06:22:10) and, in motion, against the velocity from time-differenced L1 carrier phase.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn trimble_doppler_velocity_static_and_against_carrier_phase() {
     let (Some(o), Some(n)) = (
         shared_data("psins_gnss/01.15o"),

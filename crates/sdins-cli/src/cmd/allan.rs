@@ -427,6 +427,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
     fn lasergyro_runs_and_reports_fits() {
         // real navigation-grade RLG IMU, parked (shared data; skipped if absent)
         let p = Path::new(concat!(
