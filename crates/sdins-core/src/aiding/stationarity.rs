@@ -1,0 +1,617 @@
+//! Stationarity (zero-velocity) detection from the IMU alone: a sliding-window
+//! generalised-likelihood-ratio test in the form of the SHOE detector, with the gyro term
+//! referred to the expected rate at rest and a threshold derived from the noise model
+//! (docs/theory/aiding-sensors.md §"Stationarity detection").
+//!
+//! Sources: I. Skog, P. Händel, J.-O. Nilsson and J. Rantakokko, "Zero-velocity detection —
+//! an algorithm evaluation", IEEE Trans. Biomed. Eng. 57(11):2657–2666, 2010, §III (the
+//! stance-hypothesis optimal detector, "SHOE", derived as the GLRT for a window of samples
+//! with known noise variances, unknown gravity direction and known gravity magnitude);
+//! P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
+//! Systems*, 2nd ed., §15.3 (zero velocity and zero angular-rate updates and the
+//! detection of the stationary condition that they need).
+//!
+//! ## Statistic
+//!
+//! One sample `k` is the increment pair over δt (body FRD) turned into mean rates,
+//! `f̃_k = Δv_k/δt − b̂_a` \[m/s²\], `ω̃_k = Δθ_k/δt` \[rad/s\]. Over the last W samples, with
+//! `f̄`, `ω̄` the window means and `ω_e = b̂_g + Ĉ_n^b ω_ie^n` the gyro output expected at
+//! rest (estimated bias plus earth rate, both set by the caller and updatable):
+//!
+//! ```text
+//! W·T = Σ_k ‖f̃_k − g f̄/‖f̄‖‖²/σ_a² + Σ_k ‖ω̃_k − ω_e‖²/σ_g²
+//!     = [A + W(‖f̄‖ − g)²]/σ_a² + [G + W‖ω̄ − ω_e‖²]/σ_g²,
+//! A = Σ_k ‖f̃_k − f̄‖²,   G = Σ_k ‖ω̃_k − ω̄‖².
+//! ```
+//!
+//! The first line is Skog et al.'s SHOE statistic with `ω̃_k` replaced by `ω̃_k − ω_e`
+//! (their foot-mounted MEMS case neglects the earth rate and the bias; a tactical gyro at
+//! 200 Hz does not allow it: 10 °/h and 15 °/h are 4–6 times its per-sample white noise
+//! after a 200-sample window); the second line is the exact split used here, computed from
+//! running sums that are recomputed from the ring buffer every W samples (O(1) per
+//! sample, no drift). Stationary is declared when `T < γ`.
+//!
+//! ## Threshold
+//!
+//! At rest with white Gaussian noise of per-axis σ_a, σ_g per sample and residual biases
+//! (the errors of b̂_a, b̂_g, of g and of the earth rate through Ĉ_n^b) of per-axis σ_ba,
+//! σ_bg, the four parts are independent and
+//!
+//! ```text
+//! W·T ~ χ²(6W − 6) + (1 + κ_g) χ²(3) + (1 + κ_a) χ²(1),
+//! κ_g = W σ_bg²/σ_g²,  κ_a = W σ_ba²/σ_a²
+//! ```
+//!
+//! (the scatter terms A, G lose one degree of freedom per axis to the mean; the residual
+//! bias is constant over the window and adds to the window mean, whose variance per axis is
+//! σ²/W + σ_b²; the magnitude term is, to first order in σ/(g√W), the radial component of the
+//! mean error). Without residual biases this is χ²(6W − 2). The threshold is the upper
+//! α-quantile of this law, `γ = q_{1−α}/W`, computed exactly ([`chi2::WeightedChiSquare`]).
+//! α is the probability that a window at rest is declared moving, averaged over the
+//! residual-bias population.
+//!
+//! ## Prediction in motion
+//!
+//! [`StationarityDetector::probability_declared_moving`] evaluates the same law with white
+//! vibration of RMS `a_v` (per axis, specific force) and `ω_v` (angular rate) and with steady
+//! offsets (a sustained turn or acceleration): the scatter weights become `1 + a_v²/σ_a²`
+//! and `1 + ω_v²/σ_g²`, and the mean terms become non-central. The accelerometer part grows by
+//! about `3W a_v²/σ_a²` (W a_v²/σ_a² per axis). No IMU-only test can tell a standstill from
+//! perfectly smooth, straight, constant-velocity motion: there both hypotheses give the same
+//! data.
+
+pub mod chi2;
+
+use crate::coning::Increment;
+use crate::math::{Mat3, Vec3};
+use chi2::{Chi2Error, ChiSquareTerm, WeightedChiSquare};
+
+/// Why a detector cannot be built or a sample cannot be used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum StationarityError {
+    /// A noise σ, δt, g, threshold or false-alarm rate is not finite or out of range
+    /// (σ in \[1e-30, 1e30\], α in \[1e-12, 0.5\], W ≥ 2).
+    InvalidConfig,
+    /// An input sample or vector is not finite, or a rate beyond 1e100 (the sample is not used).
+    InvalidInput,
+    /// `κ = W σ_b²/σ² > 1e5`: the residual bias, not the noise, would decide the test
+    /// (estimate the bias first or shorten the window).
+    ResidualBiasDominates,
+    /// The χ² computation failed.
+    Distribution(Chi2Error),
+}
+
+impl core::fmt::Display for StationarityError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            StationarityError::InvalidConfig => {
+                f.write_str("stationarity detector: invalid noise model, δt, g, threshold or α")
+            }
+            StationarityError::InvalidInput => {
+                f.write_str("stationarity detector: non-finite or out-of-range input")
+            }
+            StationarityError::ResidualBiasDominates => f.write_str(
+                "stationarity detector: residual bias variance exceeds 1e5 × the window-mean noise variance",
+            ),
+            StationarityError::Distribution(e) => write!(f, "stationarity detector: {e}"),
+        }
+    }
+}
+
+impl From<Chi2Error> for StationarityError {
+    fn from(e: Chi2Error) -> Self {
+        StationarityError::Distribution(e)
+    }
+}
+
+/// Per-sample white noise and residual-bias uncertainty of the IMU, per axis, at the
+/// detector's input rate (isotropic: the same σ on the three axes, as in Skog et al.).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseModel {
+    /// σ of the per-sample specific force `Δv/δt` \[m/s²\] (white: `VRW/√δt`)
+    pub sigma_accel_mps2: f64,
+    /// σ of the per-sample angular rate `Δθ/δt` \[rad/s\] (white: `ARW/√δt`)
+    pub sigma_gyro_rps: f64,
+    /// σ of the residual accelerometer bias (b_a − b̂_a), per axis, plus the error of the
+    /// caller's g \[m/s²\]
+    pub sigma_accel_bias_mps2: f64,
+    /// σ of the residual gyro bias (b_g − b̂_g), per axis, plus the earth-rate error from the
+    /// attitude error (`Ω·|δψ|`) \[rad/s\]
+    pub sigma_gyro_bias_rps: f64,
+}
+
+impl NoiseModel {
+    /// From the random-walk densities: `σ_a = VRW/√δt`, `σ_g = ARW/√δt` (a white rate noise
+    /// of density N integrated over δt has σ = N√δt in the increment, N/√δt in the mean rate).
+    pub fn from_random_walks(
+        vrw_mps_per_sqrt_s: f64,
+        arw_rad_per_sqrt_s: f64,
+        dt_s: f64,
+        sigma_accel_bias_mps2: f64,
+        sigma_gyro_bias_rps: f64,
+    ) -> Result<Self, StationarityError> {
+        if !(dt_s.is_finite() && dt_s > 0.0) {
+            return Err(StationarityError::InvalidConfig);
+        }
+        let s = libm::sqrt(dt_s);
+        let m = Self {
+            sigma_accel_mps2: vrw_mps_per_sqrt_s / s,
+            sigma_gyro_rps: arw_rad_per_sqrt_s / s,
+            sigma_accel_bias_mps2,
+            sigma_gyro_bias_rps,
+        };
+        m.check()?;
+        Ok(m)
+    }
+
+    fn check(&self) -> Result<(), StationarityError> {
+        let sigma_ok = |s: f64| (1e-30..=1e30).contains(&s);
+        let bias_ok = |s: f64| s == 0.0 || sigma_ok(s);
+        if sigma_ok(self.sigma_accel_mps2)
+            && sigma_ok(self.sigma_gyro_rps)
+            && bias_ok(self.sigma_accel_bias_mps2)
+            && bias_ok(self.sigma_gyro_bias_rps)
+        {
+            Ok(())
+        } else {
+            Err(StationarityError::InvalidConfig)
+        }
+    }
+
+    /// `(κ_a, κ_g) = (W σ_ba²/σ_a², W σ_bg²/σ_g²)`: residual-bias variance of the window mean
+    /// in units of the white-noise variance of the window mean.
+    pub fn kappas(&self, window: usize) -> (f64, f64) {
+        let w = window as f64;
+        let r = |b: f64, s: f64| w * (b / s) * (b / s);
+        (
+            r(self.sigma_accel_bias_mps2, self.sigma_accel_mps2),
+            r(self.sigma_gyro_bias_rps, self.sigma_gyro_rps),
+        )
+    }
+}
+
+/// What the vehicle does during a window, for [`StationarityDetector::probability_declared_moving`].
+/// All zero is rest.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MotionModel {
+    /// RMS per axis of zero-mean specific-force vibration, white at the sample rate \[m/s²\]
+    pub vibration_accel_mps2: f64,
+    /// RMS per axis of zero-mean angular-rate vibration, white at the sample rate \[rad/s\]
+    pub vibration_gyro_rps: f64,
+    /// steady `‖f̄‖ − g` beyond bias and noise, e.g. `√(g² + a²) − g` for a horizontal
+    /// acceleration a \[m/s²\]
+    pub mean_accel_offset_mps2: f64,
+    /// steady `‖ω̄ − ω_e‖` beyond bias and noise, e.g. a turn rate or an unmodelled earth rate
+    /// \[rad/s\]
+    pub mean_rate_offset_rps: f64,
+}
+
+/// The result of one full window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindowReport {
+    /// index of the window's first sample (samples counted from 0 since construction or
+    /// [`StationarityDetector::reset`])
+    pub first_sample: u64,
+    /// index of the window's last sample (the one just pushed)
+    pub last_sample: u64,
+    /// the statistic T (per-sample mean, Skog et al.'s normalisation; mean ≈ 6 at rest)
+    pub statistic: f64,
+    /// the threshold γ in the same units
+    pub threshold: f64,
+    /// `T < γ`
+    pub stationary: bool,
+    /// `A/σ_a²`: scatter of the specific force about its window mean
+    pub accel_scatter: f64,
+    /// `W(‖f̄‖ − g)²/σ_a²`: gravity-magnitude mismatch of the window mean
+    pub accel_magnitude: f64,
+    /// `G/σ_g²`: scatter of the angular rate about its window mean
+    pub gyro_scatter: f64,
+    /// `W‖ω̄ − ω_e‖²/σ_g²`: offset of the mean rate from the rate expected at rest
+    pub gyro_mean: f64,
+}
+
+/// Sliding-window stationarity detector over the last `W` samples (const capacity, no
+/// allocation). Feed one [`Increment`] per sample with [`push`](Self::push).
+#[derive(Clone, Debug)]
+pub struct StationarityDetector<const W: usize> {
+    noise: NoiseModel,
+    dt_s: f64,
+    g_mps2: f64,
+    threshold: f64,
+    alpha: f64,
+    gyro_bias_rps: Vec3,
+    earth_rate_b_rps: Vec3,
+    accel_bias_mps2: Vec3,
+    f_ring: [Vec3; W],
+    w_ring: [Vec3; W],
+    head: usize,
+    len: usize,
+    count: u64,
+    since_refresh: usize,
+    centre_f: Vec3,
+    centre_w: Vec3,
+    sum_f: Vec3,
+    sum_ff: f64,
+    sum_w: Vec3,
+    sum_ww: f64,
+}
+
+/// Largest |rate| accepted \[rad/s or m/s²\]: keeps every sum of squares finite.
+const MAX_INPUT: f64 = 1e100;
+
+fn finite_vec(v: &Vec3) -> bool {
+    v.iter().all(|c| c.is_finite() && libm::fabs(*c) <= MAX_INPUT)
+}
+
+impl<const W: usize> StationarityDetector<W> {
+    fn build(noise: NoiseModel, dt_s: f64, g_mps2: f64) -> Result<Self, StationarityError> {
+        noise.check()?;
+        let ok = W >= 2
+            && W <= 1 << 20
+            && dt_s.is_finite()
+            && dt_s > 0.0
+            && g_mps2.is_finite()
+            && g_mps2 > 0.0;
+        if !ok {
+            return Err(StationarityError::InvalidConfig);
+        }
+        let (ka, kg) = noise.kappas(W);
+        if ka > 1e5 || kg > 1e5 {
+            return Err(StationarityError::ResidualBiasDominates);
+        }
+        Ok(Self {
+            noise,
+            dt_s,
+            g_mps2,
+            threshold: 0.0,
+            alpha: 0.0,
+            gyro_bias_rps: Vec3::zeros(),
+            earth_rate_b_rps: Vec3::zeros(),
+            accel_bias_mps2: Vec3::zeros(),
+            f_ring: [Vec3::zeros(); W],
+            w_ring: [Vec3::zeros(); W],
+            head: 0,
+            len: 0,
+            count: 0,
+            since_refresh: 0,
+            centre_f: Vec3::zeros(),
+            centre_w: Vec3::zeros(),
+            sum_f: Vec3::zeros(),
+            sum_ff: 0.0,
+            sum_w: Vec3::zeros(),
+            sum_ww: 0.0,
+        })
+    }
+
+    /// Threshold from theory: `γ = q_{1−α}/W`, q the upper α-quantile of the law of `W·T` at
+    /// rest (module docs). `false_alarm_rate` α ∈ \[1e-12, 0.5\] is the probability that a
+    /// window at rest is declared moving; `dt_s` the sample period; `g_mps2` local gravity.
+    pub fn from_noise_model(
+        noise: NoiseModel,
+        dt_s: f64,
+        g_mps2: f64,
+        false_alarm_rate: f64,
+    ) -> Result<Self, StationarityError> {
+        if !(1e-12..=0.5).contains(&false_alarm_rate) {
+            return Err(StationarityError::InvalidConfig);
+        }
+        let mut d = Self::build(noise, dt_s, g_mps2)?;
+        let q = d.rest_distribution()?.upper_quantile(false_alarm_rate)?;
+        d.threshold = q / W as f64;
+        d.alpha = false_alarm_rate;
+        Ok(d)
+    }
+
+    /// Explicit threshold γ on T (Skog et al.'s normalisation); the implied false-alarm
+    /// rate is computed from the noise model ([`false_alarm_rate`](Self::false_alarm_rate)).
+    pub fn with_threshold(
+        noise: NoiseModel,
+        dt_s: f64,
+        g_mps2: f64,
+        threshold: f64,
+    ) -> Result<Self, StationarityError> {
+        if !(threshold.is_finite() && threshold > 0.0) {
+            return Err(StationarityError::InvalidConfig);
+        }
+        let mut d = Self::build(noise, dt_s, g_mps2)?;
+        d.alpha = d.rest_distribution()?.sf(threshold * W as f64)?;
+        d.threshold = threshold;
+        Ok(d)
+    }
+
+    /// Law of `W·T` at rest: `χ²(6W − 6) + (1 + κ_g) χ²(3) + (1 + κ_a) χ²(1)`.
+    pub fn rest_distribution(&self) -> Result<WeightedChiSquare, StationarityError> {
+        self.distribution(&MotionModel::default())
+    }
+
+    fn distribution(&self, m: &MotionModel) -> Result<WeightedChiSquare, StationarityError> {
+        let vals = [
+            m.vibration_accel_mps2,
+            m.vibration_gyro_rps,
+            m.mean_accel_offset_mps2,
+            m.mean_rate_offset_rps,
+        ];
+        if !vals.iter().all(|v| v.is_finite() && libm::fabs(*v) <= MAX_INPUT) {
+            return Err(StationarityError::InvalidInput);
+        }
+        let w = W as f64;
+        let (ka, kg) = self.noise.kappas(W);
+        let sq = |x: f64| x * x;
+        let ra = sq(m.vibration_accel_mps2 / self.noise.sigma_accel_mps2);
+        let rg = sq(m.vibration_gyro_rps / self.noise.sigma_gyro_rps);
+        let wa = 1.0 + ka + ra;
+        let wg = 1.0 + kg + rg;
+        let la = w * sq(m.mean_accel_offset_mps2 / self.noise.sigma_accel_mps2) / wa;
+        let lg = w * sq(m.mean_rate_offset_rps / self.noise.sigma_gyro_rps) / wg;
+        let scatter = 3.0 * (w - 1.0);
+        Ok(WeightedChiSquare::new(&[
+            ChiSquareTerm::central(1.0 + ra, scatter),
+            ChiSquareTerm::central(1.0 + rg, scatter),
+            ChiSquareTerm {
+                weight: wg,
+                dof: 3.0,
+                noncentrality: lg,
+            },
+            ChiSquareTerm {
+                weight: wa,
+                dof: 1.0,
+                noncentrality: la,
+            },
+        ])?)
+    }
+
+    /// Predicted probability that a window is declared moving under the motion `m`
+    /// (white vibration and steady offsets, module docs); `MotionModel::default()` (rest)
+    /// gives the false-alarm rate. `1 −` this is the probability of declaring a moving
+    /// window stationary.
+    pub fn probability_declared_moving(&self, m: &MotionModel) -> Result<f64, StationarityError> {
+        Ok(self.distribution(m)?.sf(self.threshold * W as f64)?)
+    }
+
+    /// The threshold γ on T.
+    pub fn threshold(&self) -> f64 {
+        self.threshold
+    }
+
+    /// The false-alarm rate α at rest: as given, or implied by an explicit threshold.
+    pub fn false_alarm_rate(&self) -> f64 {
+        self.alpha
+    }
+
+    /// The noise model.
+    pub fn noise(&self) -> &NoiseModel {
+        &self.noise
+    }
+
+    /// Estimated gyro bias b̂_g \[rad/s\] (body), removed from the rate before the test.
+    pub fn set_gyro_bias_rps(&mut self, b_g_rps: &Vec3) -> Result<(), StationarityError> {
+        if !finite_vec(b_g_rps) {
+            return Err(StationarityError::InvalidInput);
+        }
+        self.gyro_bias_rps = *b_g_rps;
+        Ok(())
+    }
+
+    /// Estimated accelerometer bias b̂_a \[m/s²\] (body), removed from the specific force.
+    pub fn set_accel_bias_mps2(&mut self, b_a_mps2: &Vec3) -> Result<(), StationarityError> {
+        if !finite_vec(b_a_mps2) {
+            return Err(StationarityError::InvalidInput);
+        }
+        self.accel_bias_mps2 = *b_a_mps2;
+        Ok(())
+    }
+
+    /// Earth rate resolved in the body frame, `Ĉ_n^b ω_ie^n` \[rad/s\] (or any other rate the
+    /// body has at rest, e.g. zero on a non-rotating test bench).
+    pub fn set_earth_rate_b_rps(&mut self, omega_ie_b_rps: &Vec3) -> Result<(), StationarityError> {
+        if !finite_vec(omega_ie_b_rps) {
+            return Err(StationarityError::InvalidInput);
+        }
+        self.earth_rate_b_rps = *omega_ie_b_rps;
+        Ok(())
+    }
+
+    /// Earth rate from the attitude estimate: `ω_ie^b = Ĉ_b^nᵀ ω_ie^n`.
+    pub fn set_attitude(
+        &mut self,
+        c_b_n: &Mat3,
+        omega_ie_n_rps: &Vec3,
+    ) -> Result<(), StationarityError> {
+        if !(c_b_n.iter().all(|c| c.is_finite()) && finite_vec(omega_ie_n_rps)) {
+            return Err(StationarityError::InvalidInput);
+        }
+        self.set_earth_rate_b_rps(&(c_b_n.transpose() * omega_ie_n_rps))
+    }
+
+    /// The gyro output expected at rest, `ω_e = b̂_g + Ĉ_n^b ω_ie^n` \[rad/s\].
+    pub fn expected_rate_b_rps(&self) -> Vec3 {
+        self.gyro_bias_rps + self.earth_rate_b_rps
+    }
+
+    /// Forget the buffered samples (the sample counter restarts at 0).
+    pub fn reset(&mut self) {
+        self.head = 0;
+        self.len = 0;
+        self.count = 0;
+        self.since_refresh = 0;
+        self.sum_f = Vec3::zeros();
+        self.sum_w = Vec3::zeros();
+        self.sum_ff = 0.0;
+        self.sum_ww = 0.0;
+    }
+
+    /// Recompute the running sums from the ring, centred on the current means.
+    fn refresh(&mut self) {
+        let n = self.len as f64;
+        let mean_f = self.centre_f + self.sum_f / n;
+        let mean_w = self.centre_w + self.sum_w / n;
+        self.centre_f = mean_f;
+        self.centre_w = mean_w;
+        let (mut sf, mut sw) = (Vec3::zeros(), Vec3::zeros());
+        let (mut sff, mut sww) = (0.0, 0.0);
+        for i in 0..self.len {
+            let df = self.f_ring[i] - mean_f;
+            let dw = self.w_ring[i] - mean_w;
+            sf += df;
+            sw += dw;
+            sff += df.norm_squared();
+            sww += dw.norm_squared();
+        }
+        self.sum_f = sf;
+        self.sum_w = sw;
+        self.sum_ff = sff;
+        self.sum_ww = sww;
+        self.since_refresh = 0;
+    }
+
+    /// Feed one sample (Δθ, Δv over δt, body FRD). Returns the window's report once W
+    /// samples are buffered (then on every sample), `None` before. A non-finite sample is
+    /// refused with [`StationarityError::InvalidInput`] and leaves the detector unchanged.
+    pub fn push(&mut self, inc: &Increment) -> Result<Option<WindowReport>, StationarityError> {
+        let f = inc.dv_b_mps / self.dt_s;
+        let w = inc.dtheta_b_rad / self.dt_s;
+        if !(finite_vec(&f) && finite_vec(&w)) {
+            return Err(StationarityError::InvalidInput);
+        }
+        if self.len == 0 {
+            self.centre_f = f;
+            self.centre_w = w;
+        }
+        if self.len == W {
+            let (of, ow) = (self.f_ring[self.head], self.w_ring[self.head]);
+            let (df, dw) = (of - self.centre_f, ow - self.centre_w);
+            self.sum_f -= df;
+            self.sum_w -= dw;
+            self.sum_ff -= df.norm_squared();
+            self.sum_ww -= dw.norm_squared();
+        } else {
+            self.len += 1;
+        }
+        self.f_ring[self.head] = f;
+        self.w_ring[self.head] = w;
+        self.head = (self.head + 1) % W;
+        let (df, dw) = (f - self.centre_f, w - self.centre_w);
+        self.sum_f += df;
+        self.sum_w += dw;
+        self.sum_ff += df.norm_squared();
+        self.sum_ww += dw.norm_squared();
+        self.count += 1;
+        self.since_refresh += 1;
+        if self.len < W {
+            return Ok(None);
+        }
+        if self.since_refresh >= W {
+            self.refresh();
+        }
+        Ok(Some(self.report()))
+    }
+
+    fn report(&self) -> WindowReport {
+        let n = W as f64;
+        let mean_f = self.centre_f + self.sum_f / n - self.accel_bias_mps2;
+        let mean_w = self.centre_w + self.sum_w / n;
+        let a = (self.sum_ff - self.sum_f.norm_squared() / n).max(0.0);
+        let g = (self.sum_ww - self.sum_w.norm_squared() / n).max(0.0);
+        let va = self.noise.sigma_accel_mps2 * self.noise.sigma_accel_mps2;
+        let vg = self.noise.sigma_gyro_rps * self.noise.sigma_gyro_rps;
+        let dm = mean_f.norm() - self.g_mps2;
+        let accel_scatter = a / va;
+        let accel_magnitude = n * dm * dm / va;
+        let gyro_scatter = g / vg;
+        let gyro_mean = n * (mean_w - self.expected_rate_b_rps()).norm_squared() / vg;
+        let statistic = ((accel_scatter + accel_magnitude + gyro_scatter + gyro_mean) / n)
+            .min(f64::MAX);
+        WindowReport {
+            first_sample: self.count - W as u64,
+            last_sample: self.count - 1,
+            statistic,
+            threshold: self.threshold,
+            stationary: statistic < self.threshold,
+            accel_scatter,
+            accel_magnitude,
+            gyro_scatter,
+            gyro_mean,
+        }
+    }
+}
+
+/// A run of samples declared stationary, `first_sample..=last_sample`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StationaryInterval {
+    /// first sample index
+    pub first_sample: u64,
+    /// last sample index (inclusive)
+    pub last_sample: u64,
+}
+
+impl StationaryInterval {
+    /// Number of samples.
+    pub fn len_samples(&self) -> u64 {
+        self.last_sample - self.first_sample + 1
+    }
+}
+
+/// Turns window decisions into stationary intervals with a minimum duration.
+///
+/// A window declared stationary vouches for all its W samples, so a run of consecutive
+/// stationary windows ending at samples `n₁ … n₂` gives the interval `[n₁ − W + 1, n₂]`
+/// (clipped to start after the previous interval). A window declared moving ends the run.
+/// For motion strong enough to be seen in one sample (a turn, a jolt) the interval ends
+/// exactly at the last sample before the motion and starts at the first sample after it.
+/// Runs shorter than `min_samples` are dropped. Feed windows in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IntervalTracker {
+    window: u64,
+    min_samples: u64,
+    current: Option<StationaryInterval>,
+    next_free: u64,
+}
+
+impl IntervalTracker {
+    /// `window`: the samples a decision covers (the detector's W; 1 for per-sample
+    /// decisions); `min_samples`: shortest interval reported.
+    pub fn new(window: usize, min_samples: u64) -> Self {
+        Self {
+            window: window.max(1) as u64,
+            min_samples: min_samples.max(1),
+            current: None,
+            next_free: 0,
+        }
+    }
+
+    /// One decision about the window ending at `last_sample`. Returns the interval that
+    /// this decision closes, if it lasted at least `min_samples`.
+    pub fn push_decision(&mut self, last_sample: u64, stationary: bool) -> Option<StationaryInterval> {
+        let first = (last_sample + 1).saturating_sub(self.window).max(self.next_free);
+        match (stationary, self.current) {
+            (true, Some(mut c)) if first <= c.last_sample + 1 => {
+                c.last_sample = c.last_sample.max(last_sample);
+                self.current = Some(c);
+                None
+            }
+            (true, _) => {
+                let closed = self.finish();
+                let first = first.max(self.next_free);
+                self.current = Some(StationaryInterval {
+                    first_sample: first,
+                    last_sample,
+                });
+                closed
+            }
+            (false, _) => self.finish(),
+        }
+    }
+
+    /// A [`WindowReport`] as one decision.
+    pub fn push(&mut self, report: &WindowReport) -> Option<StationaryInterval> {
+        self.push_decision(report.last_sample, report.stationary)
+    }
+
+    /// Close the open interval (end of data).
+    pub fn finish(&mut self) -> Option<StationaryInterval> {
+        let c = self.current.take()?;
+        self.next_free = c.last_sample + 1;
+        (c.len_samples() >= self.min_samples).then_some(c)
+    }
+}
