@@ -615,3 +615,269 @@ impl IntervalTracker {
         (c.len_samples() >= self.min_samples).then_some(c)
     }
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::math::{c_b_n_from_euler, Euler};
+    extern crate std;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, StandardNormal};
+    use std::println;
+
+    const D2R: f64 = core::f64::consts::PI / 180.0;
+    const DPH: f64 = D2R / 3600.0;
+    const G: f64 = 9.80665;
+    /// Tactical grade at 200 Hz: ARW 0.003 °/√h, VRW 0.03 m/s/√h.
+    const DT: f64 = 0.005;
+    const ARW: f64 = 0.003 * D2R / 60.0;
+    const VRW: f64 = 0.03 / 60.0;
+
+    fn tactical(sigma_ba: f64, sigma_bg: f64) -> NoiseModel {
+        NoiseModel::from_random_walks(VRW, ARW, DT, sigma_ba, sigma_bg).unwrap()
+    }
+
+    /// Samples of a body at rest (or moving) with white Gaussian noise.
+    struct Sim {
+        rng: ChaCha8Rng,
+        sigma_a: f64,
+        sigma_g: f64,
+        f_b: Vec3,
+        w_b: Vec3,
+    }
+
+    impl Sim {
+        /// At rest at latitude 45° with the attitude (roll, pitch, yaw) [deg]: the specific
+        /// force `C_n^b [0, 0, −g]`, the rate `C_n^b ω_ie^n` plus `gyro_bias`.
+        fn rest(seed: u64, noise: &NoiseModel, rpy_deg: [f64; 3], gyro_bias: Vec3) -> Self {
+            let c = c_b_n_from_euler(&Euler::new(
+                rpy_deg[0] * D2R,
+                rpy_deg[1] * D2R,
+                rpy_deg[2] * D2R,
+            ));
+            Self {
+                rng: ChaCha8Rng::seed_from_u64(seed),
+                sigma_a: noise.sigma_accel_mps2,
+                sigma_g: noise.sigma_gyro_rps,
+                f_b: c.transpose() * Vec3::new(0.0, 0.0, -G),
+                w_b: c.transpose() * earth_n() + gyro_bias,
+            }
+        }
+        fn gauss3(&mut self) -> Vec3 {
+            let mut v = Vec3::zeros();
+            for c in v.iter_mut() {
+                *c = StandardNormal.sample(&mut self.rng);
+            }
+            v
+        }
+        fn sample_with(&mut self, f_b: Vec3, w_b: Vec3) -> Increment {
+            let nf = self.gauss3() * self.sigma_a;
+            let nw = self.gauss3() * self.sigma_g;
+            Increment::new((w_b + nw) * DT, (f_b + nf) * DT)
+        }
+        fn sample(&mut self) -> Increment {
+            self.sample_with(self.f_b, self.w_b)
+        }
+    }
+
+    fn earth_n() -> Vec3 {
+        let (s, c) = libm::sincos(45.0 * D2R);
+        Vec3::new(7.292_115e-5 * c, 0.0, -7.292_115e-5 * s)
+    }
+
+    /// The two-sided 99 % binomial band `nα ± 2.576 √(nα(1 − α))` (normal approximation,
+    /// n α ≥ 100 in every use).
+    fn band(n: usize, p: f64) -> (f64, f64) {
+        let m = n as f64 * p;
+        let h = 2.576 * libm::sqrt(m * (1.0 - p));
+        (m - h, m + h)
+    }
+
+    /// Counts the disjoint windows (every W-th report) declared moving over `n` windows of
+    /// rest data; a fresh residual bias (σ_ba, σ_bg per axis) is drawn for every window.
+    fn rest_rate<const W: usize>(det: &mut StationarityDetector<W>, n: usize, seed: u64) -> usize {
+        let noise = *det.noise();
+        let mut sim = Sim::rest(seed, &noise, [3.0, -40.0, 120.0], Vec3::zeros());
+        let mut bias_rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5eed);
+        let mut bias = |s: f64| {
+            let v: [f64; 3] = core::array::from_fn(|_| StandardNormal.sample(&mut bias_rng));
+            Vec3::new(v[0], v[1], v[2]) * s
+        };
+        det.set_attitude(
+            &c_b_n_from_euler(&Euler::new(3.0 * D2R, -40.0 * D2R, 120.0 * D2R)),
+            &earth_n(),
+        )
+        .unwrap();
+        let (f0, w0) = (sim.f_b, sim.w_b);
+        let mut moving = 0;
+        for _ in 0..n {
+            let (ba, bg) = (
+                bias(noise.sigma_accel_bias_mps2),
+                bias(noise.sigma_gyro_bias_rps),
+            );
+            for _ in 0..W {
+                let s = sim.sample_with(f0 + ba, w0 + bg);
+                if let Some(r) = det.push(&s).unwrap() {
+                    if r.last_sample % W as u64 == W as u64 - 1 && !r.stationary {
+                        moving += 1;
+                    }
+                }
+            }
+        }
+        moving
+    }
+
+    fn check_rest_rate<const W: usize>(alpha: f64, n: usize, seed: u64) {
+        let mut det = StationarityDetector::<W>::from_noise_model(tactical(0.0, 0.0), DT, G, alpha)
+            .unwrap();
+        let k = rest_rate(&mut det, n, seed);
+        let (lo, hi) = band(n, alpha);
+        println!(
+            "W = {W}: {k} of {n} windows at rest declared moving ({:.5}), stated α = {alpha}, 99 % band [{lo:.0}, {hi:.0}]; γ = {:.4}",
+            k as f64 / n as f64,
+            det.threshold()
+        );
+        assert!((k as f64) >= lo && (k as f64) <= hi, "W = {W}: {k} outside [{lo}, {hi}]");
+    }
+
+    #[test]
+    fn false_alarm_rate_at_rest_matches_the_stated_rate() {
+        check_rest_rate::<5>(1e-3, 200_000, 1);
+        check_rest_rate::<20>(1e-2, 20_000, 2);
+        check_rest_rate::<200>(5e-2, 2_000, 3);
+    }
+
+    /// Residual biases widen the law at rest: with the widened threshold the rate over the
+    /// residual-bias population is the stated α; a threshold that ignores them (κ = 0) is
+    /// exceeded at the rate the same theory predicts for it.
+    #[test]
+    fn residual_bias_widens_the_threshold_and_keeps_the_stated_rate() {
+        const W: usize = 20;
+        let (alpha, n) = (1e-2, 20_000);
+        let s = tactical(0.0, 0.0);
+        // κ_g = 2, κ_a = 5
+        let sigma_bg = s.sigma_gyro_rps * libm::sqrt(2.0 / W as f64);
+        let sigma_ba = s.sigma_accel_mps2 * libm::sqrt(5.0 / W as f64);
+        let noise = tactical(sigma_ba, sigma_bg);
+        let (ka, kg) = noise.kappas(W);
+        assert!((ka - 5.0).abs() < 1e-12 && (kg - 2.0).abs() < 1e-12);
+        let mut det = StationarityDetector::<W>::from_noise_model(noise, DT, G, alpha).unwrap();
+        let k = rest_rate(&mut det, n, 11);
+        let (lo, hi) = band(n, alpha);
+        // the naive threshold on the same data (same seed: the same samples and biases)
+        let mut naive = StationarityDetector::<W>::from_noise_model(s, DT, G, alpha).unwrap();
+        naive.noise = noise; // the data's biases, the naive threshold
+        let predicted = naive.probability_declared_moving(&MotionModel::default()).unwrap();
+        let kn = rest_rate(&mut naive, n, 11);
+        let (nlo, nhi) = band(n, predicted);
+        println!(
+            "κ_a = 5, κ_g = 2: γ = {:.4} (naive {:.4}); moving at rest {k}/{n} (band [{lo:.0}, {hi:.0}]); naive threshold {kn}/{n}, predicted {:.4} (band [{nlo:.0}, {nhi:.0}])",
+            det.threshold(),
+            naive.threshold(),
+            predicted
+        );
+        assert!((k as f64) >= lo && (k as f64) <= hi);
+        assert!(predicted > 2.0 * alpha, "{predicted}");
+        assert!((kn as f64) >= nlo && (kn as f64) <= nhi);
+    }
+
+    /// A turn at 5 °/s and an acceleration of 0.1 g after 2 s at rest (W = 200, 1 s): every
+    /// window that holds a moving sample is declared moving. One turning sample alone adds
+    /// `(1 − 1/W)(5 °/s)²/σ_g² ≈ 5e7` to W·T and one accelerating sample
+    /// `(1 − 1/W)(0.98 m/s²)²/σ_a² ≈ 1.9e4`, against W·γ ≈ 1.3e3 (α = 1e-3); once the
+    /// window is all acceleration the scatter is back to noise and the magnitude term
+    /// `W(√(g² + a²) − g)²/σ_a² ≈ 9.6e3` carries the decision.
+    #[test]
+    fn turns_and_accelerations_are_declared_moving() {
+        const W: usize = 200;
+        let noise = tactical(0.0, 0.0);
+        for (case, turn) in [("turn 5 °/s", true), ("acceleration 0.1 g", false)] {
+            let mut det =
+                StationarityDetector::<W>::from_noise_model(noise, DT, G, 1e-3).unwrap();
+            let mut sim = Sim::rest(21, &noise, [0.0, 0.0, 0.0], Vec3::zeros());
+            det.set_attitude(&Mat3::identity(), &earth_n()).unwrap();
+            let start = 2 * W as u64;
+            let (mut rest_moving, mut moving, mut all_accel) = (0, 0, 0);
+            for i in 0..(6 * W as u64) {
+                let s = if i < start {
+                    sim.sample()
+                } else if turn {
+                    let w = sim.w_b + Vec3::new(0.0, 0.0, 5.0 * D2R);
+                    sim.sample_with(sim.f_b, w)
+                } else {
+                    // forward acceleration a: specific force gains +a along x (FRD)
+                    sim.sample_with(sim.f_b + Vec3::new(0.1 * G, 0.0, 0.0), sim.w_b)
+                };
+                let Some(r) = det.push(&s).unwrap() else {
+                    continue;
+                };
+                if r.last_sample < start {
+                    rest_moving += usize::from(!r.stationary);
+                } else {
+                    assert!(!r.stationary, "{case}: window ending {} stationary", r.last_sample);
+                    moving += 1;
+                    if !turn && r.first_sample >= start {
+                        // all-acceleration window: the magnitude term decides
+                        assert!(r.accel_scatter < W as f64 * r.threshold, "{r:?}");
+                        assert!(r.accel_magnitude > W as f64 * r.threshold, "{r:?}");
+                        all_accel += 1;
+                    }
+                }
+            }
+            println!("{case}: {moving} windows with motion, all moving; {rest_moving} of {} rest windows moving", start as usize - W + 1);
+            assert_eq!(moving, 4 * W);
+            assert!(turn || all_accel == 3 * W + 1);
+        }
+    }
+
+    /// Tactical IMU at rest with a 10 °/h gyro bias, W = 200 (1 s), α = 1e-2: with
+    /// `b̂_g` and the attitude supplied (residual 0.1 °/h) the windows are stationary at the
+    /// stated rate; with neither the earth rate (10.3 °/h at 45°) and the bias (each several
+    /// times the window-mean noise σ_g/√W = 1.8 °/h) make every window moving, as the
+    /// non-central law predicts.
+    #[test]
+    fn earth_rate_and_gyro_bias_must_be_removed_at_tactical_grade() {
+        const W: usize = 200;
+        let (alpha, n) = (1e-2, 2_000);
+        let bias = Vec3::new(10.0, -10.0, 10.0) * DPH; // 10 °/h per axis
+        let noise = tactical(0.0, 0.1 * DPH);
+        let rpy = [2.0, -1.0, 60.0];
+        let c = c_b_n_from_euler(&Euler::new(rpy[0] * D2R, rpy[1] * D2R, rpy[2] * D2R));
+        let mut with = StationarityDetector::<W>::from_noise_model(noise, DT, G, alpha).unwrap();
+        with.set_attitude(&c, &earth_n()).unwrap();
+        with.set_gyro_bias_rps(&bias).unwrap();
+        let mut without = with.clone();
+        without.set_gyro_bias_rps(&Vec3::zeros()).unwrap();
+        without.set_earth_rate_b_rps(&Vec3::zeros()).unwrap();
+        let offset = (c.transpose() * earth_n() + bias).norm();
+        let predicted = without
+            .probability_declared_moving(&MotionModel {
+                mean_rate_offset_rps: offset,
+                ..MotionModel::default()
+            })
+            .unwrap();
+        let mut sim = Sim::rest(31, &noise, rpy, bias);
+        let (mut k_with, mut k_without) = (0, 0);
+        for _ in 0..n * W {
+            let s = sim.sample();
+            let a = with.push(&s).unwrap();
+            let b = without.push(&s).unwrap();
+            if let (Some(a), Some(b)) = (a, b) {
+                if a.last_sample % W as u64 == W as u64 - 1 {
+                    k_with += usize::from(!a.stationary);
+                    k_without += usize::from(!b.stationary);
+                }
+            }
+        }
+        let (lo, hi) = band(n, alpha);
+        println!(
+            "expected rate supplied: {k_with}/{n} moving (band [{lo:.0}, {hi:.0}]); not supplied (offset {:.2} °/h): {k_without}/{n} moving, predicted P = {predicted}",
+            offset / DPH
+        );
+        assert!((k_with as f64) >= lo && (k_with as f64) <= hi);
+        assert!(predicted > 1.0 - 1e-12);
+        assert_eq!(k_without, n);
+    }
+}

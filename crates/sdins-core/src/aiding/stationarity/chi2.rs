@@ -463,7 +463,8 @@ impl WeightedChiSquare {
             // is below p_k r/(1 − r); stop when ten times that is below 1e-17 of the sum.
             // (1 − mass is no stopping rule: the recurrence's relative error grows like
             // k·ε, which leaves ~1e-14 absolute in the mass.)
-            if p_k <= p_prev && p_k > 0.0 || p_k == 0.0 && k > 0 {
+            // (p_prev > 0: weights that underflow before the mode must not stop the sum)
+            if p_prev > 0.0 && p_k <= p_prev {
                 let r = rho_max.max(p_k / p_prev);
                 if r < 1.0 && 10.0 * p_k * r / (1.0 - r) <= 1e-17 * sf {
                     return Ok((sf.clamp(0.0, 1.0), pdf / (2.0 * beta)));
@@ -808,6 +809,25 @@ mod tests {
             let beta = m.terms().iter().map(|t| t.weight).fold(f64::INFINITY, f64::min);
             let tol = mixture_tol(x / (2.0 * beta));
             eprintln!("mpmath x={x}: rel {:e} (bound {tol:e})", rel(got, want));
+            assert!(rel(got, want) < tol, "x={x}: {got} vs {want}");
+        }
+        // a large non-centrality: p_0 = e^{−λ/2} = e^{−1000} underflows, the weights are
+        // rescaled on the way up (mpmath: the Poisson series Σ_j e^{−λ/2}(λ/2)^j/j! Q(ν/2 + j, x/2)
+        // over j < 6000 at 40 digits)
+        let big = WeightedChiSquare::new(&[ChiSquareTerm {
+            weight: 1.0,
+            dof: 3.0,
+            noncentrality: 2000.0,
+        }])
+        .unwrap();
+        for (x, want) in [
+            (1800.0, 0.989_772_881_501_041_11),
+            (2000.0, 0.508_920_620_580_763_86),
+            (2300.0, 0.000_651_392_534_890_183_97),
+        ] {
+            let got = big.sf(x).unwrap();
+            let tol = mixture_tol(x / 2.0);
+            eprintln!("mpmath λ = 2000, x={x}: rel {:e} (bound {tol:e})", rel(got, want));
             assert!(rel(got, want) < tol, "x={x}: {got} vs {want}");
         }
         // the quantile inverts the survival function
