@@ -241,7 +241,8 @@ pub struct StationarityDetector<const W: usize> {
 const MAX_INPUT: f64 = 1e100;
 
 fn finite_vec(v: &Vec3) -> bool {
-    v.iter().all(|c| c.is_finite() && libm::fabs(*c) <= MAX_INPUT)
+    v.iter()
+        .all(|c| c.is_finite() && libm::fabs(*c) <= MAX_INPUT)
 }
 
 impl<const W: usize> StationarityDetector<W> {
@@ -332,7 +333,10 @@ impl<const W: usize> StationarityDetector<W> {
             m.mean_accel_offset_mps2,
             m.mean_rate_offset_rps,
         ];
-        if !vals.iter().all(|v| v.is_finite() && libm::fabs(*v) <= MAX_INPUT) {
+        if !vals
+            .iter()
+            .all(|v| v.is_finite() && libm::fabs(*v) <= MAX_INPUT)
+        {
             return Err(StationarityError::InvalidInput);
         }
         let w = W as f64;
@@ -520,8 +524,8 @@ impl<const W: usize> StationarityDetector<W> {
         let accel_magnitude = n * dm * dm / va;
         let gyro_scatter = g / vg;
         let gyro_mean = n * (mean_w - self.expected_rate_b_rps()).norm_squared() / vg;
-        let statistic = ((accel_scatter + accel_magnitude + gyro_scatter + gyro_mean) / n)
-            .min(f64::MAX);
+        let statistic =
+            ((accel_scatter + accel_magnitude + gyro_scatter + gyro_mean) / n).min(f64::MAX);
         WindowReport {
             first_sample: self.count - W as u64,
             last_sample: self.count - 1,
@@ -582,8 +586,14 @@ impl IntervalTracker {
 
     /// One decision about the window ending at `last_sample`. Returns the interval that
     /// this decision closes, if it lasted at least `min_samples`.
-    pub fn push_decision(&mut self, last_sample: u64, stationary: bool) -> Option<StationaryInterval> {
-        let first = (last_sample + 1).saturating_sub(self.window).max(self.next_free);
+    pub fn push_decision(
+        &mut self,
+        last_sample: u64,
+        stationary: bool,
+    ) -> Option<StationaryInterval> {
+        let first = (last_sample + 1)
+            .saturating_sub(self.window)
+            .max(self.next_free);
         match (stationary, self.current) {
             (true, Some(mut c)) if first <= c.last_sample + 1 => {
                 c.last_sample = c.last_sample.max(last_sample);
@@ -730,8 +740,8 @@ mod tests {
     }
 
     fn check_rest_rate<const W: usize>(alpha: f64, n: usize, seed: u64) {
-        let mut det = StationarityDetector::<W>::from_noise_model(tactical(0.0, 0.0), DT, G, alpha)
-            .unwrap();
+        let mut det =
+            StationarityDetector::<W>::from_noise_model(tactical(0.0, 0.0), DT, G, alpha).unwrap();
         let k = rest_rate(&mut det, n, seed);
         let (lo, hi) = band(n, alpha);
         println!(
@@ -739,7 +749,10 @@ mod tests {
             k as f64 / n as f64,
             det.threshold()
         );
-        assert!((k as f64) >= lo && (k as f64) <= hi, "W = {W}: {k} outside [{lo}, {hi}]");
+        assert!(
+            (k as f64) >= lo && (k as f64) <= hi,
+            "W = {W}: {k} outside [{lo}, {hi}]"
+        );
     }
 
     #[test]
@@ -769,7 +782,9 @@ mod tests {
         // the naive threshold on the same data (same seed: the same samples and biases)
         let mut naive = StationarityDetector::<W>::from_noise_model(s, DT, G, alpha).unwrap();
         naive.noise = noise; // the data's biases, the naive threshold
-        let predicted = naive.probability_declared_moving(&MotionModel::default()).unwrap();
+        let predicted = naive
+            .probability_declared_moving(&MotionModel::default())
+            .unwrap();
         let kn = rest_rate(&mut naive, n, 11);
         let (nlo, nhi) = band(n, predicted);
         println!(
@@ -794,8 +809,7 @@ mod tests {
         const W: usize = 200;
         let noise = tactical(0.0, 0.0);
         for (case, turn) in [("turn 5 °/s", true), ("acceleration 0.1 g", false)] {
-            let mut det =
-                StationarityDetector::<W>::from_noise_model(noise, DT, G, 1e-3).unwrap();
+            let mut det = StationarityDetector::<W>::from_noise_model(noise, DT, G, 1e-3).unwrap();
             let mut sim = Sim::rest(21, &noise, [0.0, 0.0, 0.0], Vec3::zeros());
             det.set_attitude(&Mat3::identity(), &earth_n()).unwrap();
             let start = 2 * W as u64;
@@ -816,7 +830,11 @@ mod tests {
                 if r.last_sample < start {
                     rest_moving += usize::from(!r.stationary);
                 } else {
-                    assert!(!r.stationary, "{case}: window ending {} stationary", r.last_sample);
+                    assert!(
+                        !r.stationary,
+                        "{case}: window ending {} stationary",
+                        r.last_sample
+                    );
                     moving += 1;
                     if !turn && r.first_sample >= start {
                         // all-acceleration window: the magnitude term decides
@@ -879,5 +897,259 @@ mod tests {
         assert!((k_with as f64) >= lo && (k_with as f64) <= hi);
         assert!(predicted > 1.0 - 1e-12);
         assert_eq!(k_without, n);
+    }
+
+    /// The predicted probability of declaring a window moving, against Monte Carlo: white
+    /// vibration (a_v = 0.5 σ_a, ω_v = 0.3 σ_g) and a steady unmodelled rate offset.
+    #[test]
+    fn motion_predictions_match_monte_carlo() {
+        const W: usize = 20;
+        let n = 10_000;
+        let noise = tactical(0.0, 0.0);
+        let (av, wv) = (0.5 * noise.sigma_accel_mps2, 0.3 * noise.sigma_gyro_rps);
+        let offset = Vec3::new(0.0, 0.6, -0.8) * (0.9 * noise.sigma_gyro_rps);
+        let cases = [
+            (
+                "vibration",
+                MotionModel {
+                    vibration_accel_mps2: av,
+                    vibration_gyro_rps: wv,
+                    ..MotionModel::default()
+                },
+                Vec3::zeros(),
+            ),
+            (
+                "rate offset",
+                MotionModel {
+                    mean_rate_offset_rps: offset.norm(),
+                    ..MotionModel::default()
+                },
+                offset,
+            ),
+        ];
+        for (i, (name, m, off)) in cases.iter().enumerate() {
+            let mut det = StationarityDetector::<W>::from_noise_model(noise, DT, G, 1e-2).unwrap();
+            det.set_attitude(&Mat3::identity(), &earth_n()).unwrap();
+            let p = det.probability_declared_moving(m).unwrap();
+            let mut sim = Sim::rest(41 + i as u64, &noise, [0.0, 0.0, 0.0], Vec3::zeros());
+            // the vibration enters as extra white noise of the stated RMS
+            sim.sigma_a = libm::hypot(noise.sigma_accel_mps2, m.vibration_accel_mps2);
+            sim.sigma_g = libm::hypot(noise.sigma_gyro_rps, m.vibration_gyro_rps);
+            sim.w_b += off;
+            let mut k = 0;
+            for _ in 0..n * W {
+                if let Some(r) = det.push(&sim.sample()).unwrap() {
+                    if r.last_sample % W as u64 == W as u64 - 1 {
+                        k += usize::from(!r.stationary);
+                    }
+                }
+            }
+            let (lo, hi) = band(n, p);
+            println!("{name}: {k}/{n} windows declared moving, predicted {p:.4} (band [{lo:.0}, {hi:.0}])");
+            assert!(
+                p > 0.1 && p < 0.9,
+                "{p}: choose a case that tests the law, not its tails"
+            );
+            assert!((k as f64) >= lo && (k as f64) <= hi);
+        }
+    }
+
+    /// The O(1) running sums (refreshed every W samples) against a two-pass evaluation of
+    /// the window, after 10⁴ samples of rest, turning and accelerating data.
+    #[test]
+    fn running_sums_match_a_two_pass_evaluation() {
+        const W: usize = 50;
+        let noise = tactical(1e-3, 1e-6);
+        let mut det = StationarityDetector::<W>::from_noise_model(noise, DT, G, 1e-3).unwrap();
+        det.set_gyro_bias_rps(&Vec3::new(1e-5, -2e-5, 3e-5))
+            .unwrap();
+        det.set_accel_bias_mps2(&Vec3::new(0.01, 0.02, -0.03))
+            .unwrap();
+        det.set_earth_rate_b_rps(&Vec3::new(5e-5, 0.0, -5e-5))
+            .unwrap();
+        let mut sim = Sim::rest(51, &noise, [10.0, 20.0, 30.0], Vec3::zeros());
+        let mut buf: std::vec::Vec<Increment> = std::vec::Vec::new();
+        let mut worst = 0.0_f64;
+        for i in 0..10_000 {
+            let phase = (i / 700) % 3;
+            let s = match phase {
+                0 => sim.sample(),
+                1 => sim.sample_with(sim.f_b, sim.w_b + Vec3::new(0.3, 0.0, 0.1)),
+                _ => sim.sample_with(sim.f_b + Vec3::new(2.0, -1.0, 0.5), sim.w_b),
+            };
+            buf.push(s);
+            let Some(r) = det.push(&s).unwrap() else {
+                continue;
+            };
+            let win = &buf[buf.len() - W..];
+            let f: std::vec::Vec<Vec3> = win
+                .iter()
+                .map(|x| x.dv_b_mps / DT - Vec3::new(0.01, 0.02, -0.03))
+                .collect();
+            let w: std::vec::Vec<Vec3> = win.iter().map(|x| x.dtheta_b_rad / DT).collect();
+            let fm = f.iter().sum::<Vec3>() / W as f64;
+            let u = fm / fm.norm();
+            let we = det.expected_rate_b_rps();
+            // Skog et al.'s SHOE sum, literally
+            let t: f64 = f
+                .iter()
+                .zip(&w)
+                .map(|(fk, wk)| {
+                    (fk - G * u).norm_squared() / noise.sigma_accel_mps2.powi(2)
+                        + (wk - we).norm_squared() / noise.sigma_gyro_rps.powi(2)
+                })
+                .sum::<f64>()
+                / W as f64;
+            worst = worst.max((r.statistic - t).abs() / t);
+        }
+        println!("running sums vs two-pass SHOE sum: worst relative difference {worst:e}");
+        // the running sums subtract squares of size ‖f − centre‖² ≤ (2 m/s²)² from sums of
+        // size W·σ²-to-W·(2 m/s²)²: relative roundoff ~ W·ε·(2/σ_a)² ≈ 1e-9 at worst
+        assert!(worst < 1e-8, "{worst:e}");
+    }
+
+    #[test]
+    fn intervals_from_window_decisions() {
+        // W = 4, min 6 samples: windows ending at 3..=20, moving at 10..=12 and 20
+        let mut t = IntervalTracker::new(4, 6);
+        let mut out = std::vec::Vec::new();
+        for last in 3..=20u64 {
+            let stationary = !(10..=12).contains(&last) && last != 20;
+            if let Some(iv) = t.push_decision(last, stationary) {
+                out.push(iv);
+            }
+        }
+        if let Some(iv) = t.finish() {
+            out.push(iv);
+        }
+        // run 3..=9 covers samples 0..=9; run 13..=19 covers 10..=19 (clipped to start after 9)
+        assert_eq!(
+            out,
+            [
+                StationaryInterval {
+                    first_sample: 0,
+                    last_sample: 9
+                },
+                StationaryInterval {
+                    first_sample: 10,
+                    last_sample: 19
+                }
+            ]
+        );
+        // a short run is dropped; a strong event at sample 30 (windows 30..=33 moving)
+        // leaves exactly sample 30 out
+        let mut t = IntervalTracker::new(4, 3);
+        let mut out = std::vec::Vec::new();
+        for last in 3..=40u64 {
+            let moving = (30..=33).contains(&last) || last == 5;
+            out.extend(t.push_decision(last, !moving));
+        }
+        out.extend(t.finish());
+        assert_eq!(out.len(), 3, "{out:?}");
+        assert_eq!((out[0].first_sample, out[0].last_sample), (0, 4)); // window 3..=4
+        assert_eq!((out[1].first_sample, out[1].last_sample), (5, 29));
+        assert_eq!((out[2].first_sample, out[2].last_sample), (31, 40));
+        assert_eq!(out[1].len_samples(), 25);
+        let mut t = IntervalTracker::new(4, 100);
+        assert_eq!(t.push_decision(3, true), None);
+        assert_eq!(t.finish(), None); // 4 samples < 100
+    }
+
+    #[test]
+    fn invalid_configuration_and_input_are_refused() {
+        let ok = tactical(0.0, 0.0);
+        type D = StationarityDetector<10>;
+        assert_eq!(
+            D::from_noise_model(ok, 0.0, G, 1e-3).unwrap_err(),
+            StationarityError::InvalidConfig
+        );
+        assert_eq!(
+            D::from_noise_model(ok, DT, f64::NAN, 1e-3).unwrap_err(),
+            StationarityError::InvalidConfig
+        );
+        assert_eq!(
+            D::from_noise_model(ok, DT, G, 0.7).unwrap_err(),
+            StationarityError::InvalidConfig
+        );
+        assert_eq!(
+            D::with_threshold(ok, DT, G, -1.0).unwrap_err(),
+            StationarityError::InvalidConfig
+        );
+        let mut bad = ok;
+        bad.sigma_gyro_rps = 0.0;
+        assert_eq!(
+            D::from_noise_model(bad, DT, G, 1e-3).unwrap_err(),
+            StationarityError::InvalidConfig
+        );
+        bad = ok;
+        bad.sigma_accel_bias_mps2 = f64::INFINITY;
+        assert_eq!(
+            D::from_noise_model(bad, DT, G, 1e-3).unwrap_err(),
+            StationarityError::InvalidConfig
+        );
+        bad = ok;
+        bad.sigma_gyro_bias_rps = 1e3 * ok.sigma_gyro_rps; // κ_g = 1e7
+        assert_eq!(
+            D::from_noise_model(bad, DT, G, 1e-3).unwrap_err(),
+            StationarityError::ResidualBiasDominates
+        );
+        assert_eq!(
+            StationarityDetector::<1>::from_noise_model(ok, DT, G, 1e-3).unwrap_err(),
+            StationarityError::InvalidConfig
+        );
+        // a refused sample leaves the detector as it was
+        let mut d = D::from_noise_model(ok, DT, G, 1e-3).unwrap();
+        let mut sim = Sim::rest(61, &ok, [0.0, 0.0, 0.0], Vec3::zeros());
+        let mut e = d.clone();
+        let mut reports = (std::vec::Vec::new(), std::vec::Vec::new());
+        for i in 0..25 {
+            let s = sim.sample();
+            if i == 12 {
+                let mut nan = s;
+                nan.dv_b_mps.y = f64::NAN;
+                assert_eq!(d.push(&nan), Err(StationarityError::InvalidInput));
+                let mut huge = s;
+                huge.dtheta_b_rad.x = 1e300;
+                assert_eq!(d.push(&huge), Err(StationarityError::InvalidInput));
+            }
+            reports.0.extend(d.push(&s).unwrap());
+            reports.1.extend(e.push(&s).unwrap());
+        }
+        assert_eq!(reports.0, reports.1);
+        assert_eq!(
+            d.set_gyro_bias_rps(&Vec3::new(f64::NAN, 0.0, 0.0)),
+            Err(StationarityError::InvalidInput)
+        );
+        let m = MotionModel {
+            vibration_accel_mps2: f64::NAN,
+            ..MotionModel::default()
+        };
+        assert_eq!(
+            d.probability_declared_moving(&m),
+            Err(StationarityError::InvalidInput)
+        );
+    }
+
+    /// An explicit threshold reports the false-alarm rate it implies, and the rest
+    /// prediction returns it.
+    #[test]
+    fn explicit_threshold_round_trip() {
+        let noise = tactical(2e-4, 0.05 * DPH);
+        let a = StationarityDetector::<40>::from_noise_model(noise, DT, G, 1e-4).unwrap();
+        let b = StationarityDetector::<40>::with_threshold(noise, DT, G, a.threshold()).unwrap();
+        assert!(
+            (b.false_alarm_rate() / 1e-4 - 1.0).abs() < 1e-9,
+            "{}",
+            b.false_alarm_rate()
+        );
+        let p = a
+            .probability_declared_moving(&MotionModel::default())
+            .unwrap();
+        assert!((p / 1e-4 - 1.0).abs() < 1e-9, "{p}");
+        // W·T at rest without biases is χ²(6W − 2): the threshold is its quantile
+        let c =
+            StationarityDetector::<40>::from_noise_model(tactical(0.0, 0.0), DT, G, 1e-4).unwrap();
+        let q = chi2::chi2_quantile(1.0 - 1e-4, 6.0 * 40.0 - 2.0).unwrap();
+        assert!((c.threshold() * 40.0 / q - 1.0).abs() < 1e-12);
     }
 }
