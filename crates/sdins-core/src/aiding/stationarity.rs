@@ -25,9 +25,10 @@
 //! ```
 //!
 //! The first line is Skog et al.'s SHOE statistic with `ω̃_k` replaced by `ω̃_k − ω_e`
-//! (their foot-mounted MEMS case neglects the earth rate and the bias; a tactical gyro at
-//! 200 Hz does not allow it: 10 °/h and 15 °/h are 4–6 times its per-sample white noise
-//! after a 200-sample window); the second line is the exact split used here, computed from
+//! (their foot-mounted MEMS case neglects the earth rate and the bias; a tactical gyro does
+//! not allow it: with ARW 0.003 °/√h at 200 Hz the per-sample σ_g is 2.5 °/h, so a 10 °/h
+//! bias and the 15 °/h earth rate are 4–6 σ_g per sample and 55–85 times the window mean's
+//! σ_g/√W after W = 200 samples); the second line is the exact split used here, computed from
 //! running sums that are recomputed from the ring buffer every W samples (O(1) per
 //! sample, no drift). Stationary is declared when `T < γ`.
 //!
@@ -850,11 +851,11 @@ mod tests {
         }
     }
 
-    /// Tactical IMU at rest with a 10 °/h gyro bias, W = 200 (1 s), α = 1e-2: with
-    /// `b̂_g` and the attitude supplied (residual 0.1 °/h) the windows are stationary at the
-    /// stated rate; with neither the earth rate (10.3 °/h at 45°) and the bias (each several
-    /// times the window-mean noise σ_g/√W = 1.8 °/h) make every window moving, as the
-    /// non-central law predicts.
+    /// Tactical IMU (σ_g = 2.55 °/h per sample at 200 Hz) at rest with a gyro bias of 10 °/h
+    /// per axis, W = 200 (1 s), α = 1e-2: with `b̂_g` and the attitude supplied (residual
+    /// 0.1 °/h) the windows are stationary at the stated rate; with neither, the earth rate
+    /// (15.04 °/h) and the bias (17.3 °/h), each far above the window-mean noise
+    /// σ_g/√W = 0.18 °/h, make every window moving, as the non-central law predicts.
     #[test]
     fn earth_rate_and_gyro_bias_must_be_removed_at_tactical_grade() {
         const W: usize = 200;
