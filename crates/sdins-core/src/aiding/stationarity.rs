@@ -60,6 +60,44 @@
 //! about `3W a_v²/σ_a²` (W a_v²/σ_a² per axis). No IMU-only test can tell a standstill from
 //! perfectly smooth, straight, constant-velocity motion: there both hypotheses give the same
 //! data.
+//!
+//! ## Use
+//!
+//! ```
+//! use sdins_core::aiding::stationarity::{IntervalTracker, NoiseModel, StationarityDetector};
+//! use sdins_core::coning::Increment;
+//! use sdins_core::earth::EarthModel;
+//! use sdins_core::math::{Mat3, Vec3};
+//!
+//! let (dt, d2r) = (0.005, core::f64::consts::PI / 180.0);
+//! let earth = EarthModel::WGS84;
+//! let lat = 45.0 * d2r;
+//! let g = earth.gravity(lat, 0.0);
+//! // tactical IMU: VRW 0.03 m/s/√h, ARW 0.003 °/√h; residual biases 100 μg, 0.1 °/h
+//! let noise =
+//!     NoiseModel::from_random_walks(0.03 / 60.0, 0.003 * d2r / 60.0, dt, 1e-4 * g, 0.1 * d2r / 3600.0)?;
+//! let mut det = StationarityDetector::<200>::from_noise_model(noise, dt, g, 1e-3)?;
+//! let c_b_n = Mat3::identity(); // level, heading north
+//! det.set_attitude(&c_b_n, &earth.omega_ie_n(lat))?; // update as the attitude changes
+//! det.set_gyro_bias_rps(&Vec3::zeros())?; // b̂_g from the navigation filter
+//! let mut tracker = IntervalTracker::new(200, 200); // intervals of at least 1 s
+//! // 2 s at rest (error-free increments here)
+//! let rest = Increment::new(
+//!     c_b_n.transpose() * earth.omega_ie_n(lat) * dt,
+//!     -(c_b_n.transpose() * earth.gravity_n(lat, 0.0)) * dt,
+//! );
+//! let mut stationary = 0;
+//! for _ in 0..400 {
+//!     if let Some(report) = det.push(&rest)? {
+//!         stationary += usize::from(report.stationary);
+//!         tracker.push(&report);
+//!     }
+//! }
+//! assert_eq!(stationary, 201);
+//! let interval = tracker.finish().expect("one interval");
+//! assert_eq!((interval.first_sample, interval.last_sample), (0, 399));
+//! # Ok::<(), sdins_core::aiding::stationarity::StationarityError>(())
+//! ```
 
 pub mod chi2;
 

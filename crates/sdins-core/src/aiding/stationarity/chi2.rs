@@ -584,7 +584,7 @@ mod tests {
     /// χ² quantiles computed with mpmath 1.3.0 at 40 significant digits
     /// (bisection on the log of `gammainc(ν/2, 0, x/2, regularized=True)` or its complement,
     /// with p the exact value of the f64 literal: `1 − 0.999999` in f64 is 2.9e-11 off
-    /// 1e-6), rounded to 17 digits; the 3–4-digit entries of Abramowitz & Stegun Table 26.8 agree with them
+    /// 1e-6), rounded to 17 digits; the familiar printed table values agree with them
     /// (e.g. ν = 10: 18.307 (0.95), 23.209 (0.99); ν = 100: 124.342, 135.807).
     const QUANTILES: [(f64, f64, f64); 72] = [
         (1.0, 0.000001, 1.5707963267957189e-12),
