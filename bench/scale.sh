@@ -7,7 +7,7 @@
 #
 #   bench/scale.sh                 # builds target/release/sdins, default sizes
 #   SDINS=/path/to/sdins bench/scale.sh       # another binary (e.g. an older build)
-#   ROUTE_N=300 CMD_N=10000 bench/scale.sh    # the smaller sizes (the larger are 10×)
+#   ROUTE_N=100 CMD_N=10000 bench/scale.sh    # the smaller sizes (the larger are 10×)
 #
 # The inputs:
 #   route     ROUTE_N waypoints 4 km apart on 51 km circles (4.5° fly-by turns, 100 m/s,
@@ -19,7 +19,7 @@
 # Wall time is printed too, but on a shared machine CPU time is the figure to compare.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-ROUTE_N=${ROUTE_N:-300}
+ROUTE_N=${ROUTE_N:-100}
 CMD_N=${CMD_N:-10000}
 MAX_RATIO=${MAX_RATIO:-12}
 if [[ -z "${SDINS:-}" ]]; then
@@ -62,13 +62,12 @@ EOF
 
 # run LABEL CMD...: prints "cpu_s wall_s maxrss_MB" for the command
 measure() {
-    local out
-    out=$({ /usr/bin/time -f "%U %S %e %M" "$@" >/dev/null 2>"$work/err"; } 2>&1 | tail -1) || {
+    /usr/bin/time -o "$work/time" -f "%U %S %e %M" "$@" >/dev/null 2>"$work/err" || {
         echo "failed: $*" >&2
         cat "$work/err" >&2
         exit 1
     }
-    read -r u s e m <<<"$out"
+    read -r u s e m <"$work/time"
     awk -v u="$u" -v s="$s" -v e="$e" -v m="$m" 'BEGIN { printf "%.2f %.2f %.0f\n", u + s, e, m / 1024 }'
 }
 

@@ -239,7 +239,7 @@ pub enum RouteError {
 }
 
 /// Most waypoints in one route (docs/scenarios.md §"Routes"): compilation is linear in
-/// their number (bench/scale.sh), about 1 ms each.
+/// their number (bench/scale.sh), about 10 ms each.
 pub const MAX_WAYPOINTS: usize = 100_000;
 
 fn kind_ways(k: &LegKind) -> &'static str {
