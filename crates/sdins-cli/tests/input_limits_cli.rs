@@ -24,7 +24,12 @@ fn run_measured(args: &[&str]) -> (i32, String, f64) {
         .spawn()
         .unwrap();
     let mut err = String::new();
-    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
     let pid = child.id() as libc::pid_t;
     let mut status = 0;
     // SAFETY: an all-zero rusage is a valid value; wait4 writes it and the status for
@@ -56,7 +61,8 @@ fn two_gib_of_nul_bytes_are_refused_on_line_1_without_reading_them() {
     let big_s = big.to_str().unwrap();
     // a small valid IMU file for `fuse --imu ... --gnss big`
     let imu = d.join("imu.csv");
-    let mut text = String::from("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n");
+    let mut text =
+        String::from("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n");
     for k in 1..=200 {
         text += &format!("{},0,0,0,0,0,-0.0980665\n", k as f64 * 0.01);
     }
@@ -71,7 +77,10 @@ fn two_gib_of_nul_bytes_are_refused_on_line_1_without_reading_them() {
     ];
     for args in cases {
         let (code, err, rss_mb) = run_measured(&args);
-        eprintln!("{args:?}: exit {code}, peak RSS {rss_mb:.1} MB: {}", err.trim());
+        eprintln!(
+            "{args:?}: exit {code}, peak RSS {rss_mb:.1} MB: {}",
+            err.trim()
+        );
         assert_eq!(code, 2, "{args:?}: {err}");
         assert!(
             err.contains("big.csv") && err.contains("line 1"),
@@ -128,7 +137,52 @@ fn sigint_stops_the_compilation_of_a_huge_route() {
     let err = String::from_utf8_lossy(&res.stderr);
     assert_eq!(res.status.code(), Some(130), "{err}");
     assert!(err.contains("interrupted"), "{err}");
-    assert!(waited < Duration::from_secs(2), "stopped {waited:?} after SIGINT");
+    assert!(
+        waited < Duration::from_secs(2),
+        "stopped {waited:?} after SIGINT"
+    );
     assert!(!out.join("truth.csv").exists());
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// One waypoint or command over the stated limit is refused naming the limit and the
+/// line, exit 2 (docs/scenarios.md §"Routes", §"Importing gnss-ins-sim motion files").
+#[test]
+fn size_limits_are_stated_errors() {
+    use std::fmt::Write as _;
+    let d = tmp("sizes");
+    let mut toml = String::from("[imu]\nrate_hz = 1.0\n");
+    for k in 0..100_001 {
+        let th = 2.0 * std::f64::consts::PI * (k % 80) as f64 / 80.0;
+        let _ = write!(
+            toml,
+            "[[waypoint]]\nlat_deg = {:.6}\nlon_deg = {:.6}\nspeed_mps = 100.0\n",
+            45.0 + 0.459 * th.cos(),
+            10.0 + 0.649 * th.sin()
+        );
+    }
+    let scn = d.join("too-many-waypoints.toml");
+    std::fs::write(&scn, toml).unwrap();
+    let (code, err, _) = run_measured(&["truth", scn.to_str().unwrap(), "--quiet"]);
+    assert_eq!(code, 2, "{err}");
+    // the 100 001st [[waypoint]] is on lines 400 003–400 006
+    assert!(
+        err.contains("100000 [[waypoint]]") && err.contains("too-many-waypoints.toml:40000"),
+        "{err}"
+    );
+    let mut csv = String::from(
+        "ini lat (deg),a,b,c,d,e,f,g,h\n32,120,0,0,0,0,0,0,0\ncommand type,a,b,c,d,e,f,g,h\n",
+    );
+    for _ in 0..1_000_001 {
+        csv.push_str("1,0.5,0,0,0,0,0,1,1\n");
+    }
+    let m = d.join("too-many-commands.csv");
+    std::fs::write(&m, csv).unwrap();
+    let (code, err, _) = run_measured(&["truth", m.to_str().unwrap(), "--quiet"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("1000000 commands") && err.contains("too-many-commands.csv:1000004"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&d).ok();
 }

@@ -64,7 +64,9 @@ pub fn read_capped_with<E>(
     let mut buf: Vec<u8> = Vec::new();
     let first_end = loop {
         let start = buf.len();
-        let want = (MAX_FIRST_LINE_BYTES + 1).saturating_sub(start).min(64 * 1024);
+        let want = (MAX_FIRST_LINE_BYTES + 1)
+            .saturating_sub(start)
+            .min(64 * 1024);
         let got = (&mut f)
             .take(want as u64)
             .read_to_end(&mut buf)
@@ -162,7 +164,10 @@ mod tests {
         let long = vec![b'1'; MAX_FIRST_LINE_BYTES + 10];
         let p2 = temp("long", &long);
         let e = read_capped(&p2).unwrap_err().to_string();
-        assert!(e.contains("line 1: no line end within the first 1 MiB"), "{e}");
+        assert!(
+            e.contains("line 1: no line end within the first 1 MiB"),
+            "{e}"
+        );
         // a NUL after line 1 is the parser's business; CRLF, tabs and no final newline pass
         let p3 = temp("ok", b"a,\tb\r\n1\x002");
         assert_eq!(read_capped(&p3).unwrap(), b"a,\tb\r\n1\x002");

@@ -34,7 +34,11 @@ fn half_a_degree_from_the_antipode_is_flown_to_its_end() {
     // (azimuth −90.026°) and stays within ±45°
     let v = 150.0;
     let dt = 0.01;
-    let r = route(wp(45.0, 10.0, v), wp(-45.0, -169.5, v), LegKind::GreatCircle);
+    let r = route(
+        wp(45.0, 10.0, v),
+        wp(-45.0, -169.5, v),
+        LegKind::GreatCircle,
+    );
     let c = compile(&r, E, dt).unwrap();
     let last = c.report[1];
     eprintln!(
@@ -98,7 +102,11 @@ fn the_exact_antipode_is_ambiguous_not_coincident() {
 fn the_cut_locus_is_ambiguous_and_its_neighbourhood_is_measured() {
     // on the equator the cut locus of (0, 0) spans |λ| ≥ (1 − f)·180° = 179.3965°: at
     // 179.5° two geodesics (north and south of the equator) have the same length
-    let r = route(wp(0.0, 0.0, 100.0), wp(0.0, 179.5, 100.0), LegKind::GreatCircle);
+    let r = route(
+        wp(0.0, 0.0, 100.0),
+        wp(0.0, 179.5, 100.0),
+        LegKind::GreatCircle,
+    );
     assert!(matches!(
         compile(&r, E, 0.01),
         Err(RouteError::Ambiguous { margin_m, .. }) if margin_m < 1e-9
@@ -115,7 +123,10 @@ fn the_cut_locus_is_ambiguous_and_its_neighbourhood_is_measured() {
         match compile(&r, E, 0.01) {
             Err(RouteError::Ambiguous { margin_m, .. }) => {
                 assert!(refused, "δ = {delta}");
-                assert!((margin_m - 1.119_355 * delta).abs() < 1e-6 * delta, "{margin_m}");
+                assert!(
+                    (margin_m - 1.119_355 * delta).abs() < 1e-6 * delta,
+                    "{margin_m}"
+                );
                 assert!(margin_m < AMBIGUOUS_M);
             }
             // the leg is long, past the conjugate point's neighbourhood: what matters is
@@ -128,7 +139,11 @@ fn the_cut_locus_is_ambiguous_and_its_neighbourhood_is_measured() {
 
 #[test]
 fn coincident_waypoints_are_still_coincident() {
-    let r = route(wp(10.0, 10.0, 50.0), wp(10.0, 10.000_001, 50.0), LegKind::GreatCircle);
+    let r = route(
+        wp(10.0, 10.0, 50.0),
+        wp(10.0, 10.000_001, 50.0),
+        LegKind::GreatCircle,
+    );
     assert!(matches!(
         compile(&r, E, 0.01),
         Err(RouteError::Coincident { waypoint: 2, .. })

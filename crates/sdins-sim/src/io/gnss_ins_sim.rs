@@ -225,6 +225,11 @@ pub fn parse_motion_def_with(
 
 /// Read and parse a motion-definition file.
 pub fn read_motion_def(path: &Path) -> Result<MotionFile, GisError> {
+    read_motion_def_with(path, &CancelToken::new())
+}
+
+/// [`read_motion_def`], polling `cancel` ([`parse_motion_def_with`]).
+pub fn read_motion_def_with(path: &Path, cancel: &CancelToken) -> Result<MotionFile, GisError> {
     let file = path.display().to_string();
     let bytes = crate::input::read_capped(path).map_err(|e| GisError::Read {
         file: file.clone(),
@@ -234,7 +239,7 @@ pub fn read_motion_def(path: &Path) -> Result<MotionFile, GisError> {
         file: file.clone(),
         reason: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
     })?;
-    parse_motion_def(&text, &file)
+    parse_motion_def_with(&text, &file, cancel)
 }
 
 /// Whether a text looks like a gnss-ins-sim motion-definition file (its first line is the
@@ -477,21 +482,11 @@ pub fn import_file_with(
     opts: &ImportOptions,
     cancel: &CancelToken,
 ) -> Result<String, GisError> {
-    let file = path.display().to_string();
-    let bytes = crate::input::read_capped(path).map_err(|e| GisError::Read {
-        file: file.clone(),
-        reason: e.to_string(),
-    })?;
-    let text = String::from_utf8(bytes).map_err(|e| GisError::Read {
-        file: file.clone(),
-        reason: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-    })?;
-    let mf = parse_motion_def_with(&text, &file, cancel)?;
-    drop(text);
+    let mf = read_motion_def_with(path, cancel)?;
     let name = path
         .file_stem()
         .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned());
-    to_scenario_toml(&mf, &name, &path.display().to_string(), opts)
+    to_scenario_toml_with(&mf, &name, &path.display().to_string(), opts, cancel)
 }
 
 #[cfg(test)]
