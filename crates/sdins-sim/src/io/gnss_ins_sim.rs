@@ -93,7 +93,7 @@ pub fn parse_motion_def_with(
     // (1-based line, fields) of the non-empty lines
     let mut rows: Vec<(usize, Vec<&str>)> = Vec::new();
     for (i, l) in text.lines().enumerate() {
-        if i as u64 % POLL_EVERY_SAMPLES == 0 {
+        if (i as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
             cancel.check()?;
         }
         if l.trim().is_empty() {
@@ -171,7 +171,7 @@ pub fn parse_motion_def_with(
     let mut lines = Vec::new();
     let mut raw = vec![ini];
     for (k, row) in rows[3..].iter().enumerate() {
-        if k as u64 % POLL_EVERY_SAMPLES == 0 {
+        if (k as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
             cancel.check()?;
         }
         let c = numbers(row)?;
@@ -399,7 +399,7 @@ pub fn to_scenario_toml_with(
     let ext: std::collections::HashMap<usize, f64> =
         body.extended.iter().map(|e| (e.index, e.used_s)).collect();
     for (i, (c, &line)) in mf.commands.iter().zip(&mf.lines).enumerate() {
-        if i as u64 % POLL_EVERY_SAMPLES == 0 {
+        if (i as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
             cancel.check()?;
         }
         let _ = writeln!(s, "\n[[command]] # line {line}");

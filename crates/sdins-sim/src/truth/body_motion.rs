@@ -325,7 +325,7 @@ impl BodyMotion {
         let mut pieces = Vec::with_capacity(commands.len());
         let mut extended = Vec::new();
         for (index, c) in commands.iter().enumerate() {
-            if index as u64 % POLL_EVERY_SAMPLES == 0 {
+            if (index as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
                 poll()?;
             }
             let cmd = [

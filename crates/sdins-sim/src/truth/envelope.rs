@@ -320,7 +320,7 @@ pub fn check_trajectory_with(
         Ok(k.v_n_mps)
     };
     for (i, &(t, t_sel)) in extra.iter().enumerate() {
-        if i as u64 % POLL_EVERY_SAMPLES == 0 {
+        if (i as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
             cancel.check()?;
         }
         check_point(t, t_sel, None, &mut rep)?;
@@ -329,7 +329,7 @@ pub fn check_trajectory_with(
     let (mut lat, mut hgt) = (start.lat_rad, start.h_m);
     let mut v_prev = check_point(0.0, 0.0, None, &mut rep)?;
     for i in 1..=n_grid {
-        if i % POLL_EVERY_SAMPLES == 0 {
+        if i.is_multiple_of(POLL_EVERY_SAMPLES) {
             cancel.check()?;
         }
         let t = if i == n_grid { dur } else { i as f64 * h };
