@@ -72,7 +72,19 @@ fn two_gib_of_nul_bytes_are_refused_on_line_1_without_reading_them() {
     let out_s = out.to_str().unwrap();
     let cases: Vec<Vec<&str>> = vec![
         vec!["nav", "--imu", big_s],
-        vec!["fuse", "--imu", imu_s, "--gnss", big_s, "--out", out_s],
+        vec![
+            "fuse",
+            "--imu",
+            imu_s,
+            "--gnss",
+            big_s,
+            "--grade",
+            "tactical",
+            "--static-s",
+            "1",
+            "--out",
+            out_s,
+        ],
         vec!["truth", "--from-reference", big_s, "--out", out_s],
     ];
     for args in cases {
