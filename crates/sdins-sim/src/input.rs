@@ -160,7 +160,7 @@ mod tests {
     fn the_first_line_is_checked_before_the_rest() {
         let p = temp("nul", b"t_s,a\x00b\n1,2\n");
         let e = read_capped(&p).unwrap_err().to_string();
-        assert_eq!(e, "line 1: a NUL byte at column 4: not a text file");
+        assert_eq!(e, "line 1: a NUL byte at column 6: not a text file");
         let long = vec![b'1'; MAX_FIRST_LINE_BYTES + 10];
         let p2 = temp("long", &long);
         let e = read_capped(&p2).unwrap_err().to_string();
