@@ -16,6 +16,8 @@ fn tmp(name: &str) -> std::path::PathBuf {
 
 /// Run `sdins args`, returning (exit code, stderr, peak resident set size \[MB\]) from
 /// `wait4`'s resource usage of that child alone.
+// the child is reaped by `wait4` (for its own resource usage), not by `Child::wait`
+#[allow(clippy::zombie_processes)]
 fn run_measured(args: &[&str]) -> (i32, String, f64) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_sdins"))
         .args(args)
