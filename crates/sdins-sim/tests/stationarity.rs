@@ -72,19 +72,21 @@ fn disjoint_reports<const W: usize>(
 /// (3) the earth-rate term is what the theory says: over 10 s windows accepted with and
 /// without it, the gyro-mean part rises by `W Ω²/σ_g²` (within 3 standard errors).
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn lasergyro_parked_windows_are_accepted() {
     let Some(path) = lasergyro_path() else {
         return;
     };
     let data =
-        sdins_sim::imu_file::read_imu_file(&path, sdins_sim::imu_file::ImuFormat::Psins).unwrap();
+        sdins_sim::io::imu_file::read_imu_file(&path, sdins_sim::io::imu_file::ImuFormat::Psins)
+            .unwrap();
     let hdr = data.psins.clone().unwrap();
     let dt = data.dt_s;
     let incs = &data.increments;
     let earth = EarthModel::PSINS;
     let lat = hdr.lat_deg * D2R;
     let g = earth.gravity(lat, hdr.h_m);
-    let allan = sdins_sim::allan::analyse(incs, dt);
+    let allan = sdins_sim::analysis::allan::analyse(incs, dt);
     let adev0: Vec<f64> = allan.curves.iter().map(|c| c.adev[0]).collect();
     assert!((allan.curves[0].tau_s[0] - dt).abs() < 1e-12);
     let sigma_g = adev0[..3].iter().copied().fold(0.0, f64::max);

@@ -99,7 +99,7 @@ impl TruthObserver for Sink<'_> {
 pub fn run(args: Args) -> Result<(), CliError> {
     let (scn, t_offset) = match (&args.from_reference, &args.scenario) {
         (Some(file), _) => from_reference(file, &args)?,
-        (None, Some(name)) => (Scenario::load(name)?, 0.0),
+        (None, Some(name)) => (Scenario::load_with(name, &crate::progress::token())?, 0.0),
         (None, None) => return Err(CliError::bad("give a scenario or --from-reference FILE")),
     };
     crate::report::print_vibration(&scn);
