@@ -472,7 +472,7 @@ fn write_report(
         );
         r.svg(
             bias,
-            "Bias estimates (solid) with ±3σ (shaded) and, for scenarios, the true bias (dashed), body axes (align_bias.svg, align_bias.png).",
+            "Bias estimates (solid) with ±3σ (shaded and outlined in the estimate's color) and, for scenarios, the true bias (dashed), body axes; the states the record does not observe (σ not reduced below 90 % of its start) in their own panels (align_bias.svg, align_bias.png).",
         );
     }
     r.write(&dir.join("report.html"))

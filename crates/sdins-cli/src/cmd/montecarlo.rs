@@ -97,50 +97,69 @@ pub fn write_outputs(dir: &Path, state: &McState, stats: &McStats) -> Result<(),
     write_report(dir, state, stats)
 }
 
-/// Envelopes per channel group: mean (line) and mean ± σ (shaded band) of the N and E
-/// errors over the runs (the percentiles are in the table and the CSV). Attitude errors
-/// in μrad (the unit of free-inertial attitude errors in every report, docs/user-guide.md).
-fn envelope_figure(stats: &McStats) -> crate::plot::Figure {
+/// Envelopes of every channel the statistics hold: position, velocity and attitude
+/// error (rows) in N, E, D (columns), each with the mean over the runs (line), mean ± σ
+/// (shaded band) and the 5th and 95th percentiles (dashed). A channel that is exactly
+/// zero in every run says so on its panel: with the vertical channel held (`--vertical
+/// hold`, the Monte Carlo default) the down position and velocity errors are zero by
+/// construction. Attitude errors in μrad (the unit of free-inertial attitude errors in
+/// every report, docs/user-guide.md).
+fn envelope_figure(stats: &McStats, vertical_hold: bool) -> crate::plot::Figure {
     use crate::plot::{Band, Figure, Panel, Series};
-    let panel = |title: &str, unit: &str, first: usize, scale: f64| {
-        let mut series = Vec::new();
-        let mut bands = Vec::new();
-        for (k, axis) in ["N", "E"].iter().enumerate() {
+    let groups = [
+        ("position error", "δp", "m", 0, 1.0),
+        ("velocity error", "δv", "m/s", 3, 1.0),
+        ("attitude error", "ε", "μrad", 6, 1e6),
+    ];
+    let mut panels = Vec::new();
+    for (what, sym, unit, first, scale) in groups {
+        for (k, axis) in ["N", "E", "D"].iter().enumerate() {
             let c = first + k;
             let rows = || stats.times_s.iter().zip(&stats.cells);
-            let mean = format!("{axis} mean");
-            series.push(Series::line(
-                mean.clone(),
-                rows().map(|(t, row)| (*t, row[c].mean * scale)).collect(),
-            ));
-            bands.push(Band {
-                name: format!("{axis} mean ± σ"),
-                color_of: mean,
-                points: rows()
-                    .map(|(t, row)| {
-                        let x = &row[c];
-                        (*t, (x.mean - x.sigma) * scale, (x.mean + x.sigma) * scale)
-                    })
-                    .collect(),
+            let pick = |f: fn(&montecarlo::ChannelStats) -> f64| -> Vec<(f64, f64)> {
+                rows().map(|(t, row)| (*t, f(&row[c]) * scale)).collect()
+            };
+            let zero = rows().all(|(_, row)| {
+                let x = &row[c];
+                [x.mean, x.sigma, x.p05, x.p50, x.p95]
+                    .iter()
+                    .all(|v| *v == 0.0)
+            });
+            let note = match (zero, vertical_hold && k == 2 && first < 6) {
+                (false, _) => String::new(),
+                (true, true) => "≡ 0: vertical channel held (--vertical hold)".to_string(),
+                (true, false) => "≡ 0 in every run".to_string(),
+            };
+            panels.push(Panel {
+                title: format!("{what}, {axis}"),
+                x_label: "time [s]".into(),
+                y_label: format!("{sym}_{axis} [{unit}]"),
+                min_y_span: if zero { 1.0 } else { 0.0 },
+                series: vec![
+                    Series::line("mean", pick(|x| x.mean)),
+                    Series::dashed("p05, p95", pick(|x| x.p05)).colored_as("mean"),
+                    Series::dashed("p05, p95", pick(|x| x.p95)).colored_as("mean"),
+                ],
+                bands: vec![Band {
+                    name: "mean ± σ".into(),
+                    color_of: "mean".into(),
+                    points: rows()
+                        .map(|(t, row)| {
+                            let x = &row[c];
+                            (*t, (x.mean - x.sigma) * scale, (x.mean + x.sigma) * scale)
+                        })
+                        .collect(),
+                    outline: false,
+                }],
+                note,
+                ..Panel::default()
             });
         }
-        Panel {
-            title: title.to_string(),
-            x_label: "time [s]".into(),
-            y_label: unit.to_string(),
-            series,
-            bands,
-            ..Panel::default()
-        }
-    };
+    }
     Figure {
-        panels: vec![
-            panel("position error", "error [m]", 0, 1.0),
-            panel("velocity error", "error [m/s]", 3, 1.0),
-            panel("attitude error", "error [μrad]", 6, 1e6),
-        ],
+        panels,
         cols: 3,
-        size: (1800, 560),
+        size: (1500, 1150),
     }
 }
 
@@ -175,8 +194,8 @@ fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliE
         r.para(&format!("Statistics at the last epoch, t = {t} s:"));
         r.table(&["channel", "mean", "σ", "p05", "p50", "p95"], &rows);
     }
-    let fig = envelope_figure(stats);
-    r.figure_file(&fig, dir, "envelopes", "North and east error envelopes over the runs: mean (line) and mean ± σ (band); percentiles in the table and mc_stats.csv.")?;
+    let fig = envelope_figure(stats, job.vertical_hold);
+    r.figure_file(&fig, dir, "envelopes", "Error envelopes over the runs, position, velocity and attitude in N, E, D: mean (line), mean ± σ (band), 5th and 95th percentiles (dashed); all statistics in the table and mc_stats.csv.")?;
     r.write(&dir.join("report.html"))?;
     let mut t = toml::Table::new();
     t.insert("scenario".into(), job.scenario.clone().into());
