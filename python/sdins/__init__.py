@@ -64,6 +64,7 @@ __all__ = [
     "ErrorAnalysis",
     "FuseResult",
     "align",
+    "calibrate",
     "errors",
     "fuse",
     "schuler_share",
@@ -322,6 +323,36 @@ def errors(
     g = None if gyro_bias_dph is None else [float(x) for x in gyro_bias_dph]
     a = None if accel_bias_ug is None else [float(x) for x in accel_bias_ug]
     return ErrorAnalysis(_sdins.errors(grade, g, a, hours, lat_deg, nonlinear))
+
+
+def calibrate(
+    scenario: Union[Scenario, str],
+    imu: Optional[Any] = None,
+    imu_format: Optional[str] = None,
+    run: Optional[int] = None,
+    runs: Optional[int] = None,
+    draw_scale_ppm: Optional[Tuple[float, float]] = None,
+    draw_misalignment_mrad: Optional[Tuple[float, float]] = None,
+    draw: Optional[bool] = None,
+) -> Dict[str, Any]:
+    """Turntable calibration (``sdins calibrate``) of the scenario's schedule: on its
+    simulated IMU (run ``run``, default 0; ``runs`` > 1: a Monte Carlo over runs 0..runs)
+    or on a recorded IMU file ``imu`` (``imu_format``: auto (default), sdins, psins, …).
+
+    ``draw_scale_ppm`` / ``draw_misalignment_mrad``: the (lo, hi) magnitudes of the drawn
+    scale factors and misalignments (default (100, 1000) ppm, (0.1, 1) mrad); ``draw=False``
+    keeps the scenario's own. Returns the ``sdins calibrate --json`` summary as a dict
+    (parameters with estimate, 1σ and truth; NEES; the Monte Carlo summary).
+    """
+    import json
+
+    t = _sdins.calibrate(
+        _scenario(scenario), None if imu is None else str(imu), imu_format, run, runs,
+        None if draw_scale_ppm is None else (float(draw_scale_ppm[0]), float(draw_scale_ppm[1])),
+        None if draw_misalignment_mrad is None else (float(draw_misalignment_mrad[0]), float(draw_misalignment_mrad[1])),
+        draw,
+    )
+    return json.loads(t)
 
 
 def schuler_share() -> List[Dict[str, Any]]:
