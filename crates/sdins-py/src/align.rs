@@ -281,7 +281,10 @@ pub fn calibrate(
     let d = DrawSpec::DEFAULT;
     let req = CalibrateRequest {
         imu,
-        imu_format: imu_format.unwrap_or("auto").parse::<ImuFormat>().map_err(err)?,
+        imu_format: imu_format
+            .unwrap_or("auto")
+            .parse::<ImuFormat>()
+            .map_err(err)?,
         run: run.unwrap_or(0),
         runs: runs.unwrap_or(1),
         draw: draw.unwrap_or(true).then_some(DrawSpec {

@@ -45,7 +45,12 @@ impl DrawSpec {
     /// ([`Self::MAX_SCALE_PPM`], [`Self::MAX_MISALIGNMENT_MRAD`]).
     pub fn validate(&self) -> Result<(), CalibrationError> {
         for (key, (lo, hi), max, what) in [
-            ("scale_ppm", self.scale_ppm, Self::MAX_SCALE_PPM, "small-error"),
+            (
+                "scale_ppm",
+                self.scale_ppm,
+                Self::MAX_SCALE_PPM,
+                "small-error",
+            ),
             (
                 "misalignment_mrad",
                 self.misalignment_mrad,
