@@ -657,8 +657,8 @@ fn initial_states_from_files_are_validated() {
     assert!(err.contains("first row") && err.contains("speed"), "{err}");
 }
 
-/// Process conditions: a closed stdout ends the command quietly (SIGPIPE, exit 141 like
-/// other Unix tools, no panic message), an output folder that is a file and absurd
+/// Process conditions: a closed stdout ends the command quietly (exit 141 like other Unix
+/// tools killed by SIGPIPE, no panic message), an output folder that is a file and absurd
 /// resource requests are bad input (exit 2), non-UTF-8 arguments are refused by the parser.
 #[test]
 fn process_conditions_and_resource_bounds() {
@@ -676,9 +676,10 @@ fn process_conditions_and_resource_bounds() {
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("panicked"), "{err}");
-    use std::os::unix::process::ExitStatusExt;
+    // 141 = 128 + SIGPIPE without dying by the signal (staging folder removed), or 0 if
+    // the whole output was in the pipe before it closed
     assert!(
-        out.status.success() || out.status.signal() == Some(13),
+        out.status.success() || out.status.code() == Some(141),
         "{:?} {err}",
         out.status
     );

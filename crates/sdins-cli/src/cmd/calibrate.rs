@@ -236,38 +236,51 @@ fn finish(args: &Args, scn: &Scenario, o: &CalibrateResult) -> Result<(), CliErr
         crate::report::write_run_toml(dir, t)?;
     }
     if args.json {
-        println!("{json}");
+        outln!("{json}");
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: {} samples at {} Hz ({:.0} s); {note}",
         scn.name,
         o.samples,
         scn.imu.rate_hz,
         scn.duration_s(),
     );
-    println!(
+    outln!(
         "{:<8} {:>6} {:>14} {:>12} {:>14} {:>8}",
-        "param", "unit", "estimate", "1σ", "truth", "err/σ"
+        "param",
+        "unit",
+        "estimate",
+        "1σ",
+        "truth",
+        "err/σ"
     );
     for r in param_table(&o.rows) {
-        println!(
+        outln!(
             "{:<8} {:>6} {:>14} {:>12} {:>14} {:>8}",
-            r[0], r[1], r[2], r[3], r[4], r[5]
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            r[4],
+            r[5]
         );
     }
     if let Some(m) = &o.mc {
-        println!(
+        outln!(
             "Monte Carlo, {} runs: mean NEES {:.2} (95 % band of χ²(24·{0})/{0}: [{:.2}, {:.2}])",
-            m.runs, m.mean_nees, m.nees_band.0, m.nees_band.1
+            m.runs,
+            m.mean_nees,
+            m.nees_band.0,
+            m.nees_band.1
         );
-        println!("max |error| over runs and axes: bias, scale [ppm], misalignment [mrad]");
+        outln!("max |error| over runs and axes: bias, scale [ppm], misalignment [mrad]");
         for r in mc_rows(m) {
-            println!("  {:<14} {:>14} {:>10} {:>10}", r[0], r[1], r[2], r[3]);
+            outln!("  {:<14} {:>14} {:>10} {:>10}", r[0], r[1], r[2], r[3]);
         }
     }
     if let Some(d) = &args.out {
-        println!(
+        outln!(
             "wrote {0}/calibration.csv, {0}/calibration.json, {0}/report.html, {0}/run.toml{1}",
             d.display(),
             if o.all.is_empty() {

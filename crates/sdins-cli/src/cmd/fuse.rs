@@ -297,9 +297,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     crate::report::write_run_toml(&out, fields)?;
     if args.json {
-        println!("{summary:#}");
+        outln!("{summary:#}");
     } else {
-        println!(
+        outln!(
             "sdins fuse {}: {} fixes, {} rejected; RMS position N/E/D {:.3}/{:.3}/{:.3} m, velocity {:.4}/{:.4}/{:.4} m/s; wrote {}",
             scn.name, s.fixes, s.rejected, rms[0], rms[1], rms[2], rms[3], rms[4], rms[5],
             out.display()

@@ -375,9 +375,9 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         eprintln!("warning: {}: {w}", gnss.display());
     }
     if args.json {
-        println!("{summary:#}");
+        outln!("{summary:#}");
     } else {
-        println!(
+        outln!(
             "sdins fuse {} + {}: {} IMU samples ({}), {} fixes used ({} outside the IMU record skipped), {} rejected; wrote {}",
             imu.display(),
             gnss.display(),
@@ -391,7 +391,7 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         for (name, c) in [("forward", &r.forward), ("smoothed", &r.smoothed)] {
             if let Some(c) = c {
                 let rm = c.rmse();
-                println!(
+                outln!(
                     "  {name} RMSE vs truth: roll/pitch/yaw {:.4}/{:.4}/{:.4} deg, v N/E/D {:.4}/{:.4}/{:.4} m/s, N/E/D {:.3}/{:.3}/{:.3} m",
                     rm[0].to_degrees(), rm[1].to_degrees(), rm[2].to_degrees(), rm[3], rm[4], rm[5], rm[6], rm[7], rm[8]
                 );
