@@ -15,7 +15,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import _sdins
+from . import _sdins as _raw
 from ._results import (
     AlgorithmRun,
     AlignResult,
@@ -31,7 +31,48 @@ from ._results import (
 )
 from ._sdins import McState, Scenario, SdinsError
 
-__version__: str = _sdins.__version__
+__version__: str = _raw.__version__
+
+_U64_MAX = 2**64 - 1
+
+
+def _overflow_message(f: Any, name: str, args: tuple, kwargs: dict) -> str:
+    """Name the integer argument PyO3 could not convert (negative, or above u64)."""
+    import inspect
+
+    try:
+        bound = inspect.signature(f).bind(*args, **kwargs).arguments
+    except (TypeError, ValueError):
+        bound = {}
+    for arg, v in bound.items():
+        for x in v if isinstance(v, tuple) else (v,):
+            if isinstance(x, int) and not isinstance(x, bool) and not 0 <= x <= _U64_MAX:
+                return f"{arg} = {x}: expected a whole number in 0..={_U64_MAX}"
+    return f"{name}: an integer argument is negative or too large"
+
+
+class _Checked:
+    """``_sdins`` with PyO3's OverflowError (a negative ``seed``, ``runs``, …) raised as
+    :class:`SdinsError` naming the argument, like every other bad value."""
+
+    def __init__(self, mod: Any) -> None:
+        self._mod = mod
+
+    def __getattr__(self, name: str) -> Any:
+        f = getattr(self._mod, name)
+        if isinstance(f, type) or not callable(f):
+            return f
+
+        def call(*args: Any, **kwargs: Any) -> Any:
+            try:
+                return f(*args, **kwargs)
+            except OverflowError:
+                raise SdinsError(_overflow_message(f, name, args, kwargs)) from None
+
+        return call
+
+
+_sdins = _Checked(_raw)
 
 
 def __dir__() -> List[str]:

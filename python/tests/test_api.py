@@ -205,3 +205,18 @@ def test_statistics_and_merge_return_one_type():
     b = sdins.merge([st])
     assert type(a) is type(b) is sdins.McStatistics
     assert a.sigma.tobytes() == b.sigma.tobytes()
+
+
+@pytest.mark.parametrize(
+    "call,arg",
+    [
+        (lambda: sdins.montecarlo("turn-90dps", -1), "runs = -1"),
+        (lambda: sdins.montecarlo("turn-90dps", 2, seed=-5, until_s=1.0), "seed = -5"),
+        (lambda: sdins.run("turn-90dps", run=2**64, until_s=1.0), "run = 18446744073709551616"),
+        (lambda: sdins.truth("turn-90dps", every=-2), "every = -2"),
+    ],
+)
+def test_out_of_range_integers_raise_sdins_error_naming_the_argument(call, arg):
+    # PyO3 raises OverflowError for a negative u64; the front end says which argument
+    with pytest.raises(sdins.SdinsError, match=arg.replace("+", r"\+")):
+        call()

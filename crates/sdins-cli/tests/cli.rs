@@ -514,8 +514,8 @@ fn nav_truth_time_base_mismatch_exit_2() {
     assert_eq!(code, 0, "{err}");
 }
 
-/// An output folder that cannot be created fails with exit 1, naming it, and leaves
-/// nothing behind.
+/// An output folder that cannot be created (here: under a file) is the user's input error:
+/// exit 2 in sdins's words, naming it, and nothing left behind.
 #[test]
 fn unwritable_output_leaves_no_file() {
     let d = tmp("unwritable");
@@ -529,8 +529,11 @@ fn unwritable_output_leaves_no_file() {
         out.to_str().unwrap(),
         "--quiet",
     ]);
-    assert_eq!(code, 1, "{err}");
-    assert!(err.contains("file/sub") || err.contains("file"), "{err}");
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("file/sub") && err.contains("is a file, not a folder"),
+        "{err}"
+    );
     let names: Vec<_> = std::fs::read_dir(&d)
         .unwrap()
         .map(|e| e.unwrap().file_name())
