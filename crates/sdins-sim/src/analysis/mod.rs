@@ -6,3 +6,4 @@ pub mod allan;
 pub mod error_analysis;
 pub mod errors_run;
 pub mod montecarlo;
+pub mod static_check;
