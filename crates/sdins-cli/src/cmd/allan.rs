@@ -68,6 +68,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let svg = plot_svg(&report)?;
     write_string(&args.out.join("allan.svg"), &svg)?;
     plot_png(&report, &args.out.join("allan.png"))?;
+    for w in report.warnings() {
+        eprintln!("warning: {}: {w}", args.imu.display());
+    }
     if args.json {
         outln!("{}", json(&report));
     } else {
@@ -201,7 +204,7 @@ pub fn json(r: &AllanReport) -> String {
             }
         })
         .collect();
-    serde_json::json!({ "channels": ch }).to_string()
+    serde_json::json!({ "channels": ch, "warnings": r.warnings() }).to_string()
 }
 
 /// `allan.csv`: τ and the six deviations (gyro °/h, accelerometer μg).

@@ -7,11 +7,15 @@
 //! * white noise per sample: σ_g, σ_a = the largest Allan deviation of the three gyro and the
 //!   three accelerometer channels at τ = δt (IEEE Std 952: at the shortest τ the white noise
 //!   dominates, σ(δt) = N/√δt, exactly the per-sample σ of the detector);
-//! * the rate expected at rest is the record's own mean rate (bias plus earth rate), and g is
-//!   the norm of the record's mean specific force; the residual "bias" σ_b covers how far a
-//!   window's mean may wander from the record's mean at rest: the largest Allan deviation
-//!   at τ ≥ W·δt of the channel type (bias instability, rate random walk and the white noise
-//!   of a window mean; conservative, it counts the window's white noise twice).
+//! * the rate and specific force expected at rest are the medians, per channel, of the
+//!   means of the disjoint windows (bias plus earth rate; g is the norm of the specific
+//!   force's), and the residual "bias" σ_b, how far a window's mean may wander from them at
+//!   rest, is a robust scale of the spread of those window means: the lower quartile of
+//!   their absolute deviation from the median over 0.3186 (the lower quartile of |Z|, Z
+//!   normal), largest of the three channels of a type. It holds the white noise of a window
+//!   mean, bias instability and rate random walk, and motion in up to three windows in
+//!   four does not inflate it (an Allan deviation at τ ≥ W·δt would: a sway at half the
+//!   window's frequency is its largest term).
 //!
 //! Disjoint windows of [`WINDOW`] samples are tested at false-alarm rate [`ALPHA`]: on a
 //! static record the expected share of windows declared moving is ≤ α (plus what the record's
@@ -20,6 +24,7 @@
 //! apart from a static record by any IMU-only test (docs/theory/aiding-sensors.md).
 
 use super::allan::AllanReport;
+
 use sdins_core::aiding::stationarity::{NoiseModel, StationarityDetector};
 use sdins_core::coning::Increment;
 use sdins_core::math::Vec3;
@@ -30,6 +35,16 @@ pub const WINDOW: usize = 100;
 pub const ALPHA: f64 = 1e-3;
 /// Largest share of windows declared moving for a record still called static.
 pub const MAX_MOVING_SHARE: f64 = 0.10;
+
+/// The lower quartile of |Z|, Z standard normal (Φ⁻¹(0.625)).
+const LOWER_QUARTILE_ABS_NORMAL: f64 = 0.318_639_363_964_375;
+
+/// The `p`-quantile of `v` (nearest rank; sorts `v`).
+fn quantile(v: &mut [f64], p: f64) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let k = ((v.len() as f64 - 1.0) * p).round() as usize;
+    v.get(k).copied().unwrap_or(0.0)
+}
 
 /// The verdict over one record.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,27 +92,42 @@ pub fn check(incs: &[Increment], dt_s: f64, allan: &AllanReport) -> Option<Stati
             .filter_map(|c| c.adev.first().copied())
             .fold(0.0_f64, f64::max)
     };
-    let wander = |r: std::ops::Range<usize>| {
-        let t_min = WINDOW as f64 * dt_s;
-        allan.curves[r]
-            .iter()
-            .flat_map(|c| c.tau_s.iter().zip(&c.adev))
-            .filter(|(t, _)| **t >= t_min)
-            .map(|(_, a)| *a)
-            .fold(0.0_f64, f64::max)
+    // per channel: the means of the disjoint windows, their median, and a robust scale of
+    // their spread about it (the lower quartile of |deviation| over 0.3186, the lower
+    // quartile of |Z| for Z normal): unaffected by up to three windows in four moving
+    let windows = incs.len() / WINDOW;
+    let channel = |ch: usize| -> (f64, f64) {
+        let mut means: Vec<f64> = (0..windows)
+            .map(|w| {
+                incs[w * WINDOW..(w + 1) * WINDOW]
+                    .iter()
+                    .map(|i| {
+                        if ch < 3 {
+                            i.dtheta_b_rad[ch]
+                        } else {
+                            i.dv_b_mps[ch - 3]
+                        }
+                    })
+                    .sum::<f64>()
+                    / (WINDOW as f64 * dt_s)
+            })
+            .collect();
+        let med = quantile(&mut means, 0.5);
+        let mut dev: Vec<f64> = means.iter().map(|m| (m - med).abs()).collect();
+        (med, quantile(&mut dev, 0.25) / LOWER_QUARTILE_ABS_NORMAL)
     };
+    let ch: Vec<(f64, f64)> = (0..6).map(channel).collect();
+    let wander = |r: std::ops::Range<usize>| ch[r].iter().map(|c| c.1).fold(0.0_f64, f64::max);
     let noise = NoiseModel {
         sigma_accel_mps2: first(3..6),
         sigma_gyro_rps: first(0..3),
         sigma_accel_bias_mps2: wander(3..6),
         sigma_gyro_bias_rps: wander(0..3),
     };
-    let n = incs.len() as f64;
-    let mean_f: Vec3 = incs.iter().map(|i| i.dv_b_mps).sum::<Vec3>() / (n * dt_s);
-    let mean_w: Vec3 = incs.iter().map(|i| i.dtheta_b_rad).sum::<Vec3>() / (n * dt_s);
+    let mean_w = Vec3::new(ch[0].0, ch[1].0, ch[2].0);
+    let mean_f = Vec3::new(ch[3].0, ch[4].0, ch[5].0);
     let mut det =
-        StationarityDetector::<WINDOW>::from_noise_model(noise, dt_s, mean_f.norm(), ALPHA)
-            .ok()?;
+        StationarityDetector::<WINDOW>::from_noise_model(noise, dt_s, mean_f.norm(), ALPHA).ok()?;
     det.set_gyro_bias_rps(&mean_w).ok()?;
     let mut c = StaticCheck {
         windows: 0,
@@ -155,15 +185,16 @@ mod tests {
         assert!(c.warning("an Allan deviation").is_none());
 
         let mut s = ImuErrorState::new(&m, 7, 0).unwrap();
-        let half: Vec<Increment> = (0..n)
-            .map(|k| s.apply(&ideal(k, k >= n / 2), dt))
-            .collect();
+        let half: Vec<Increment> = (0..n).map(|k| s.apply(&ideal(k, k >= n / 2), dt)).collect();
         let rep = super::super::allan::analyse(&half, dt);
         let c = check(&half, dt, &rep).unwrap();
         // the sway is 0.14 m/s² RMS against σ_a ≈ a few mm/s² per sample: every swaying
         // window fails its scatter term
         assert!(c.moving_share() > 0.45, "{c:?}");
         let w = c.warning("an Allan deviation").unwrap();
-        assert!(w.contains("does not look static") && w.contains("Allan"), "{w}");
+        assert!(
+            w.contains("does not look static") && w.contains("Allan"),
+            "{w}"
+        );
     }
 }
