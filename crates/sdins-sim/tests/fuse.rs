@@ -871,7 +871,7 @@ fn zero_prior_scale_factor_filter_equals_15_state_filter() {
             let dp = (x.p[(i, i)] - y.p[(i, i)]).abs() / x.p[(i, i)].max(1e-300);
             worst = worst.max(dp);
         }
-        assert!(y.scale_factors.is_some() && x.scale_factors.is_none());
+        assert!(y.scale_factors().is_some() && x.scale_factors().is_none());
     }
     println!("largest difference 15 vs 21 states (in σ or relative variance): {worst:.2e}");
     // rounding only: a few hundred epochs of 1e-16 relative operations
@@ -891,7 +891,7 @@ fn scale_factor_filter_estimates_observable_scale_factors() {
     scn.imu.model.accel_scale_ppm = [0.0, 0.0, -800.0];
     let (e, s) = epochs_of(&scn, &sf_opts(1000.0, 1000.0));
     let last = e.last().unwrap();
-    let sf = last.scale_factors.unwrap();
+    let sf = last.scale_factors().unwrap();
     let (ts_a, ts_g) = s.true_scale.unwrap();
     assert!((ts_a.z + 800e-6).abs() < 1e-18 && (ts_g.z - 1500e-6).abs() < 1e-18);
     for (i, name) in [(2, "accel z"), (5, "gyro z")] {
@@ -972,12 +972,12 @@ fn mc_consistency_scale_factors_tactical() {
         check_band(&format!("21-state NEES {name}"), &m, 3.0, 100.0);
     }
     for (name, i0) in [("accel scale factor", 0), ("gyro scale factor", 3)] {
-        let m = means(&|e| e.scale_factors.unwrap().nees_block(i0));
+        let m = means(&|e| e.scale_factors().unwrap().nees_block(i0));
         check_band(&format!("21-state NEES {name}"), &m, 3.0, 100.0);
     }
     let mut ratio = [0.0; 6];
     for r in &runs {
-        let (a, b) = (r[0].scale_factors.unwrap(), r[n - 1].scale_factors.unwrap());
+        let (a, b) = (r[0].scale_factors().unwrap(), r[n - 1].scale_factors().unwrap());
         for (i, x) in ratio.iter_mut().enumerate() {
             *x += (b.p[(i, i)] / a.p[(i, i)]).sqrt() / runs.len() as f64;
         }

@@ -1,6 +1,11 @@
-//! Aided navigation: the linear navigation-error model and the INS/GNSS error-state
-//! Kalman filter with closed-loop correction (see `docs/theory/ins-gnss.md`).
+//! Aided navigation: the linear navigation-error model, the state layout, the measurement
+//! interface and the error-state Kalman filter with closed-loop correction, and the
+//! Rauch–Tung–Striebel smoother step (see `docs/theory/ins-gnss.md`).
 
 pub mod ekf;
 pub mod error_model;
+pub mod history;
+pub mod layout;
+pub mod linalg;
+pub mod meas;
 pub mod rts;
