@@ -257,8 +257,10 @@ struct Track {
     /// per epoch: the estimates (n values) and the state
     epoch_est: Vec<f64>,
     epoch_state: Vec<NavState>,
-    /// per row: the compact state, its update index and epoch
+    /// per row: the state (compact without a truth, exact with one), its update index
+    /// and epoch
     rows: Vec<(Compact, u64, u32)>,
+    exact: Vec<NavState>,
     truth: Vec<TruthSample>,
 }
 
@@ -332,6 +334,7 @@ pub fn run_engine(
             epoch_est: Vec::with_capacity(epochs * nx),
             epoch_state: Vec::with_capacity(epochs),
             rows: Vec::with_capacity(rows.min(cfg.total_updates as usize + 1)),
+            exact: Vec::new(),
             truth: Vec::new(),
         }
     });
@@ -365,6 +368,7 @@ pub fn run_engine(
             t.rows.push((Compact::of(&st), j, epoch as u32));
             if let Some(tr) = truth {
                 t.truth.push(*tr);
+                t.exact.push(st);
             }
         }
     };
@@ -530,7 +534,8 @@ fn smooth_rows(
             e += 1;
         }
         let x = corr.at(e, c.t_s);
-        let s = correct_nav_state(&c.state(), &x);
+        let fwd = t.exact.get(i).copied().unwrap_or_else(|| c.state());
+        let s = correct_nav_state(&fwd, &x);
         let mut est = XVec::zeros();
         for k in 0..nx {
             est[k] = t.epoch_est.get(e * nx + k).copied().unwrap_or(0.0);
