@@ -41,7 +41,7 @@ use sdins_core::aiding::linalg::MAX_ROWS;
 use sdins_core::aiding::meas::{GnssMeasurement, MeasKind};
 use sdins_core::coning::Increment;
 use sdins_core::earth::EarthModel;
-use sdins_core::math::{Quat, Vec3};
+use sdins_core::math::Vec3;
 use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, NavState};
 use std::collections::VecDeque;
 
@@ -216,52 +216,17 @@ pub enum EngineError {
     Cancelled(#[from] Cancelled),
 }
 
-/// Compact forward state kept for the smoother (88 bytes).
-#[derive(Clone, Copy, Debug)]
-struct Compact {
-    t_s: f64,
-    lat: f64,
-    lon: f64,
-    h: f64,
-    v: [f64; 3],
-    q: [f64; 4],
-}
-
-impl Compact {
-    fn of(s: &NavState) -> Self {
-        let q = Quat::from_dcm(&s.c_b_n);
-        Self {
-            t_s: s.t_s,
-            lat: s.lat_rad,
-            lon: s.lon_rad,
-            h: s.h_m,
-            v: [s.v_n_mps.x, s.v_n_mps.y, s.v_n_mps.z],
-            q: [q.w, q.x, q.y, q.z],
-        }
-    }
-    fn state(&self) -> NavState {
-        NavState {
-            t_s: self.t_s,
-            lat_rad: self.lat,
-            lon_rad: self.lon,
-            h_m: self.h,
-            v_n_mps: Vec3::from(self.v),
-            c_b_n: Quat::new(self.q[0], self.q[1], self.q[2], self.q[3]).to_dcm(),
-        }
-    }
-}
-
 /// The smoother's forward records.
 struct Track {
     log: SmootherLog,
     /// per epoch: the estimates (n values) and the state
     epoch_est: Vec<f64>,
     epoch_state: Vec<NavState>,
-    /// per row: the state (compact without a truth, exact with one), its update index
-    /// and epoch
-    rows: Vec<(Compact, u64, u32)>,
-    exact: Vec<NavState>,
+    /// per row: the forward state
+    rows: Vec<NavState>,
     truth: Vec<TruthSample>,
+    /// update interval \[s\]
+    dt_update_s: f64,
 }
 
 impl Track {
@@ -334,8 +299,8 @@ pub fn run_engine(
             epoch_est: Vec::with_capacity(epochs * nx),
             epoch_state: Vec::with_capacity(epochs),
             rows: Vec::with_capacity(rows.min(cfg.total_updates as usize + 1)),
-            exact: Vec::new(),
             truth: Vec::new(),
+            dt_update_s: cfg.dt_s * n as f64,
         }
     });
     let mut cov_state = ekf.state();
@@ -365,10 +330,9 @@ pub fn run_engine(
         };
         observe(EngineEvent::Forward(&row));
         if let Some(t) = track.as_mut() {
-            t.rows.push((Compact::of(&st), j, epoch as u32));
+            t.rows.push(st);
             if let Some(tr) = truth {
                 t.truth.push(*tr);
-                t.exact.push(st);
             }
         }
     };
@@ -526,16 +490,15 @@ fn smooth_rows(
         }
     })?;
     let mut e = 0usize;
-    for (i, (c, j, _)) in t.rows.iter().enumerate() {
+    for (i, fwd) in t.rows.iter().enumerate() {
         if i % 4096 == 0 {
             cancel.check()?;
         }
-        while e + 1 < corr.len() && t.log.t_s(e + 1).is_some_and(|te| te <= c.t_s + 1e-9) {
+        while e + 1 < corr.len() && t.log.t_s(e + 1).is_some_and(|te| te <= fwd.t_s + 1e-9) {
             e += 1;
         }
-        let x = corr.at(e, c.t_s);
-        let fwd = t.exact.get(i).copied().unwrap_or_else(|| c.state());
-        let s = correct_nav_state(&fwd, &x);
+        let x = corr.at(e, fwd.t_s);
+        let s = correct_nav_state(fwd, &x);
         let mut est = XVec::zeros();
         for k in 0..nx {
             est[k] = t.epoch_est.get(e * nx + k).copied().unwrap_or(0.0);
@@ -547,7 +510,7 @@ fn smooth_rows(
             continue;
         };
         let row = Row {
-            index: *j,
+            index: (fwd.t_s / t.dt_update_s).round() as u64,
             t_s: t0 + s.t_s,
             state: &s,
             est: &est,

@@ -279,12 +279,17 @@ pub fn scenario_start<'a>(
     let dp = Vec3::from_fn(|i, _| s.pos_ned_m[i] * w[i]);
     let dv = Vec3::from_fn(|i, _| s.vel_ned_mps[i] * w[3 + i]);
     let eps = Vec3::from_fn(|i, _| s.att_rad[i] * w[6 + i]);
-    let mut init = InitialState {
-        lat_rad: init_true.lat_rad + dp.x / t0.x,
-        lon_rad: init_true.lon_rad + dp.y / t0.y,
-        h_m: init_true.h_m - dp.z,
-        v_n_mps: init_true.v_n_mps + dv,
-        c_b_n: Quat::from_rotvec(&eps).to_dcm() * init_true.c_b_n,
+    // without drawn errors the truth itself (adding zero errors would turn −0 into +0)
+    let mut init = if opts.draw_initial_errors {
+        InitialState {
+            lat_rad: init_true.lat_rad + dp.x / t0.x,
+            lon_rad: init_true.lon_rad + dp.y / t0.y,
+            h_m: init_true.h_m - dp.z,
+            v_n_mps: init_true.v_n_mps + dv,
+            c_b_n: Quat::from_rotvec(&eps).to_dcm() * init_true.c_b_n,
+        }
+    } else {
+        init_true
     };
     let mut layout = noise.layout();
     if opts.scale_factors.is_some() {

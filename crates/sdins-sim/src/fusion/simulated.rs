@@ -244,6 +244,10 @@ pub struct FuseEpoch {
     pub nav: NavError,
     /// the true attitude at the epoch
     pub c_b_n_true: Mat3,
+    /// the filter's navigation state (its `t_s` counts from the navigation start)
+    pub state: NavState,
+    /// the filter's sensor-parameter estimates (at their block offsets)
+    pub est: XVec,
 }
 
 /// The scale-factor states of a row (accelerometer x, y, z then gyro x, y, z): true error
@@ -463,6 +467,8 @@ fn epoch_of(row: &Row<'_>, p: &Cov, truth: &TruthSample, earth: &EarthModel, tr:
         ),
         nav: ne,
         c_b_n_true: truth.c_b_n,
+        state: *st,
+        est: *est,
     }
 }
 
