@@ -3,6 +3,8 @@
 //! ([`allan`]).
 
 pub mod allan;
+pub mod consistency;
 pub mod error_analysis;
 pub mod errors_run;
+pub mod fuse_mc;
 pub mod montecarlo;

@@ -7,6 +7,7 @@
 pub mod engine;
 pub mod files;
 pub mod records;
+pub mod request;
 pub mod scenario_stream;
 pub mod simulated;
 pub mod smoother;

@@ -251,6 +251,8 @@ pub struct RecordSummary {
     pub final_scale: (Vec3, Vec3),
     /// bytes held by the smoother log (0 without smoothing)
     pub smoother_bytes: usize,
+    /// the state layout
+    pub layout: StateLayout,
 }
 
 /// The matrix `M` of the first-order Euler-angle errors in terms of the attitude error
@@ -518,6 +520,7 @@ pub fn fuse_records(
         final_bias: (vec3_at(&s.est, Some(I_BA)), vec3_at(&s.est, Some(I_BG))),
         final_scale: (vec3_at(&s.est, a), vec3_at(&s.est, g)),
         smoother_bytes: s.smoother_bytes,
+        layout: s.layout,
     })
 }
 
