@@ -1,5 +1,6 @@
 //! Error analysis and statistics: INS error propagation and the Schuler analysis
-//! ([`error_analysis`], [`errors_run`]), Monte Carlo ([`montecarlo`]) and Allan variance
+//! ([`error_analysis`], [`errors_run`]), Monte Carlo ([`montecarlo`]), the fusion Monte
+//! Carlo ([`fuse_mc`]) and its consistency criterion ([`consistency`]), and Allan variance
 //! ([`allan`]).
 
 pub mod allan;

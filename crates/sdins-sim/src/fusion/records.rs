@@ -847,7 +847,7 @@ mod tests {
         for j in 0..3 {
             let mut eps = Vec3::zeros();
             eps[j] = h;
-            let cp = Quat::from_rotvec(&eps).to_dcm() * c;
+            let cp = sdins_core::math::Quat::from_rotvec(&eps).to_dcm() * c;
             let e = sdins_core::math::euler_from_c_b_n(&cp);
             let d = [
                 (e.roll_rad - e0.roll_rad) / h,
