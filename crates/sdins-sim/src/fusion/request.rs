@@ -131,6 +131,17 @@ impl FuseRequest {
     }
 }
 
+impl FuseRequest {
+    /// Check the options shared by both modes (the rest is checked when it runs).
+    pub fn check(&self) -> Result<(), FuseRunError> {
+        let samples = match &self.data {
+            FuseData::Scenario(d) => d.scenario.nav.samples,
+            FuseData::Files(_) => 2,
+        };
+        common(self, samples).map(|_| ())
+    }
+}
+
 /// Why a request failed.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
