@@ -118,6 +118,10 @@ pub struct Args {
     /// Monte Carlo: runs per block (all shards must use the same)
     #[arg(long, requires = "runs", default_value_t = 16)]
     pub block: u64,
+    /// Monte Carlo with --scale-factors-ppm: draw each run's true scale factors from the
+    /// filter's prior (instead of the scenario's)
+    #[arg(long, requires = "runs")]
+    pub draw_scale_factors: bool,
     /// Monte Carlo: worker threads (default: all cores)
     #[arg(long, requires = "runs")]
     pub threads: Option<usize>,

@@ -35,6 +35,7 @@ pub fn run(args: &Args, req: &FuseRequest) -> Result<(), CliError> {
         runs,
         seed: args.seed.unwrap_or(d.scenario.imu.seed),
         block: args.block,
+        draw_scale_factors: args.draw_scale_factors,
     };
     let shard = match &args.shard {
         None => Shard::ALL,

@@ -11,6 +11,10 @@
 //! split ([`super::montecarlo::plan`]). The seed replaces both the scenario's `[imu] seed`
 //! and its `[gnss] seed` (their random streams are disjoint by construction).
 //!
+//! With [`FuseMcOptions::draw_scale_factors`] each run's true scale factors are drawn
+//! from the filter's prior (stream `2⁶² + run` of the seed; disjoint from the IMU streams
+//! `6·run + channel` and the GNSS streams `2⁶³ + 16·run + channel`).
+//!
 //! NIS cells: the updates of a kind applied after the previous output row and up to this
 //! one (so with rows at the covariance epochs and 1 Hz fixes, one NIS per run at the fix
 //! epochs and none elsewhere; a cell's count says how many).
@@ -28,6 +32,9 @@ use crate::fusion::simulated::{
 };
 use crate::scenario::Scenario;
 use crate::sensors::gnss::GnssConfig;
+use rand::SeedableRng;
+use rand_chacha::ChaCha20Rng;
+use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use sdins_core::aiding::layout::{BlockKind, StateLayout};
 use sdins_core::aiding::meas::MeasKind;
@@ -59,6 +66,11 @@ pub struct FuseMcOptions {
     pub seed: u64,
     /// block size K
     pub block: u64,
+    /// with scale-factor states: draw each run's true accelerometer and gyro scale
+    /// factors from the filter's prior (normal, σ of the prior per axis; a stream of the
+    /// seed per run), replacing the scenario's, so that the truth is distributed as the
+    /// filter assumes
+    pub draw_scale_factors: bool,
 }
 
 /// Why a fusion Monte Carlo stopped.
@@ -103,6 +115,8 @@ pub struct FuseMcJob {
     pub seed: u64,
     /// block size K
     pub block: u64,
+    /// the true scale factors drawn per run from the prior
+    pub draw_scale_factors: bool,
     /// statistics: `nees_<block>` then `nis_<kind>`
     pub columns: Vec<String>,
     /// their degrees of freedom
@@ -215,6 +229,7 @@ fn setup(
         runs: mc.runs,
         seed: mc.seed,
         block: mc.block,
+        draw_scale_factors: mc.draw_scale_factors && opts.scale_factors.is_some(),
         columns,
         dof,
     };
@@ -234,6 +249,25 @@ fn one_run(
     run: u64,
 ) -> Result<RunRows, FuseMcError> {
     let n_nees = job.columns.iter().filter(|c| c.starts_with("nees_")).count();
+    let drawn;
+    let scn = match (&opts.scale_factors, job.draw_scale_factors) {
+        (Some(sp), true) => {
+            let mut rng = ChaCha20Rng::seed_from_u64(job.seed);
+            rng.set_stream((1u64 << 62) | run);
+            let mut s = scn.clone();
+            for i in 0..3 {
+                let (wa, wg): (f64, f64) = (
+                    StandardNormal.sample(&mut rng),
+                    StandardNormal.sample(&mut rng),
+                );
+                s.imu.model.accel_scale_ppm[i] = sp.accel_ppm[i] * wa;
+                s.imu.model.gyro_scale_ppm[i] = sp.gyro_ppm[i] * wg;
+            }
+            drawn = s;
+            &drawn
+        }
+        _ => scn,
+    };
     let mut times = Vec::new();
     let mut nees = Vec::new();
     let mut nis: Vec<Vec<(usize, f64)>> = Vec::new();
