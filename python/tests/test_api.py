@@ -174,3 +174,30 @@ def test_gnss_ins_sim_motion_file_as_scenario(shared_data):
     a = sdins.truth(s, until_s=2.0)
     b = sdins.truth(u, until_s=2.0)
     assert np.array_equal(a.dv_mps, b.dv_mps)
+
+
+def test_docs_list_every_builtin_scenario():
+    """docs/python.md names every built-in scenario (a new one must be documented)."""
+    import pathlib
+    import re
+
+    doc = (pathlib.Path(__file__).parents[2] / "docs" / "python.md").read_text()
+    line = next(l for l in doc.splitlines() if l.startswith("| `sdins.Scenario.builtin(name)`"))
+    listed = set(re.findall(r"`([a-z0-9-]+)`", line.split("|")[2]))
+    names = {n for n, _ in sdins.scenarios()}
+    assert names <= listed, names - listed
+
+
+def test_dir_shows_only_the_public_api():
+    public = set(sdins.__all__) | {"__version__"}
+    assert set(dir(sdins)) == public
+    for hidden in ("Any", "Dict", "np", "Optional"):
+        assert hidden not in dir(sdins)
+
+
+def test_statistics_and_merge_return_one_type():
+    st = sdins.montecarlo("turn-90dps", 2, 1, grade="tactical", until_s=1.0, every_s=0.5)
+    a = st.statistics()
+    b = sdins.merge([st])
+    assert type(a) is type(b) is sdins.McStatistics
+    assert a.sigma.tobytes() == b.sigma.tobytes()

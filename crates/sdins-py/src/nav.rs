@@ -11,9 +11,9 @@ use pyo3::types::PyDict;
 use sdins_core::nav::{InitialState, NavState};
 use sdins_sim::nav::options::{self, AlgoChoice};
 use sdins_sim::nav::pipeline::{NavError, RunObserver};
+use sdins_sim::nav::recorded;
 use sdins_sim::nav::run::{self as run_lib, RunRequest, SensorRun};
 use sdins_sim::truth::TruthSample;
-use sdins_sim::nav::recorded;
 
 /// Navigation-state columns.
 #[derive(Default)]

@@ -977,7 +977,10 @@ fn mc_consistency_scale_factors_tactical() {
     }
     let mut ratio = [0.0; 6];
     for r in &runs {
-        let (a, b) = (r[0].scale_factors().unwrap(), r[n - 1].scale_factors().unwrap());
+        let (a, b) = (
+            r[0].scale_factors().unwrap(),
+            r[n - 1].scale_factors().unwrap(),
+        );
         for (i, x) in ratio.iter_mut().enumerate() {
             *x += (b.p[(i, i)] / a.p[(i, i)]).sqrt() / runs.len() as f64;
         }
@@ -1069,8 +1072,14 @@ fn late_fix_case(nhc_sigma_mps: Option<f64>) {
             EngineEvent::Update(u) => reps.push(*u),
             _ => {}
         };
-        run_engine(&mut stream, &setup.start, &setup.cfg, &CancelToken::new(), &mut sink)
-            .unwrap();
+        run_engine(
+            &mut stream,
+            &setup.start,
+            &setup.cfg,
+            &CancelToken::new(),
+            &mut sink,
+        )
+        .unwrap();
         (rows, reps)
     };
     // Q over the delay (tactical: VRW 100 μg/√Hz, ARW 0.01 °/√h), NED metres

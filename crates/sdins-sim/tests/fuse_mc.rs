@@ -26,7 +26,11 @@ fn maneuver(grade: &str, minutes: u32) -> Scenario {
             ("turn", "rate_dps = -9.0"),
             ("sturn", "amplitude_dps = 5.0"),
         ] {
-            write!(segs, "[[segment]]\ntype = \"{kind}\"\nduration_s = 10.0\n{extra}\n").unwrap();
+            write!(
+                segs,
+                "[[segment]]\ntype = \"{kind}\"\nduration_s = 10.0\n{extra}\n"
+            )
+            .unwrap();
         }
     }
     let toml = format!(
@@ -46,7 +50,11 @@ fn loops(minutes: u32) -> Scenario {
             ("accelerate", "accel_mps2 = -0.5", 5.0),
             ("turn", "rate_dps = 9.0", 20.0),
         ] {
-            write!(segs, "[[segment]]\ntype = \"{kind}\"\nduration_s = {dur}\n{extra}\n").unwrap();
+            write!(
+                segs,
+                "[[segment]]\ntype = \"{kind}\"\nduration_s = {dur}\n{extra}\n"
+            )
+            .unwrap();
         }
     }
     let toml = format!(
@@ -151,9 +159,18 @@ fn bit_identical_for_threads_and_shards() {
     bad.blocks[0].moments[0].n += 1;
     assert!(bad.validate().is_err());
     // a Monte Carlo needs runs, a scenario, and runs that share their epochs
-    assert!(run_shard(&req, &FuseMcOptions { runs: 0, ..mc }, Shard::ALL, &none, &go).is_err());
+    assert!(run_shard(
+        &req,
+        &FuseMcOptions { runs: 0, ..mc },
+        Shard::ALL,
+        &none,
+        &go
+    )
+    .is_err());
     assert_eq!(
-        run_shard(&req, &mc, Shard::ALL, &none, &|| true).unwrap_err().to_string(),
+        run_shard(&req, &mc, Shard::ALL, &none, &|| true)
+            .unwrap_err()
+            .to_string(),
         "interrupted"
     );
 }

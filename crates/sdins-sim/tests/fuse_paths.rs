@@ -30,7 +30,11 @@ fn scenario() -> Scenario {
         ("turn", "rate_dps = -9.0"),
         ("sturn", "amplitude_dps = 5.0"),
     ] {
-        write!(segs, "[[segment]]\ntype = \"{kind}\"\nduration_s = 10.0\n{extra}\n").unwrap();
+        write!(
+            segs,
+            "[[segment]]\ntype = \"{kind}\"\nduration_s = 10.0\n{extra}\n"
+        )
+        .unwrap();
     }
     let toml = format!(
         "name = \"two-paths\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nh_m = 100.0\nspeed_mps = 10.0\nyaw_deg = 30.0\n[imu]\nrate_hz = 128.0\nseed = 11\ngrade = \"tactical\"\n[nav]\nsamples = 2\n{segs}{segs}"
@@ -80,25 +84,31 @@ fn scenario_in_memory_and_through_files_give_bit_identical_estimates() {
             smoothed: Vec::new(),
             updates: Vec::new(),
         };
-        let sa = fuse_scenario(&scn, &gnss, &opts, run, &CancelToken::new(), |ev| match ev {
-            FuseEvent::Epoch(e) => {
-                let sig = std::array::from_fn(|i| e.p[(3 + i, 3 + i)].max(0.0).sqrt());
-                let b = std::array::from_fn(|i| e.est[9 + i]);
-                a.rows.push((e.t_s, e.state, b, sig));
-            }
-            FuseEvent::Smoothed(e) => {
-                a.smoothed
-                    .push((e.t_s, e.state, std::array::from_fn(|i| e.est[9 + i])))
-            }
-            FuseEvent::Update(u) => a.updates.push(*u),
-            _ => {}
-        })
+        let sa = fuse_scenario(
+            &scn,
+            &gnss,
+            &opts,
+            run,
+            &CancelToken::new(),
+            |ev| match ev {
+                FuseEvent::Epoch(e) => {
+                    let sig = std::array::from_fn(|i| e.p[(3 + i, 3 + i)].max(0.0).sqrt());
+                    let b = std::array::from_fn(|i| e.est[9 + i]);
+                    a.rows.push((e.t_s, e.state, b, sig));
+                }
+                FuseEvent::Smoothed(e) => {
+                    a.smoothed
+                        .push((e.t_s, e.state, std::array::from_fn(|i| e.est[9 + i])))
+                }
+                FuseEvent::Update(u) => a.updates.push(*u),
+                _ => {}
+            },
+        )
         .unwrap();
         // to files: the same run's IMU record and fixes
         let (imu, fixes) = record_from_scenario(&scn, &gnss, run).unwrap();
-        let mut text = String::from(
-            "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n",
-        );
+        let mut text =
+            String::from("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n");
         for (k, i) in imu.increments.iter().enumerate() {
             let (th, dv) = (i.dtheta_b_rad, i.dv_b_mps);
             writeln!(
@@ -180,7 +190,11 @@ fn scenario_in_memory_and_through_files_give_bit_identical_estimates() {
         assert_eq!(imu.dt_s, 1.0 / 128.0);
         assert_eq!(sb.imu_dt_s, imu.dt_s);
         assert_eq!(sb.summary.fixes_used, sa.fixes);
-        assert!(a.rows.len() == 481 && a.updates.len() > 1300, "{}", a.rows.len());
+        assert!(
+            a.rows.len() == 481 && a.updates.len() > 1300,
+            "{}",
+            a.rows.len()
+        );
         println!(
             "scale factors {}: {} rows, {} smoothed rows, {} updates ({} fixes)",
             sf.is_some(),
@@ -204,7 +218,10 @@ fn scenario_in_memory_and_through_files_give_bit_identical_estimates() {
         assert_eq!(a.updates.len(), b.updates.len());
         for (x, y) in a.updates.iter().zip(&b.updates) {
             assert_eq!(x.nis.to_bits(), y.nis.to_bits(), "{x:?} {y:?}");
-            assert_eq!(x.innovation.map(f64::to_bits), y.innovation.map(f64::to_bits));
+            assert_eq!(
+                x.innovation.map(f64::to_bits),
+                y.innovation.map(f64::to_bits)
+            );
             assert_eq!(x.t_s.to_bits(), y.t_s.to_bits());
         }
         assert_eq!(

@@ -30,8 +30,28 @@ fn err_row(p: &RecordPoint, e: &[f64; 9]) -> ErrRow {
     let se = &p.sigma_euler_rad;
     (
         p.t_s,
-        [e[6], e[7], e[8], e[3], e[4], e[5], d(e[0]), d(e[1]), d(e[2])],
-        [s[0], s[1], s[2], s[3], s[4], s[5], d(se[0]), d(se[1]), d(se[2])],
+        [
+            e[6],
+            e[7],
+            e[8],
+            e[3],
+            e[4],
+            e[5],
+            d(e[0]),
+            d(e[1]),
+            d(e[2]),
+        ],
+        [
+            s[0],
+            s[1],
+            s[2],
+            s[3],
+            s[4],
+            s[5],
+            d(se[0]),
+            d(se[1]),
+            d(se[2]),
+        ],
     )
 }
 
@@ -113,7 +133,9 @@ pub fn run(args: &Args, req: &FuseRequest) -> Result<(), CliError> {
         .map_err(run_err)
     })?;
     let FuseDetails::Files(r) = &o.details else {
-        return Err(CliError::Other("fuse on files returned no file result".into()));
+        return Err(CliError::Other(
+            "fuse on files returned no file result".into(),
+        ));
     };
     if !plot.forward.pts.is_empty() || !plot.gnss.is_empty() {
         report(&out, args, d, &o, r, &plot)?;

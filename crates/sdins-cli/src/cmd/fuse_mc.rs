@@ -12,7 +12,7 @@ use sdins_sim::analysis::fuse_mc::{run_shard, FuseMcError, FuseMcOptions, FuseMc
 use sdins_sim::analysis::montecarlo::plan::{block_count, block_runs, shard_blocks};
 use sdins_sim::analysis::montecarlo::Shard;
 use sdins_sim::fusion::request::{FuseData, FuseRequest};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Mutex;
 
 /// Consistency is judged after this time \[s\] (convergence).
@@ -103,7 +103,9 @@ pub fn merge(args: &Args) -> Result<(), CliError> {
             missing[0]
         );
         if !args.allow_partial {
-            return Err(CliError::bad(format!("{msg}: give every shard, or --allow-partial")));
+            return Err(CliError::bad(format!(
+                "{msg}: give every shard, or --allow-partial"
+            )));
         }
         if !args.quiet {
             eprintln!("sdins: warning: {msg}");
@@ -124,14 +126,17 @@ fn read_state(p: &Path) -> Result<FuseMcState, CliError> {
         source,
     })?;
     let st: FuseMcState = serde_json::from_str(&text).map_err(|e| {
-        CliError::bad(format!("{}: not a fuse Monte Carlo state: {e}", file.display()))
+        CliError::bad(format!(
+            "{}: not a fuse Monte Carlo state: {e}",
+            file.display()
+        ))
     })?;
     st.validate()
         .map_err(|e| CliError::bad(format!("{}: {e}", file.display())))?;
     Ok(st)
 }
 
-fn finish(args: &Args, out: &PathBuf, state: &FuseMcState) -> Result<(), CliError> {
+fn finish(args: &Args, out: &Path, state: &FuseMcState) -> Result<(), CliError> {
     let stats = state.statistics();
     let json = serde_json::to_string(state).map_err(|e| CliError::Other(e.to_string()))?;
     write_string(&out.join("fuse_mc_state.json"), &json)?;
@@ -165,7 +170,11 @@ fn finish(args: &Args, out: &PathBuf, state: &FuseMcState) -> Result<(), CliErro
             "sdins fuse {}: {} runs ({}), {} epochs; wrote {}",
             state.job.scenario,
             stats.runs,
-            if stats.complete { "complete" } else { "partial" },
+            if stats.complete {
+                "complete"
+            } else {
+                "partial"
+            },
             stats.times_s.len(),
             out.display()
         );

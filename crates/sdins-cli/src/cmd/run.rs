@@ -9,8 +9,8 @@ use sdins_core::nav::NavState;
 use sdins_sim::nav::options::{self, AlgoChoice};
 use sdins_sim::nav::pipeline::{NavError, RunObserver, RunSummary};
 use sdins_sim::nav::run::{self, RunRequest, SensorRun};
-use sdins_sim::truth::TruthSample;
 use sdins_sim::scenario::Scenario;
+use sdins_sim::truth::TruthSample;
 use std::path::PathBuf;
 
 /// Arguments of `sdins run`.
@@ -232,8 +232,20 @@ impl RunObserver for Sink<'_> {
         let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
         self.series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
         let row = [
-            e.t_s, p[0], p[1], p[2], v[0], v[1], v[2], a[0], a[1], a[2], e.height_err_m, u[0],
-            u[1], u[2],
+            e.t_s,
+            p[0],
+            p[1],
+            p[2],
+            v[0],
+            v[1],
+            v[2],
+            a[0],
+            a[1],
+            a[2],
+            e.height_err_m,
+            u[0],
+            u[1],
+            u[2],
         ];
         let r = self.nav_csv[i]
             .row(&nav_row(e.t_s, st))

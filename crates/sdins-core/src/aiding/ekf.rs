@@ -61,20 +61,22 @@ use super::error_model::{f_matrix, position_scale, ModelPoint, N_STATES};
 use super::history::{nav_entry_at, EpochEntry, NavEntry, Ring, HIST_EPOCHS, HIST_UPDATES};
 use super::layout::{BlockKind, Cov, Process, StateLayout, XVec};
 use super::linalg::{
-    chol_solve, cholesky, dot, mul, mul_tr, propagate as propagate_p, symmetrize, transition,
-    HMat, KMat, MVec, MAX_ROWS,
+    chol_solve, cholesky, dot, mul, mul_tr, propagate as propagate_p, symmetrize, transition, HMat,
+    KMat, MVec, MAX_ROWS,
 };
-use super::meas::{MeasError, MeasModel, MeasPoint, Measurement, Nhc, Zupt};
 pub use super::meas::{GnssMeasurement, MeasKind};
+use super::meas::{MeasError, MeasModel, MeasPoint, Measurement, Nhc, Zupt};
 use crate::coning::Increment;
 use crate::earth::EarthModel;
 use crate::math::{Mat3, Quat, Vec3};
 use crate::nav::{wrap_pi, Mechanization, NavState};
+pub use error::FilterError;
+
+mod error;
 
 /// 99.9 % quantiles of χ² with 1…12 degrees of freedom (default gate).
 pub const CHI2_999: [f64; MAX_ROWS] = [
-    10.828, 13.816, 16.266, 18.467, 20.515, 22.458, 24.322, 26.124, 27.877, 29.588, 31.264,
-    32.909,
+    10.828, 13.816, 16.266, 18.467, 20.515, 22.458, 24.322, 26.124, 27.877, 29.588, 31.264, 32.909,
 ];
 
 /// Default largest latency of a measurement \[s\].
@@ -189,61 +191,6 @@ pub struct UpdateReport {
     /// refused: older than the largest latency or than the history
     pub late: bool,
 }
-
-/// What the filter refuses to continue with.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum FilterError {
-    /// A covariance (P or an innovation covariance S) is not positive definite or not finite.
-    NotPositiveDefinite {
-        /// filter time \[s\]
-        t_s: f64,
-        /// which matrix
-        what: &'static str,
-    },
-    /// The navigation state became non-finite.
-    NonFiniteState {
-        /// filter time \[s\]
-        t_s: f64,
-    },
-    /// A measurement has a non-finite value or a time of validity in the future.
-    BadMeasurement {
-        /// filter time \[s\]
-        t_s: f64,
-    },
-    /// The layout lacks a block a measurement needs.
-    MissingBlock {
-        /// filter time \[s\]
-        t_s: f64,
-        /// the block
-        block: BlockKind,
-    },
-}
-
-impl core::fmt::Display for FilterError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            FilterError::NotPositiveDefinite { t_s, what } => write!(
-                f,
-                "epoch t = {t_s} s: {what} is not finite or not positive definite"
-            ),
-            FilterError::NonFiniteState { t_s } => {
-                write!(f, "epoch t = {t_s} s: navigation state is not finite")
-            }
-            FilterError::BadMeasurement { t_s } => write!(
-                f,
-                "epoch t = {t_s} s: measurement has a non-finite value or a time of validity in the future"
-            ),
-            FilterError::MissingBlock { t_s, block } => write!(
-                f,
-                "epoch t = {t_s} s: a measurement needs the state block `{}`",
-                block.name()
-            ),
-        }
-    }
-}
-
-impl core::error::Error for FilterError {}
 
 /// One covariance epoch k, what a Rauch–Tung–Striebel smoother needs (see
 /// [`super::rts`]): `P(k|k−1) = Φ P(k−1|k−1) Φᵀ + Q`, the covariance after the epoch's
@@ -518,8 +465,7 @@ impl<M: Mechanization> Ekf<M> {
         );
         let f15 = f_matrix(&pt, true, false);
         f.fill(0.0);
-        f.fixed_view_mut::<N_STATES, N_STATES>(0, 0)
-            .copy_from(&f15);
+        f.fixed_view_mut::<N_STATES, N_STATES>(0, 0).copy_from(&f15);
         if let Some(o) = self.layout.offset(BlockKind::AccelScale) {
             f.fixed_view_mut::<3, 3>(3, o).copy_from(&e.sa);
         }
@@ -635,7 +581,13 @@ impl<M: Mechanization> Ekf<M> {
         )
     }
 
-    fn point<'a>(&'a self, prev: &NavState, cur: &NavState, omega: Vec3, t_s: f64) -> MeasPoint<'a> {
+    fn point<'a>(
+        &'a self,
+        prev: &NavState,
+        cur: &NavState,
+        omega: Vec3,
+        t_s: f64,
+    ) -> MeasPoint<'a> {
         let (lat, lon, h, v) = self.state_at(prev, cur, t_s);
         let tau = cur.t_s - t_s;
         MeasPoint {
@@ -677,10 +629,10 @@ impl<M: Mechanization> Ekf<M> {
         } else {
             None
         };
-        let back = entry.and_then(|e| {
+        let back = entry.map(|e| {
             let pt = self.point(&e.prev, &e.cur, e.omega_ib_b, t_v);
             let r = m.evaluate(&pt, &mut model);
-            Some(r.map(|_| e.cur.t_s))
+            r.map(|_| e.cur.t_s)
         });
         let t_entry = match back {
             Some(r) => r.map_err(bad)?,
@@ -833,7 +785,7 @@ impl<M: Mechanization> Ekf<M> {
             for k in 1..n {
                 let hk = h[(c, k)];
                 for i in 0..n {
-                    pht[(i, c)] = self.p[(i, k)] * hk + pht[(i, c)];
+                    pht[(i, c)] += self.p[(i, k)] * hk;
                 }
             }
         }
@@ -843,7 +795,7 @@ impl<M: Mechanization> Ekf<M> {
             for a in 0..d {
                 let mut acc = h[(a, 0)] * pht[(0, b)];
                 for k in 1..n {
-                    acc = h[(a, k)] * pht[(k, b)] + acc;
+                    acc += h[(a, k)] * pht[(k, b)];
                 }
                 s[b * R + a] = acc + r[(a, b)];
             }
@@ -912,7 +864,7 @@ impl<M: Mechanization> Ekf<M> {
         }
         for c in 1..d {
             for i in 0..n {
-                x[i] = k[(i, c)] * nu[c] + x[i];
+                x[i] += k[(i, c)] * nu[c];
             }
         }
         // I − K H
@@ -921,7 +873,7 @@ impl<M: Mechanization> Ekf<M> {
             for i in 0..n {
                 let mut acc = k[(i, 0)] * h[(0, j)];
                 for c in 1..d {
-                    acc = k[(i, c)] * h[(c, j)] + acc;
+                    acc += k[(i, c)] * h[(c, j)];
                 }
                 ikh[(i, j)] = if i == j { 1.0 } else { 0.0 } - acc;
             }
@@ -935,7 +887,7 @@ impl<M: Mechanization> Ekf<M> {
             for i in 0..n {
                 let mut acc = k[(i, 0)] * r[(0, c2)];
                 for c in 1..d {
-                    acc = k[(i, c)] * r[(c, c2)] + acc;
+                    acc += k[(i, c)] * r[(c, c2)];
                 }
                 kr[(i, c2)] = acc;
             }
@@ -944,7 +896,7 @@ impl<M: Mechanization> Ekf<M> {
             for i in 0..n {
                 let mut acc = kr[(i, 0)] * k[(j, 0)];
                 for c in 1..d {
-                    acc = kr[(i, c)] * k[(j, c)] + acc;
+                    acc += kr[(i, c)] * k[(j, c)];
                 }
                 self.p[(i, j)] = b[(i, j)] + acc;
             }

@@ -277,7 +277,7 @@ impl StateLayout {
             BlockProcess::Navigation => false,
             BlockProcess::PerAxis(p) => p
                 .iter()
-                .all(|x| x.q.is_finite() && x.q >= 0.0 && !(x.tau_s <= 0.0) && !x.tau_s.is_nan()),
+                .all(|x| x.q.is_finite() && x.q >= 0.0 && x.tau_s > 0.0),
             BlockProcess::Clock { h0, h_m2 } => {
                 dim == 2 && h0.is_finite() && h0 >= 0.0 && h_m2.is_finite() && h_m2 >= 0.0
             }
@@ -465,10 +465,12 @@ mod tests {
         let bad = StateLayout::ins([Process::CONSTANT; 3], [Process::CONSTANT; 3]).with(
             BlockKind::BaroBias,
             1,
-            BlockProcess::PerAxis([Process {
-                tau_s: -1.0,
-                q: 1.0,
-            }; 3]),
+            BlockProcess::PerAxis(
+                [Process {
+                    tau_s: -1.0,
+                    q: 1.0,
+                }; 3],
+            ),
         );
         assert_eq!(bad, Err(LayoutError::BadProcess(BlockKind::BaroBias)));
     }
@@ -491,7 +493,10 @@ mod tests {
     fn clock_q_is_the_integral_of_the_continuous_model() {
         let (h0, hm2, t) = (9.4e-20, 3.8e-21, 1.7);
         let c2 = C_LIGHT_MPS * C_LIGHT_MPS;
-        let (sf, sg) = (c2 * h0 / 2.0, 2.0 * core::f64::consts::PI.powi(2) * c2 * hm2);
+        let (sf, sg) = (
+            c2 * h0 / 2.0,
+            2.0 * core::f64::consts::PI.powi(2) * c2 * hm2,
+        );
         // Φ(s) = [[1, s], [0, 1]]: Φ Qc Φᵀ = [[S_f + S_g s², S_g s], [S_g s, S_g]]
         let f = |s: f64| [sf + sg * s * s, sg * s, sg];
         let (a, m, b) = (f(0.0), f(t / 2.0), f(t));

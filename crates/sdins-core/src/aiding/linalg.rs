@@ -37,7 +37,7 @@ pub fn mul(out: &mut Cov, a: &Cov, b: &Cov, n: usize) {
         for k in 1..n {
             let xk = b[j * L + k];
             for (y, ai) in oj.iter_mut().zip(&a[k * L..k * L + n]) {
-                *y = ai * xk + *y;
+                *y += ai * xk;
             }
         }
     }
@@ -155,12 +155,12 @@ pub fn cholesky(s: &mut [f64], ld: usize, m: usize) -> bool {
         for k in 0..j {
             let factor = -s[k * ld + j];
             for r in j..m {
-                s[j * ld + r] = factor * s[k * ld + r] + s[j * ld + r];
+                s[j * ld + r] += factor * s[k * ld + r];
             }
         }
         let diag = s[j * ld + j];
         // nalgebra: zero → None, try_sqrt of a negative (or NaN) → None
-        if diag == 0.0 || !(diag >= 0.0) {
+        if diag.is_nan() || diag <= 0.0 {
             return false;
         }
         let denom = libm::sqrt(diag);
@@ -179,7 +179,7 @@ pub fn chol_solve(l: &[f64], ld: usize, m: usize, b: &mut [f64]) {
         let coeff = b[i] / l[i * ld + i];
         b[i] = coeff;
         for r in i + 1..m {
-            b[r] = -coeff * l[i * ld + r] + b[r];
+            b[r] += -coeff * l[i * ld + r];
         }
     }
     // backward: Lᵀ x = y
@@ -201,7 +201,7 @@ pub fn mul_vec(a: &Cov, x: &XVec, n: usize) -> XVec {
     for k in 1..n {
         let xk = x[k];
         for i in 0..n {
-            y[i] = a[(i, k)] * xk + y[i];
+            y[i] += a[(i, k)] * xk;
         }
     }
     y
@@ -216,7 +216,9 @@ mod tests {
     fn filled<const N: usize>(seed: u64) -> SMatrix<f64, N, N> {
         let mut s = seed;
         SMatrix::<f64, N, N>::from_fn(|_, _| {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
         })
     }

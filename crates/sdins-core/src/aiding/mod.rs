@@ -1,6 +1,7 @@
 //! Aided navigation: the linear navigation-error model, the state layout, the measurement
 //! interface and the error-state Kalman filter with closed-loop correction, and the
-//! Rauch–Tung–Striebel smoother step (see `docs/theory/ins-gnss.md`).
+//! Rauch–Tung–Striebel smoother step (see `docs/theory/ins-gnss.md`); the stationarity
+//! (zero-velocity) detector (`docs/theory/aiding-sensors.md`).
 
 pub mod ekf;
 pub mod error_model;
@@ -9,3 +10,4 @@ pub mod layout;
 pub mod linalg;
 pub mod meas;
 pub mod rts;
+pub mod stationarity;

@@ -230,14 +230,26 @@ mod tests {
             [b95.0, b95.1, b99.0, b99.1].map(|x| (x * 100.0).round() / 100.0),
             [2.54, 3.50, 2.41, 3.67]
         );
-        for (d, r) in [(3.0, 100.0), (6.0, 100.0), (3.0, 10.0), (2.0, 15.0), (1.0, 30.0)] {
+        for (d, r) in [
+            (3.0, 100.0),
+            (6.0, 100.0),
+            (3.0, 10.0),
+            (2.0, 15.0),
+            (1.0, 30.0),
+        ] {
             for alpha in [0.05, 0.01] {
                 let (lo, hi) = band(d, r, alpha);
                 let k = d * r;
                 let p_lo = gamma_p(k / 2.0, lo * r / 2.0);
                 let p_hi = gamma_p(k / 2.0, hi * r / 2.0);
-                assert!((p_lo - alpha / 2.0).abs() < 0.1 * alpha / 2.0, "{d} {r} {p_lo}");
-                assert!((1.0 - p_hi - alpha / 2.0).abs() < 0.1 * alpha / 2.0, "{d} {r} {p_hi}");
+                assert!(
+                    (p_lo - alpha / 2.0).abs() < 0.1 * alpha / 2.0,
+                    "{d} {r} {p_lo}"
+                );
+                assert!(
+                    (1.0 - p_hi - alpha / 2.0).abs() < 0.1 * alpha / 2.0,
+                    "{d} {r} {p_hi}"
+                );
             }
         }
     }

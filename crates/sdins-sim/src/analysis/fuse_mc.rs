@@ -199,7 +199,8 @@ fn setup(
     };
     if d.in_motion {
         return Err(FuseMcError::Config(
-            "in-motion alignment starts each run at its own time: the runs' epochs would differ".into(),
+            "in-motion alignment starts each run at its own time: the runs' epochs would differ"
+                .into(),
         ));
     }
     if mc.runs == 0 || mc.runs > MAX_RUNS || mc.block == 0 {
@@ -248,7 +249,11 @@ fn one_run(
     job: &FuseMcJob,
     run: u64,
 ) -> Result<RunRows, FuseMcError> {
-    let n_nees = job.columns.iter().filter(|c| c.starts_with("nees_")).count();
+    let n_nees = job
+        .columns
+        .iter()
+        .filter(|c| c.starts_with("nees_"))
+        .count();
     let drawn;
     let scn = match (&opts.scale_factors, job.draw_scale_factors) {
         (Some(sp), true) => {
@@ -288,17 +293,25 @@ fn one_run(
         }
         v
     };
-    fuse_scenario_with(scn, truth, gnss, opts, run, &CancelToken::new(), |ev| match ev {
-        FuseEvent::Epoch(e) => {
-            times.push(e.t_s);
-            nees.extend(nees_of(e));
-            nis.push(std::mem::take(&mut pending));
-        }
-        FuseEvent::Update(u) if u.accepted => {
-            pending.push((n_nees + u.kind.index(), u.nis));
-        }
-        _ => {}
-    })
+    fuse_scenario_with(
+        scn,
+        truth,
+        gnss,
+        opts,
+        run,
+        &CancelToken::new(),
+        |ev| match ev {
+            FuseEvent::Epoch(e) => {
+                times.push(e.t_s);
+                nees.extend(nees_of(e));
+                nis.push(std::mem::take(&mut pending));
+            }
+            FuseEvent::Update(u) if u.accepted => {
+                pending.push((n_nees + u.kind.index(), u.nis));
+            }
+            _ => {}
+        },
+    )
     .map_err(|e| FuseMcError::Run {
         run,
         source: FuseRunError::Fuse(e),
@@ -326,7 +339,11 @@ pub fn run_shard(
     let len = crate::truth::TruthGenerator::new(&scn.trajectory, scn.truth_config()).len_samples();
     let cached = (len <= 1_000_000).then(|| scenario_truth(&scn));
     let ncol = job.columns.len();
-    let n_nees = job.columns.iter().filter(|c| c.starts_with("nees_")).count();
+    let n_nees = job
+        .columns
+        .iter()
+        .filter(|c| c.starts_with("nees_"))
+        .count();
     let blocks: Vec<u64> = shard_blocks(shard, mc.runs, mc.block).collect();
     let results: Vec<Result<(BlockResult, Vec<f64>), FuseMcError>> = blocks
         .par_iter()
@@ -342,7 +359,9 @@ pub fn run_shard(
                     times = t;
                     moments = vec![Moments::default(); times.len() * ncol];
                 } else if t.len() != times.len()
-                    || t.iter().zip(&times).any(|(a, b)| a.to_bits() != b.to_bits())
+                    || t.iter()
+                        .zip(&times)
+                        .any(|(a, b)| a.to_bits() != b.to_bits())
                 {
                     return Err(FuseMcError::Config(format!(
                         "run {r} has other output epochs than the first run of its block"
@@ -372,7 +391,9 @@ pub fn run_shard(
         if state.blocks.is_empty() {
             state.times_s = times;
         } else if times.len() != state.times_s.len() {
-            return Err(FuseMcError::Config("blocks produced different epochs".into()));
+            return Err(FuseMcError::Config(
+                "blocks produced different epochs".into(),
+            ));
         }
         state.blocks.push(block);
     }

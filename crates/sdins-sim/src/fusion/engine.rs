@@ -310,12 +310,12 @@ pub fn run_engine(
     }
     let mut truth = start.truth;
     let emit_row = |ekf: &Ekf<AnyMechanization>,
-                        j: u64,
-                        cov_state: &NavState,
-                        epoch: usize,
-                        truth: Option<&TruthSample>,
-                        track: &mut Option<Track>,
-                        observe: &mut dyn FnMut(EngineEvent<'_>)| {
+                    j: u64,
+                    cov_state: &NavState,
+                    epoch: usize,
+                    truth: Option<&TruthSample>,
+                    track: &mut Option<Track>,
+                    observe: &mut dyn FnMut(EngineEvent<'_>)| {
         let st = ekf.state();
         let row = Row {
             index: j,
@@ -349,7 +349,7 @@ pub fn run_engine(
     let mut k = 0u64;
     let mut cov_epochs = 0u64;
     'outer: while k < cfg.total_updates {
-        if k % 1024 == 0 {
+        if k.is_multiple_of(1024) {
             cancel.check()?;
         }
         // n samples, and every non-IMU event up to the next sample
@@ -405,7 +405,7 @@ pub fn run_engine(
                 i += 1;
             }
         }
-        if (k + 1) % cfg.cov_updates.max(1) as u64 == 0 {
+        if (k + 1).is_multiple_of(cfg.cov_updates.max(1) as u64) {
             let rep = match (at_rest, cfg.zupt_sigma_mps, cfg.nhc_sigma_mps) {
                 (true, Some(s), _) => Some(ekf.update_zupt(s)?),
                 (_, _, Some(s)) => Some(ekf.update_nhc(s)?),
@@ -425,12 +425,28 @@ pub fn run_engine(
         }
         k += 1;
         if cursor.is_output(k) {
-            emit_row(&ekf, k, &cov_state, epoch, truth.as_ref(), &mut track, observe);
+            emit_row(
+                &ekf,
+                k,
+                &cov_state,
+                epoch,
+                truth.as_ref(),
+                &mut track,
+                observe,
+            );
             last_row = Some(k);
         }
     }
     if last_row != Some(k) {
-        emit_row(&ekf, k, &cov_state, epoch, truth.as_ref(), &mut track, observe);
+        emit_row(
+            &ekf,
+            k,
+            &cov_state,
+            epoch,
+            truth.as_ref(),
+            &mut track,
+            observe,
+        );
     }
     let mut smoother_bytes = 0;
     if let Some(t) = track {

@@ -403,7 +403,10 @@ pub fn fuse_records(
         layout = layout
             .with_scale_factors()
             .map_err(|e| opt_err("scale_factors", e.to_string()))?;
-        let (a, g) = (layout.offset(BlockKind::AccelScale), layout.offset(BlockKind::GyroScale));
+        let (a, g) = (
+            layout.offset(BlockKind::AccelScale),
+            layout.offset(BlockKind::GyroScale),
+        );
         if let (Some(a), Some(g)) = (a, g) {
             for i in 0..3 {
                 p0n[(a + i, a + i)] = (sp.accel_ppm[i] * 1e-6).powi(2);

@@ -276,11 +276,21 @@ fn common(req: &FuseRequest, default_samples: usize) -> Result<AlgorithmSpec, Fu
         }
     }
     if let Some(sp) = &req.scale_factors {
-        sp.validate()
-            .map_err(|_| bad("scale_factors", "--scale-factors-ppm", "prior σ must be finite and in (0, 100000] ppm"))?;
+        sp.validate().map_err(|_| {
+            bad(
+                "scale_factors",
+                "--scale-factors-ppm",
+                "prior σ must be finite and in (0, 100000] ppm",
+            )
+        })?;
     }
-    AlgorithmSpec::from_name(&req.algo, samples)
-        .ok_or_else(|| bad("algo", "--algo", format!("unknown algorithm `{}`", req.algo)))
+    AlgorithmSpec::from_name(&req.algo, samples).ok_or_else(|| {
+        bad(
+            "algo",
+            "--algo",
+            format!("unknown algorithm `{}`", req.algo),
+        )
+    })
 }
 
 /// Run a request; `observe` sees every row and update.
@@ -317,11 +327,9 @@ impl Rms {
 
 fn errors9(e: &FuseEpoch) -> [f64; 9] {
     let mut v = [0.0; 9];
-    for i in 0..3 {
-        v[i] = e.nav.pos_err_ned_m[i];
-        v[3 + i] = e.nav.vel_err_ned_mps[i];
-        v[6 + i] = e.nav.att_err_rad[i];
-    }
+    v[..3].copy_from_slice(&e.nav.pos_err_ned_m);
+    v[3..6].copy_from_slice(&e.nav.vel_err_ned_mps);
+    v[6..].copy_from_slice(&e.nav.att_err_rad);
     v
 }
 

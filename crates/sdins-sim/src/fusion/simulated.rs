@@ -36,7 +36,9 @@ use crate::sensors::imu_error::{ImuErrorModel, DEG, DPH, DPHPSH, DPSH, MPS_PER_S
 use crate::sensors::imu_error::{UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ};
 use crate::truth::{lon_diff, TruthGenerator, TruthSample};
 use nalgebra::{SMatrix, SVector};
-use sdins_core::aiding::ekf::{FilterError, NoiseModel, UpdateReport, CHI2_999, DEFAULT_MAX_LATENCY_S};
+use sdins_core::aiding::ekf::{
+    FilterError, NoiseModel, UpdateReport, CHI2_999, DEFAULT_MAX_LATENCY_S,
+};
 use sdins_core::aiding::error_model::{StateMat, I_ATT, I_POS, I_VEL, N_STATES};
 use sdins_core::aiding::layout::{BlockKind, Cov, StateLayout, XVec};
 use sdins_core::aiding::linalg::MAX_ROWS;
@@ -223,7 +225,6 @@ impl From<EngineError> for FuseError {
         }
     }
 }
-
 
 /// One output row of a scenario run: the true error in the filter's state coordinates
 /// (navigation `estimate − truth`; sensor parameters `truth − estimate`, zero for blocks
@@ -431,7 +432,13 @@ pub(crate) struct Truths {
 }
 
 /// The row's true error and covariance.
-fn epoch_of(row: &Row<'_>, p: &Cov, truth: &TruthSample, earth: &EarthModel, tr: &Truths) -> FuseEpoch {
+fn epoch_of(
+    row: &Row<'_>,
+    p: &Cov,
+    truth: &TruthSample,
+    earth: &EarthModel,
+    tr: &Truths,
+) -> FuseEpoch {
     let st = row.state;
     let ne = nav_error(earth, st, truth);
     let mut err = XVec::zeros();

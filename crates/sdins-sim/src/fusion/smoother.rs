@@ -361,7 +361,7 @@ mod tests {
         e.p_post[(2, 1)] = 0.25;
         log.push(&e).unwrap();
         assert_eq!(log.epoch(1).unwrap(), e);
-        assert_eq!(log.bytes() >= 2 * 3848, true);
+        assert!(log.bytes() >= 2 * 3848);
     }
 
     #[test]

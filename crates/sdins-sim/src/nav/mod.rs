@@ -7,3 +7,5 @@ pub mod options;
 pub mod pipeline;
 pub mod recorded;
 pub mod run;
+pub mod spp;
+pub mod truth_rows;

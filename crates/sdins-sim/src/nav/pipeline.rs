@@ -247,8 +247,7 @@ pub trait RunObserver {
     /// An output row of algorithm `algo` (the rows of [`RunOptions::every_s`]).
     fn epoch(&mut self, algo: usize, state: &NavState, truth: &TruthSample, err: &NavError);
     /// Every navigation update of algorithm `algo` (figures), when [`Self::wants_updates`].
-    fn update(&mut self, _algo: usize, _state: &NavState, _truth: &TruthSample, _err: &NavError) {
-    }
+    fn update(&mut self, _algo: usize, _state: &NavState, _truth: &TruthSample, _err: &NavError) {}
     /// Whether [`Self::update`] is wanted (the errors of every update cost time).
     fn wants_updates(&self) -> bool {
         false
@@ -319,7 +318,8 @@ pub fn run_observed(
     };
     let grid = match opts.every_s {
         Some(e) => Some(
-            EpochGrid::new(e, cfg.dt_s * n as f64).map_err(|e| PipelineError::BadEvery(e.to_string()))?,
+            EpochGrid::new(e, cfg.dt_s * n as f64)
+                .map_err(|e| PipelineError::BadEvery(e.to_string()))?,
         ),
         None => None,
     };

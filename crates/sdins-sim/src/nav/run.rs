@@ -149,7 +149,10 @@ mod tests {
         let dt = p.dt_update_s;
         assert_eq!(rows.0[0], 0.0);
         for (k, t) in rows.0.iter().enumerate().take(rows.0.len() - 1) {
-            assert!((t - 0.5 * k as f64).abs() <= 0.5 * dt + 1e-12, "row {k}: {t}");
+            assert!(
+                (t - 0.5 * k as f64).abs() <= 0.5 * dt + 1e-12,
+                "row {k}: {t}"
+            );
         }
         assert!((rows.0.last().unwrap() - p.t_end_s).abs() < 1e-9);
         assert!(rows.0.len() as u64 <= p.rows);

@@ -12,8 +12,8 @@
 //! (static, level cruise) use the generator's closed form, which is cheaper than reading
 //! a cache, and are streamed instead ([`worth_caching`]).
 
-use crate::nav::pipeline::{nav_error, NavError};
 use crate::nav::epochs::EpochGrid;
+use crate::nav::pipeline::{nav_error, NavError};
 use crate::scenario::Scenario;
 use crate::sensors::imu_error::{ImuErrorModel, ImuErrorState};
 use crate::truth::{TruthConfig, TruthGenerator, TruthSample};
