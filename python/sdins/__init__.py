@@ -29,7 +29,7 @@ from ._results import (
     RunResult,
     Truth,
 )
-from ._sdins import McState, Scenario, SdinsError
+from ._sdins import FuseMcState, McState, Scenario, SdinsError
 
 __version__: str = _raw.__version__
 
@@ -81,6 +81,9 @@ def __dir__() -> List[str]:
 
 __all__ = [
     "fuse_files",
+    "fuse_montecarlo",
+    "fuse_merge",
+    "FuseMcState",
     "SdinsError",
     "Scenario",
     "McState",
@@ -418,30 +421,85 @@ def fuse(
     smooth: Optional[bool] = None,
     in_motion: Optional[bool] = None,
     scale_factors_ppm: Optional[Tuple[float, float]] = None,
+    grade: Optional[str] = None,
+    every_s: Optional[float] = None,
+    max_latency_s: Optional[float] = None,
 ) -> FuseResult:
-    """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``); the scenario's
-    ``[gnss]`` table sets the receiver.
+    """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``, the same library
+    call); the scenario's ``[gnss]`` table sets the receiver.
 
-    Every parameter defaults to the library's ``FuseOptions::default()``: ``algo``
-    songlee-complete, ``samples`` the scenario's N (as the CLI), ``run`` 0 (IMU/GNSS/
-    initial-error streams), ``cov_rate_hz`` 10, ``gate`` True (χ² 99.9 % NIS gate),
-    ``exact_start`` False (initial errors drawn from P0), ``zupt_sigma_mps`` /
-    ``nhc_sigma_mps`` None (off), ``until_s`` None (whole scenario), ``smooth`` False
-    (True: the Rauch–Tung–Striebel smoother; ``result.smoothed`` then holds the smoothed
-    epochs with the same fields as the forward ones), ``in_motion`` False (True: in-motion
-    alignment from an unknown heading, started at the first fix at ≥ 5 m/s),
-    ``scale_factors_ppm`` None (15 states; ``(accel_ppm, gyro_ppm)``: the 21-state filter
-    that also estimates the accelerometer and gyro scale factors with that prior σ per
-    axis; the result then has ``scale_factor_error`` / ``scale_factor_sigma`` (n × 6,
-    dimensionless, accel x y z then gyro x y z) and the ``accel_scale_est`` /
-    ``accel_scale_true`` / ``gyro_scale_est`` / ``gyro_scale_true`` summaries).
+    Every parameter defaults to the library's: ``algo`` songlee-complete, ``samples`` the
+    scenario's N (as the CLI), ``run`` 0 (IMU/GNSS/initial-error streams), ``cov_rate_hz``
+    10, ``gate`` True (χ² 99.9 % NIS gate), ``exact_start`` False (initial errors drawn
+    from P0), ``zupt_sigma_mps`` / ``nhc_sigma_mps`` None (off), ``until_s`` None (whole
+    scenario), ``smooth`` False (True: the Rauch–Tung–Striebel smoother; ``result.smoothed``
+    then holds the smoothed rows with the same fields as the forward ones), ``in_motion``
+    False (True: in-motion alignment from an unknown heading, started at the first fix at
+    ≥ 5 m/s), ``scale_factors_ppm`` None (15 states; ``(accel_ppm, gyro_ppm)``: the
+    layout with the accelerometer and gyro scale factors, prior σ per axis; the result
+    then has ``scale_factor_error`` / ``scale_factor_sigma`` (n × 6, dimensionless, accel
+    x y z then gyro x y z) and the ``accel_scale_est`` / ``accel_scale_true`` /
+    ``gyro_scale_est`` / ``gyro_scale_true`` summaries), ``grade`` None (an IMU grade
+    preset replacing the scenario's error model: the simulated IMU errors and the
+    filter's model), ``every_s`` None (output rows at the updates nearest to k·every_s;
+    default the covariance interval), ``max_latency_s`` None (1 s: older measurements are
+    refused and counted in ``late``).
     """
     return FuseResult(
         _sdins.fuse(
             _scenario(scenario), algo, samples, run, cov_rate_hz, gate, exact_start,
             zupt_sigma_mps, nhc_sigma_mps, until_s, smooth, in_motion, scale_factors_ppm,
+            grade, every_s, max_latency_s,
         )
     )
+
+
+def fuse_montecarlo(
+    scenario: Union[Scenario, str],
+    runs: int,
+    seed: Optional[int] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    block: Optional[int] = None,
+    threads: Optional[int] = None,
+    draw_scale_factors: Optional[bool] = None,
+    algo: Optional[str] = None,
+    samples: Optional[int] = None,
+    cov_rate_hz: Optional[float] = None,
+    gate: Optional[bool] = None,
+    exact_start: Optional[bool] = None,
+    zupt_sigma_mps: Optional[float] = None,
+    nhc_sigma_mps: Optional[float] = None,
+    until_s: Optional[float] = None,
+    scale_factors_ppm: Optional[Tuple[float, float]] = None,
+    grade: Optional[str] = None,
+    every_s: Optional[float] = None,
+    max_latency_s: Optional[float] = None,
+) -> FuseMcState:
+    """Shard ``shard = (i, n)`` (default: the whole job) of the Monte Carlo of the filter on
+    a scenario (``sdins fuse SCENARIO --runs N --seed S --shard i/n``): per output epoch the
+    mergeable moments of the NEES of every state block with a known truth and of the NIS
+    of every measurement kind. ``seed`` (default the scenario's ``[imu] seed``) replaces
+    the IMU and GNSS seeds; ``block`` runs per block (default 16, equal in every shard);
+    ``threads`` (default: rayon's pool); ``draw_scale_factors`` draws each run's true
+    scale factors from the prior of ``scale_factors_ppm``; the filter options as in
+    :func:`fuse` (use ``gate=False`` for consistency). Returns a picklable
+    :class:`FuseMcState` (``.statistics()``, ``.consistency(column, after_s=30)``); merge
+    shards with :func:`fuse_merge` in any order: the statistics equal a single run's bit
+    for bit, for any thread count.
+    """
+    return _sdins.fuse_montecarlo(
+        _scenario(scenario), runs, seed,
+        None if shard is None else (int(shard[0]), int(shard[1])),
+        block, threads, draw_scale_factors, algo, samples, cov_rate_hz, gate, exact_start,
+        zupt_sigma_mps, nhc_sigma_mps, until_s, scale_factors_ppm, grade, every_s,
+        max_latency_s,
+    )
+
+
+def fuse_merge(states: Iterable[FuseMcState], allow_partial: Optional[bool] = None) -> FuseMcState:
+    """Merge fusion Monte Carlo shard states exactly, in any order (``sdins fuse --merge``).
+    Missing blocks are an error unless ``allow_partial=True``."""
+    return _sdins.fuse_merge(list(states), allow_partial)
 
 
 def fuse_files(
@@ -465,6 +523,8 @@ def fuse_files(
     nhc_sigma_mps: Optional[float] = None,
     gnss_offset_s: Optional[float] = None,
     scale_factors_ppm: Optional[Tuple[float, float]] = None,
+    every_s: Optional[float] = None,
+    max_latency_s: Optional[float] = None,
 ) -> Dict[str, Any]:
     """INS/GNSS filter (and smoother) on recorded files (``sdins fuse --imu --gnss``).
 
@@ -481,8 +541,8 @@ def fuse_files(
     (n, 6: accelerometer [m/s²], gyro [rad/s]), ``scale_factor`` and
     ``sigma_scale_factor`` (n, 6: accelerometer then gyro, dimensionless; zero unless
     ``scale_factors_ppm = (accel_ppm, gyro_ppm)`` selects the 21-state filter with that
-    prior σ); ``innovations`` (t_s, nis, dof,
-    accepted); ``fixes_used``, ``rejected``, ``fixes_outside`` (before, after),
+    prior σ); ``innovations`` (t_s, t_valid_s, kind, dof, nis, accepted, forced, late,
+    innovation (m, 12)); ``fixes_used``, ``rejected``, ``late``, ``fixes_outside`` (before, after),
     ``imu_samples``; with ``truth``: ``forward_rmse`` / ``smoothed_rmse`` (roll, pitch,
     yaw [rad], v N, E, D [m/s], N, E, D [m]) and their ``*_inside_3sigma`` fractions.
     """
@@ -493,5 +553,5 @@ def fuse_files(
         static_s,
         None if lever_arm_m is None else [float(x) for x in lever_arm_m],
         truth, smooth, algo, samples, cov_rate_hz, gate, nhc_sigma_mps, gnss_offset_s,
-        scale_factors_ppm,
+        scale_factors_ppm, every_s, max_latency_s,
     )
