@@ -105,6 +105,82 @@ pub fn sin_cos_shift(s: f64, c: f64, d: f64) -> (f64, f64) {
     (s + (s * cdm1 + c * sd), c + (c * cdm1 - s * sd))
 }
 
+/// `sin(a + d)`, `cos(a + d)` from `sin a`, `cos a` for the small steps of one navigation
+/// update: |d| < 1e-4 rad by the series `sin d = d − d³/6`, `cos d − 1 = −d²/2 + d⁴/24`
+/// (first omitted terms d⁵/120 < 8.4e-23 and d⁶/720 < 1.4e-27, far below the rounding of
+/// the sums, 1.1e-16), larger steps by [`sin_cos_shift`].
+#[inline(always)]
+pub fn sin_cos_step(s: f64, c: f64, d: f64) -> (f64, f64) {
+    if libm::fabs(d) < 1e-4 {
+        sin_cos_series4(s, c, d)
+    } else {
+        sin_cos_shift(s, c, d)
+    }
+}
+
+/// The series of [`sin_cos_step`] (|d| < 1e-4 rad).
+#[inline(always)]
+fn sin_cos_series4(s: f64, c: f64, d: f64) -> (f64, f64) {
+    let d2 = d * d;
+    let sd = d - d * d2 * (1.0 / 6.0);
+    let cdm1 = d2 * (d2 * (1.0 / 24.0) - 0.5); // cos d − 1
+    (s + (s * cdm1 + c * sd), c + (c * cdm1 - s * sd))
+}
+
+/// `sin`/`cos` of a slowly varying angle `base + x` without a libm call per evaluation:
+/// libm evaluates a reference angle `base + x_ref` once, and every later `x` within
+/// 1e-4 rad of it is one angle addition from the reference, with the series of
+/// [`sin_cos_step`] for the difference (truncation below 1e-22).
+///
+/// Every value is one shift away from a libm value, so the rounding does not accumulate
+/// along a trajectory (as it would if each value were shifted from the previous one):
+/// the error is that of libm plus the final additions of the shift, ≈ 1 ulp. When `x`
+/// leaves the window, the reference moves to `x` (one `sincos`). The local-level
+/// mechanization tracks half the latitude and half the transport angle of S1 eq. (32); at
+/// Mach 1 each needs a new reference about once a second.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SinCosTrack {
+    base: f64,
+    x_ref: f64,
+    s_ref: f64,
+    c_ref: f64,
+}
+
+impl SinCosTrack {
+    /// Half-width of the window around the reference \[rad\].
+    pub const WINDOW_RAD: f64 = 1e-4;
+
+    /// Track `base + x`, with the reference at `x`.
+    pub fn new(base: f64, x: f64) -> Self {
+        let (s_ref, c_ref) = libm::sincos(base + x);
+        Self {
+            base,
+            x_ref: x,
+            s_ref,
+            c_ref,
+        }
+    }
+
+    /// `(sin, cos)` of the reference angle (libm's values).
+    #[inline]
+    pub fn sin_cos_ref(&self) -> (f64, f64) {
+        (self.s_ref, self.c_ref)
+    }
+
+    /// `(sin, cos)` of `base + x`; moves the reference to `x` (one `sincos`) when
+    /// `|x − x_ref| ≥ 1e-4` rad (or `x` is not finite).
+    #[inline]
+    pub fn sin_cos(&mut self, x: f64) -> (f64, f64) {
+        let d = x - self.x_ref;
+        if libm::fabs(d) < Self::WINDOW_RAD {
+            sin_cos_series4(self.s_ref, self.c_ref, d)
+        } else {
+            *self = Self::new(self.base, x);
+            (self.s_ref, self.c_ref)
+        }
+    }
+}
+
 impl EarthModel {
     /// Radii from `sin L` (no trigonometry): see [`EarthModel::radii`].
     #[inline]

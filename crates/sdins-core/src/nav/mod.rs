@@ -16,7 +16,7 @@ mod transport;
 pub use dual::DualQuat;
 pub use dualquat::DualQuatNav;
 pub use local_level::{AttitudeMode, LocalLevel, LocalLevelConfig, RotVector, VelocityMode};
-pub use transport::{transport_matrix, transport_matrix_sc};
+pub use transport::{transport_matrix, transport_matrix_sc, transport_matrix_trig};
 
 use crate::coning::{ConingSet, Increment};
 use crate::earth::EarthModel;
