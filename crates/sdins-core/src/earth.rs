@@ -109,9 +109,17 @@ pub fn sin_cos_shift(s: f64, c: f64, d: f64) -> (f64, f64) {
 /// update: |d| < 1e-4 rad by the series `sin d = d − d³/6`, `cos d − 1 = −d²/2 + d⁴/24`
 /// (first omitted terms d⁵/120 < 8.4e-23 and d⁶/720 < 1.4e-27, far below the rounding of
 /// the sums, 1.1e-16), larger steps by [`sin_cos_shift`].
+///
+/// Below |d| = 1e-6 rad (the latitude steps of one update: 1e-7 rad at Mach 1 and 6 ms)
+/// the series stop at `sin d = d`, `cos d − 1 = −d²/2` (omitted d³/6 < 1.7e-19, 1/600 of
+/// the rounding of a sine near 1, and d⁴/24 < 4.2e-26).
 #[inline(always)]
 pub fn sin_cos_step(s: f64, c: f64, d: f64) -> (f64, f64) {
-    if libm::fabs(d) < 1e-4 {
+    let ad = libm::fabs(d);
+    if ad < 1e-6 {
+        let half_d2 = 0.5 * d * d;
+        (s + (c * d - s * half_d2), c - (s * d + c * half_d2))
+    } else if ad < 1e-4 {
         sin_cos_series4(s, c, d)
     } else {
         sin_cos_shift(s, c, d)
@@ -181,16 +189,123 @@ impl SinCosTrack {
     }
 }
 
-impl EarthModel {
+/// The latitude-independent factors of [`EarthModel::local_sc`] and
+/// [`EarthModel::radii_sin`] (`1 − e²`, `2/a`, `1 + f + m`, `2f`, `3/a²`), computed once:
+/// the mechanizations keep one and evaluate the earth terms of every update without
+/// recomputing them. Each factor is the same expression as in the formula, so the results
+/// are the same bits as [`EarthModel::local_sc`]'s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthCoeffs {
+    a_m: f64,
+    e2: f64,
+    one_minus_e2: f64,
+    gravity: GravityCoeffs,
+}
+
+/// [`Gravity`] with its constant factors evaluated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum GravityCoeffs {
+    /// `γ_e (1 + k s²)/w · (1 − (2/a)(1 + f + m − 2f s²) h + (3/a²) h²)`
+    Somigliana {
+        gamma_e: f64,
+        k: f64,
+        two_over_a: f64,
+        one_f_m: f64,
+        two_f: f64,
+        three_over_a2: f64,
+    },
+    /// `γ_e (1 + k s²)/w · (1 − 2h/a)`
+    SomiglianaLinear { gamma_e: f64, k: f64 },
+    /// `g0 (1 + c2 s² + c4 s⁴) − dh h`
+    Psins { g0: f64, c2: f64, c4: f64, dh: f64 },
+    /// constant
+    Constant { g_mps2: f64 },
+}
+
+impl EarthCoeffs {
     /// Radii from `sin L` (no trigonometry): see [`EarthModel::radii`].
-    #[inline]
+    #[inline(always)]
     pub fn radii_sin(&self, sin_lat: f64) -> Radii {
         let w2 = 1.0 - self.e2 * sin_lat * sin_lat;
         let r_n_m = self.a_m / libm::sqrt(w2);
         Radii {
-            r_m_m: r_n_m * (1.0 - self.e2) / w2,
+            r_m_m: r_n_m * self.one_minus_e2 / w2,
             r_n_m,
         }
+    }
+
+    /// [`LocalEarth`] from `sin L`, `cos L` and the height.
+    #[inline(always)]
+    pub fn local_sc(&self, sin_lat: f64, cos_lat: f64, h_m: f64) -> LocalEarth {
+        let s2 = sin_lat * sin_lat;
+        let w2 = 1.0 - self.e2 * s2;
+        let w = libm::sqrt(w2);
+        let r_n_m = self.a_m / w;
+        // the WGS-84 default first (one test and branch, not a jump table)
+        let g_mps2 = if let GravityCoeffs::Somigliana {
+            gamma_e,
+            k,
+            two_over_a,
+            one_f_m,
+            two_f,
+            three_over_a2,
+        } = self.gravity
+        {
+            let gamma = gamma_e * (1.0 + k * s2) / w;
+            gamma * (1.0 - two_over_a * (one_f_m - two_f * s2) * h_m + three_over_a2 * h_m * h_m)
+        } else {
+            match self.gravity {
+                GravityCoeffs::SomiglianaLinear { gamma_e, k } => {
+                    gamma_e * (1.0 + k * s2) / w * (1.0 - 2.0 * h_m / self.a_m)
+                }
+                GravityCoeffs::Psins { g0, c2, c4, dh } => {
+                    g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h_m
+                }
+                GravityCoeffs::Constant { g_mps2 } => g_mps2,
+                GravityCoeffs::Somigliana { .. } => f64::NAN, // handled above
+            }
+        };
+        LocalEarth {
+            sin_lat,
+            cos_lat,
+            r_m_m: r_n_m * self.one_minus_e2 / w2,
+            r_n_m,
+            g_mps2,
+        }
+    }
+}
+
+impl EarthModel {
+    /// The constant factors of the latitude-dependent terms ([`EarthCoeffs`]).
+    #[inline(always)]
+    pub fn coeffs(&self) -> EarthCoeffs {
+        let a = self.a_m;
+        EarthCoeffs {
+            a_m: a,
+            e2: self.e2,
+            one_minus_e2: 1.0 - self.e2,
+            gravity: match self.gravity {
+                Gravity::Somigliana { gamma_e, k, m } => GravityCoeffs::Somigliana {
+                    gamma_e,
+                    k,
+                    two_over_a: 2.0 / a,
+                    one_f_m: 1.0 + self.f + m,
+                    two_f: 2.0 * self.f,
+                    three_over_a2: 3.0 / (a * a),
+                },
+                Gravity::SomiglianaLinear { gamma_e, k } => {
+                    GravityCoeffs::SomiglianaLinear { gamma_e, k }
+                }
+                Gravity::Psins { g0, c2, c4, dh } => GravityCoeffs::Psins { g0, c2, c4, dh },
+                Gravity::Constant { g_mps2 } => GravityCoeffs::Constant { g_mps2 },
+            },
+        }
+    }
+
+    /// Radii from `sin L` (no trigonometry): see [`EarthModel::radii`].
+    #[inline]
+    pub fn radii_sin(&self, sin_lat: f64) -> Radii {
+        self.coeffs().radii_sin(sin_lat)
     }
 
     /// [`LocalEarth`] at latitude `lat_rad` and height `h_m`.
@@ -204,31 +319,7 @@ impl EarthModel {
     /// [`LocalEarth`] from precomputed `sin L`, `cos L`.
     #[inline]
     pub fn local_sc(&self, sin_lat: f64, cos_lat: f64, h_m: f64) -> LocalEarth {
-        let s2 = sin_lat * sin_lat;
-        let w2 = 1.0 - self.e2 * s2;
-        let w = libm::sqrt(w2);
-        let r_n_m = self.a_m / w;
-        let g_mps2 = match self.gravity {
-            Gravity::Somigliana { gamma_e, k, m } => {
-                let gamma = gamma_e * (1.0 + k * s2) / w;
-                let a = self.a_m;
-                gamma
-                    * (1.0 - (2.0 / a) * (1.0 + self.f + m - 2.0 * self.f * s2) * h_m
-                        + (3.0 / (a * a)) * h_m * h_m)
-            }
-            Gravity::SomiglianaLinear { gamma_e, k } => {
-                gamma_e * (1.0 + k * s2) / w * (1.0 - 2.0 * h_m / self.a_m)
-            }
-            Gravity::Psins { g0, c2, c4, dh } => g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h_m,
-            Gravity::Constant { g_mps2 } => g_mps2,
-        };
-        LocalEarth {
-            sin_lat,
-            cos_lat,
-            r_m_m: r_n_m * (1.0 - self.e2) / w2,
-            r_n_m,
-            g_mps2,
-        }
+        self.coeffs().local_sc(sin_lat, cos_lat, h_m)
     }
 
     /// Earth rate in NED from a [`LocalEarth`].

@@ -200,7 +200,7 @@ impl Quat {
     }
 
     /// Quaternion of a rotation vector (S1 eq. 2): `q(φ) = [cos(φ/2), (φ/|φ|) sin(φ/2)]`,
-    /// with the Taylor series below |φ| = 1e-2 rad.
+    /// with the Taylor series below |φ| = 1e-2 rad (two terms below 1e-6 rad).
     ///
     /// Series (φ² = |φ|²): `cos(φ/2) = 1 − (φ²/8)(1 − (φ²/48)(1 − φ²/120))` and
     /// `sin(φ/2)/φ = ½(1 − (φ²/24)(1 − (φ²/80)(1 − φ²/168)))`, the first omitted terms
@@ -211,11 +211,13 @@ impl Quat {
     pub fn from_rotvec(phi: &Vec3) -> Self {
         let a2 = phi.norm_squared();
         // |φ| < 1e-2 ⇔ |φ|² < 1e-4: the square root is only taken where it is used
-        let (c, s_over) = if a2 < 1e-4 {
+        let (c, s_over) = if a2 < 1e-12 {
+            // |φ| < 1e-6: the next terms φ⁴/384 and φ⁴/3840 are below 3e-27
+            (1.0 - 0.125 * a2, 0.5 - a2 * (1.0 / 48.0))
+        } else if a2 < 1e-4 {
             (
                 1.0 - (0.125 * a2) * (1.0 - (a2 * (1.0 / 48.0)) * (1.0 - a2 * (1.0 / 120.0))),
-                0.5 - (0.5 / 24.0 * a2)
-                    * (1.0 - (a2 * (1.0 / 80.0)) * (1.0 - a2 * (1.0 / 168.0))),
+                0.5 - (0.5 / 24.0 * a2) * (1.0 - (a2 * (1.0 / 80.0)) * (1.0 - a2 * (1.0 / 168.0))),
             )
         } else {
             let a = libm::sqrt(a2);

@@ -7,8 +7,8 @@
 
 use super::{wrap_pi, InitialState, Mechanization, NavState};
 use crate::coning::{compensate, ConingSet, Increment};
-use crate::earth::{sin_cos_step, EarthModel, SinCosTrack};
-use crate::math::{Mat3, Quat, Vec3};
+use crate::earth::{sin_cos_step, EarthCoeffs, EarthModel, SinCosTrack};
+use crate::math::{Quat, Vec3};
 
 /// Velocity-update formula (docs/theory/mechanizations.md §"Velocity").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,8 +99,12 @@ pub struct LocalLevelConfig {
 #[derive(Clone, Debug)]
 pub struct LocalLevel {
     cfg: LocalLevelConfig,
+    /// the earth model's constant factors
+    earth: EarthCoeffs,
     /// which instance of the update runs (see [`Shape`])
     shape: u8,
+    /// which coning instance [`Mechanization::update_many`] runs (see [`Shape::coning`])
+    coning_shape: u8,
     dt_update_s: f64,
     // position carried as offsets from the start (docs/theory/mechanizations.md §"Position"
     // roundoff recommendation)
@@ -113,16 +117,16 @@ pub struct LocalLevel {
     c_half_lat0: f64,
     dlat_rad: f64,
     dlon_rad: f64,
-    h_m: f64,
-    v_n_mps: Vec3,
     /// Transport mode: `P = q_y(−L0) ⊗ Q_b^{n0ⁱ}` (the gyro-only quaternion of S1 eq. 6
     /// referred to the start's earth axes); Five, Savage modes: q_b^n
     q: Quat,
-    c_b_n: Mat3,
+    /// updates until the next renormalization of `q`
+    renorm_in: u8,
+    /// the state: time, position (from the offsets), height, velocity, attitude, kept as
+    /// the value [`Mechanization::state`] returns (one copy per hand-off)
+    out: NavState,
     /// updates done, as a float (exact below 2⁵³)
     updates: f64,
-    /// time of the state, `updates · ΔT` \[s\]
-    t_s: f64,
     prev: Increment,
     /// ω_ie, ω_en, g at t_{k−2} (for midpoint extrapolation)
     rates_prev: Rates,
@@ -136,6 +140,13 @@ pub struct LocalLevel {
     /// sin/cos of half the transport angle, `(Δλ + Ω_e t)/2`
     half_delta: SinCosTrack,
 }
+
+/// Updates between two renormalizations of the attitude quaternion. A product of unit
+/// quaternions is unit to a few ulp; the norm error random-walks by ≈ 2e-16 per update, so
+/// it stays below 1e-15 between renormalizations (tested), and the DCM it gives is a
+/// rotation scaled by `|q|²`: the velocity increment `C Δv` changes by |q|² − 1 of itself
+/// (< 1e-15 of a few cm/s), and the attitude error, the antisymmetric part, not at all.
+const RENORM_EVERY: u8 = 8;
 
 /// The options that select branches of the update, as constants of an instance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -189,13 +200,39 @@ impl Shape {
         }
     }
 
-    /// The instance that runs `cfg`.
+    /// The instance that runs `cfg` (the dedicated ones assume the transport rate, i.e.
+    /// not the flat model).
     fn instance(cfg: &LocalLevelConfig) -> u8 {
         match Shape::of(cfg) {
+            _ if !cfg.earth.transport => Shape::GENERAL,
             s if s == Shape::SONG_LEE_COMPLETE => Shape::SLC,
             s if s == Shape::SONG_LEE => Shape::SL,
             s if s == Shape::SAVAGE => Shape::SAV,
             _ => Shape::GENERAL,
+        }
+    }
+
+    /// Coning instances of the batch update: the set as a constant for the defaults of
+    /// N = 1 (`1prev`) and N = 3 (`three_poly`), else read from the configuration.
+    const CONING_ANY: u8 = 0;
+    const CONING_1PREV: u8 = 1;
+    const CONING_THREE_POLY: u8 = 3;
+
+    fn coning(cfg: &LocalLevelConfig) -> u8 {
+        match (cfg.coning, cfg.samples) {
+            (ConingSet::OnePrev, 1) => Shape::CONING_1PREV,
+            (ConingSet::ThreePoly, 3) => Shape::CONING_THREE_POLY,
+            _ => Shape::CONING_ANY,
+        }
+    }
+
+    /// The coning set of coning instance `K`.
+    #[inline(always)]
+    fn coning_set<const K: u8>(cfg: &LocalLevelConfig) -> ConingSet {
+        match K {
+            Shape::CONING_1PREV => ConingSet::OnePrev,
+            Shape::CONING_THREE_POLY => ConingSet::ThreePoly,
+            _ => cfg.coning,
         }
     }
 
@@ -278,6 +315,8 @@ impl LocalLevel {
         };
         Self {
             shape: Shape::instance(&cfg),
+            coning_shape: Shape::coning(&cfg),
+            earth: cfg.earth.coeffs(),
             dt_update_s: cfg.dt_s * cfg.samples as f64,
             cfg,
             lat0_rad: init.lat_rad,
@@ -288,12 +327,17 @@ impl LocalLevel {
             c_half_lat0,
             dlat_rad: 0.0,
             dlon_rad: 0.0,
-            h_m: init.h_m,
-            v_n_mps: init.v_n_mps,
             q: q_state,
-            c_b_n: q.to_dcm(),
+            renorm_in: RENORM_EVERY,
+            out: NavState {
+                t_s: 0.0,
+                lat_rad: init.lat_rad,
+                lon_rad: wrap_pi(init.lon_rad),
+                h_m: init.h_m,
+                v_n_mps: init.v_n_mps,
+                c_b_n: q.to_dcm(),
+            },
             updates: 0.0,
-            t_s: 0.0,
             prev: Increment::default(),
             rates_prev: Rates::default(),
             has_rates_prev: false,
@@ -314,12 +358,25 @@ impl LocalLevel {
         self.lat0_rad + self.dlat_rad
     }
 
+    /// `q`, renormalized ([`Quat::renormalized`]) every [`RENORM_EVERY`] updates.
+    /// (`countdown` is `renorm_in`.)
+    #[inline(always)]
+    fn renorm(countdown: &mut u8, q: Quat) -> Quat {
+        *countdown -= 1;
+        if *countdown == 0 {
+            *countdown = RENORM_EVERY;
+            q.renormalized()
+        } else {
+            q
+        }
+    }
+
     /// `sin/cos` of half the transport angle, `(Δλ + Ω_e t)/2` (S1 eq. 32; on the flat model
     /// without transport `Ω_e t`).
     #[inline]
-    fn half_delta(&mut self, dlon_rad: f64, t_s: f64) -> (f64, f64) {
+    fn half_delta(&mut self, transport: bool, dlon_rad: f64, t_s: f64) -> (f64, f64) {
         let e = &self.cfg.earth;
-        let delta = if e.transport {
+        let delta = if transport {
             dlon_rad + e.omega_ie_rps * t_s
         } else {
             e.omega_ie_rps * t_s
@@ -327,22 +384,81 @@ impl LocalLevel {
         self.half_delta.sin_cos(0.5 * delta)
     }
 
-    /// One update (see [`Mechanization::update`]); `S` is the instance of [`Shape`].
+    /// [`Mechanization::update_many`] with instances `S`, `K` (the dispatch once per call).
+    #[inline(never)]
+    fn steps<const S: u8, const K: u8>(
+        &mut self,
+        samples: &[Increment],
+        states: &mut [NavState],
+    ) -> usize {
+        // N as a constant where the coning instance fixes it (its instance requires it)
+        let n = match K {
+            Shape::CONING_1PREV => 1,
+            Shape::CONING_THREE_POLY => 3,
+            _ => self.cfg.samples.max(1),
+        };
+        let m = (samples.len() / n).min(states.len());
+        let mut chunks = samples.chunks_exact(n);
+        let (Some(first), Some(slot0)) = (chunks.next(), states.first_mut()) else {
+            return 0;
+        };
+        let cur = self.out;
+        *slot0 = self.step::<S, K>(first, &cur);
+        // the state of update k is read from slot k − 1 and written into slot k (not via
+        // `out`: one copy of the 128-byte state less per update)
+        for (k, chunk) in (1..m).zip(chunks) {
+            let (done, rest) = states.split_at_mut(k);
+            rest[0] = self.step::<S, K>(chunk, &done[k - 1]);
+        }
+        self.out = states[m - 1];
+        m
+    }
+
+    /// One update (see [`Mechanization::update`]) from the state `cur` (height, velocity
+    /// and attitude are read from it, the rest of the state is `self`'s); returns the new
+    /// state. `S` and `K` are the instances of [`Shape`] (options, coning set).
     #[inline(always)]
-    fn step<const S: u8>(&mut self, samples: &[Increment]) {
+    fn step<const S: u8, const K: u8>(
+        &mut self,
+        samples: &[Increment],
+        cur: &NavState,
+    ) -> NavState {
         let shape = Shape::get::<S>(&self.cfg);
+        // the dedicated instances run with the transport rate only
+        let transport = S != Shape::GENERAL || self.cfg.earth.transport;
         let n = self.cfg.samples.min(samples.len());
-        let samples = &samples[..n];
+        // (the coning instances are run with chunks of exactly N samples)
+        let samples = match K {
+            Shape::CONING_ANY => &samples[..n],
+            _ => samples,
+        };
         let e = &self.cfg.earth;
         let dt = self.dt_update_s;
         let (s_lat, c_lat) = (self.sin_lat, self.cos_lat);
-        let h = self.h_m;
-        let v = self.v_n_mps;
+        let h = cur.h_m;
+        let v = cur.v_n_mps;
 
         // 1.–2. increments and rates at t_{k−1}
-        let comp = compensate(self.cfg.coning, samples, &self.prev);
-        let le = e.local_sc(s_lat, c_lat, h);
-        let w_en = e.omega_en_n_local(&le, h, &v);
+        let comp = compensate(Shape::coning_set::<K>(&self.cfg), samples, &self.prev);
+        if shape.attitude == AttitudeMode::Transport {
+            // the gyro-only part of the attitude (step 5 below) needs nothing else: done
+            // here, it does not keep Δφ through the velocity and position updates
+            self.q = Self::renorm(
+                &mut self.renorm_in,
+                self.q.mul(&Quat::from_rotvec(&comp.dphi_b_rad)),
+            );
+        }
+        let ec = &self.earth;
+        let le = ec.local_sc(s_lat, c_lat, h);
+        // ω_en^n = [v_E/(R_N+h), −v_N/(R_M+h), −v_E tan L/(R_N+h)] (EarthModel::omega_en_n)
+        //  (v_E tan L/(R_N+h) as (v_E/(R_N+h)) tan L: one division less, ≤ 1 ulp apart)
+        let w_en = if transport {
+            let rn = le.r_n_m + h;
+            let ve_rn = v.y / rn;
+            Vec3::new(ve_rn, -v.x / (le.r_m_m + h), -ve_rn * (s_lat / c_lat))
+        } else {
+            Vec3::zeros()
+        };
         let now = Rates {
             w_ie_n: e.omega_ie_rps * c_lat,
             w_ie_d: -e.omega_ie_rps * s_lat,
@@ -380,7 +496,7 @@ impl LocalLevel {
         if shape.rot3 {
             dv_rot += x.cross(&x_dv) * (1.0 / 6.0);
         }
-        let c = &self.c_b_n;
+        let c = &cur.c_b_n;
         let c_dv = c * dv_b;
         let u = Vec3::new(0.0, 0.0, r.g_mps2) - w_cor.cross(&v);
         let mut v_new = v + c_dv + c * dv_rot + dt * u;
@@ -403,18 +519,23 @@ impl LocalLevel {
         let h_bar = 0.5 * (h + h_new);
         let vn_bar = 0.5 * (v.x + v_new.x);
         let ve_bar = 0.5 * (v.y + v_new.y);
-        let (dlat_step, s_bar, c_bar) = if e.transport {
+        //    The radii are those of the predicted midpoint; the corrected one is
+        //    δ = ½(step − pred_step) away (δ ≈ 0.005 step², 5e-17 rad at Mach 1 north and
+        //    6 ms, 5e-15 rad at 6 m per update), which moves R_N by e² sinL cosL δ (< 2e-17
+        //    of it) and enters cos L̄ to first order.
+        let (dlat_step, r_n_bar, c_bar) = if transport {
             let pred_step = vn_bar * dt / (le.r_m_m + h_bar);
-            let (s_m, _) = sin_cos_step(s_lat, c_lat, 0.5 * pred_step);
-            let step = vn_bar * dt / (e.radii_sin(s_m).r_m_m + h_bar);
-            let (s_bar, c_bar) = sin_cos_step(s_lat, c_lat, 0.5 * step);
-            (step, s_bar, c_bar)
+            let (s_m, c_m) = sin_cos_step(s_lat, c_lat, 0.5 * pred_step);
+            let r_mid = ec.radii_sin(s_m);
+            let step = vn_bar * dt / (r_mid.r_m_m + h_bar);
+            (step, r_mid.r_n_m, c_m - s_m * (0.5 * (step - pred_step)))
         } else {
             let (s0, c0) = (self.s_lat0, self.c_lat0);
-            (vn_bar * dt / (e.radii_sin(s0).r_m_m + h_bar), s0, c0)
+            let r0 = ec.radii_sin(s0);
+            (vn_bar * dt / (r0.r_m_m + h_bar), r0.r_n_m, c0)
         };
         let dlat_new = self.dlat_rad + dlat_step;
-        let dlon_new = self.dlon_rad + ve_bar * dt / ((e.radii_sin(s_bar).r_n_m + h_bar) * c_bar);
+        let dlon_new = self.dlon_rad + ve_bar * dt / ((r_n_bar + h_bar) * c_bar);
         // sin/cos of L_k/2: the transport rotation's, and (as sin/cos L) L_{k−1} of the next
         // update
         let (s_half, c_half) = self.half_lat.sin_cos(0.5 * dlat_new);
@@ -422,32 +543,31 @@ impl LocalLevel {
         // 5. attitude
         self.updates += 1.0;
         let t = self.updates * dt;
-        match shape.attitude {
+        let c_b_n = match shape.attitude {
             AttitudeMode::Transport => {
                 // S1 eq. (6)/(32): Q_k = Q_{k−1} ⊗ q(Δφ), C_b^n = T(L_k, Δλ_k + Ω_e t_k) C(Q_k),
-                // with T = R_y(L) R_x(−Δ) R_y(−L0) and P = q_y(−L0) ⊗ Q (see the type's notes)
-                self.q = self
-                    .q
-                    .mul(&Quat::from_rotvec(&comp.dphi_b_rad))
-                    .renormalized();
-                let (s_l, c_l) = if self.cfg.earth.transport {
+                // with T = R_y(L) R_x(−Δ) R_y(−L0) and P = q_y(−L0) ⊗ Q (see the type's notes);
+                // P was advanced after the coning compensation
+                let (s_l, c_l) = if transport {
                     (s_half, c_half)
                 } else {
                     (self.s_half_lat0, self.c_half_lat0)
                 };
-                let (s_d, c_d) = self.half_delta(dlon_new, t);
-                self.c_b_n = y_mul(s_l, c_l, &x_mul(-s_d, c_d, &self.q)).to_dcm();
+                let (s_d, c_d) = self.half_delta(transport, dlon_new, t);
+                y_mul(s_l, c_l, &x_mul(-s_d, c_d, &self.q)).to_dcm()
             }
             AttitudeMode::Savage => {
                 let zeta = w_in * dt;
-                self.q = Quat::from_rotvec(&(-zeta))
-                    .mul(&self.q)
-                    .mul(&Quat::from_rotvec(&comp.dphi_b_rad))
-                    .renormalized();
-                self.c_b_n = self.q.to_dcm();
+                self.q = Self::renorm(
+                    &mut self.renorm_in,
+                    Quat::from_rotvec(&(-zeta))
+                        .mul(&self.q)
+                        .mul(&Quat::from_rotvec(&comp.dphi_b_rad)),
+                );
+                self.q.to_dcm()
             }
             AttitudeMode::Five => {
-                let w_in_b = self.c_b_n.transpose() * w_in * (dt / n.max(1) as f64);
+                let w_in_b = cur.c_b_n.transpose() * w_in * (dt / n.max(1) as f64);
                 let mut rel = [Increment::default(); 4];
                 for (r, s) in rel.iter_mut().zip(samples.iter()) {
                     *r = Increment::new(s.dtheta_b_rad - w_in_b, s.dv_b_mps);
@@ -457,20 +577,25 @@ impl LocalLevel {
                     self.prev.dv_b_mps,
                 );
                 let comp_rel = compensate(self.cfg.coning, &rel[..n.min(4)], &prev_rel);
-                self.q = self
-                    .q
-                    .mul(&Quat::from_rotvec(&comp_rel.dphi_b_rad))
-                    .renormalized();
-                self.c_b_n = self.q.to_dcm();
+                self.q = Self::renorm(
+                    &mut self.renorm_in,
+                    self.q.mul(&Quat::from_rotvec(&comp_rel.dphi_b_rad)),
+                );
+                self.q.to_dcm()
             }
-        }
-        self.t_s = t;
-        self.v_n_mps = v_new;
-        self.h_m = h_new;
+        };
         self.dlat_rad = dlat_new;
         self.dlon_rad = dlon_new;
         (self.sin_lat, self.cos_lat) = full_angle(s_half, c_half);
         self.prev = Increment::new(comp.dtheta_b_rad, comp.dv_b_mps);
+        NavState {
+            t_s: t,
+            lat_rad: self.lat(),
+            lon_rad: wrap_pi(self.lon0_rad + dlon_new),
+            h_m: h_new,
+            v_n_mps: v_new,
+            c_b_n,
+        }
     }
 }
 
@@ -481,37 +606,55 @@ impl Mechanization for LocalLevel {
     }
 
     fn update(&mut self, samples: &[Increment]) {
-        match self.shape {
-            Shape::SLC => self.step::<{ Shape::SLC }>(samples),
-            Shape::SL => self.step::<{ Shape::SL }>(samples),
-            Shape::SAV => self.step::<{ Shape::SAV }>(samples),
-            _ => self.step::<{ Shape::GENERAL }>(samples),
+        const ANY: u8 = Shape::CONING_ANY;
+        let cur = self.out;
+        self.out = match self.shape {
+            Shape::SLC => self.step::<{ Shape::SLC }, ANY>(samples, &cur),
+            Shape::SL => self.step::<{ Shape::SL }, ANY>(samples, &cur),
+            Shape::SAV => self.step::<{ Shape::SAV }, ANY>(samples, &cur),
+            _ => self.step::<{ Shape::GENERAL }, ANY>(samples, &cur),
+        };
+    }
+
+    fn update_many(&mut self, samples: &[Increment], states: &mut [NavState]) -> usize {
+        const ANY: u8 = Shape::CONING_ANY;
+        match (self.shape, self.coning_shape) {
+            (Shape::SLC, Shape::CONING_1PREV) => {
+                self.steps::<{ Shape::SLC }, { Shape::CONING_1PREV }>(samples, states)
+            }
+            (Shape::SLC, Shape::CONING_THREE_POLY) => {
+                self.steps::<{ Shape::SLC }, { Shape::CONING_THREE_POLY }>(samples, states)
+            }
+            (Shape::SLC, _) => self.steps::<{ Shape::SLC }, ANY>(samples, states),
+            (Shape::SL, _) => self.steps::<{ Shape::SL }, ANY>(samples, states),
+            (Shape::SAV, _) => self.steps::<{ Shape::SAV }, ANY>(samples, states),
+            _ => self.steps::<{ Shape::GENERAL }, ANY>(samples, states),
         }
     }
 
     #[inline]
     fn state(&self) -> NavState {
-        NavState {
-            t_s: self.t_s,
-            lat_rad: self.lat(),
-            lon_rad: wrap_pi(self.lon0_rad + self.dlon_rad),
-            h_m: self.h_m,
-            v_n_mps: self.v_n_mps,
-            c_b_n: self.c_b_n,
-        }
+        self.out
+    }
+
+    #[inline]
+    fn state_into(&self, out: &mut NavState) {
+        *out = self.out;
     }
 
     fn hold_vertical(&mut self, h_m: f64, v_d_mps: f64) {
-        self.h_m = h_m;
-        self.v_n_mps.z = v_d_mps;
+        self.out.h_m = h_m;
+        self.out.v_n_mps.z = v_d_mps;
     }
 
     fn correct_state(&mut self, s: &NavState) {
         // offsets from the start stay continuous (no wrap of dlon across ±180°)
         self.dlat_rad += s.lat_rad - self.lat();
         self.dlon_rad += wrap_pi(s.lon_rad - wrap_pi(self.lon0_rad + self.dlon_rad));
-        self.h_m = s.h_m;
-        self.v_n_mps = s.v_n_mps;
+        self.out.lat_rad = self.lat();
+        self.out.lon_rad = wrap_pi(self.lon0_rad + self.dlon_rad);
+        self.out.h_m = s.h_m;
+        self.out.v_n_mps = s.v_n_mps;
         // the latitude jumped: a new reference for its sine and cosine
         self.half_lat = SinCosTrack::new(0.5 * self.lat0_rad, 0.5 * self.dlat_rad);
         let (s_half, c_half) = self.half_lat.sin_cos_ref();
@@ -525,11 +668,13 @@ impl Mechanization for LocalLevel {
                 } else {
                     (self.s_half_lat0, self.c_half_lat0)
                 };
-                let (s_d, c_d) = self.half_delta(self.dlon_rad, self.t_s);
+                let (s_d, c_d) =
+                    self.half_delta(self.cfg.earth.transport, self.dlon_rad, self.out.t_s);
                 x_mul(s_d, c_d, &y_mul(-s_l, c_l, &q_b_n)).normalized()
             }
             AttitudeMode::Savage | AttitudeMode::Five => q_b_n,
         };
-        self.c_b_n = s.c_b_n;
+        self.out.c_b_n = s.c_b_n;
+        self.renorm_in = RENORM_EVERY;
     }
 }
