@@ -301,6 +301,20 @@ mod tests {
             let back = Quat::from_rotvec(&phi).to_rotvec();
             assert!((back - phi).norm() <= 1e-15 * (1.0 + phi.norm()), "{phi:?}");
         }
+        // The series against the closed form below 1e-2 rad, and across both switches
+        for a in [5e-7, 2e-6, 1e-4, 3e-3, 9.99e-3] {
+            let phi = Vec3::new(0.6, -0.48, 0.64) * a; // |(0.6, −0.48, 0.64)| = 1
+            let q = Quat::from_rotvec(&phi);
+            let (s, c) = (0.5 * a).sin_cos();
+            assert!((q.w - c).abs() < 2e-16 && (q.vec() - phi * (s / a)).norm() < 2e-16 * a);
+        }
+        for a in [1e-6, 1e-2] {
+            let below = Quat::from_rotvec(&Vec3::new(a * (1.0 - 1e-15), 0.0, 0.0));
+            let above = Quat::from_rotvec(&Vec3::new(a * (1.0 + 1e-15), 0.0, 0.0));
+            assert!((above.w - below.w).abs() < 3e-16 && (above.x - below.x).abs() < 3e-16);
+        }
+        let q = Quat::new(1.0 + 3e-12, 2e-12, -1e-12, 0.0).renormalized();
+        assert!((q.norm() - 1.0).abs() < 2e-16);
         // Series and closed form agree across the 1e-6 switch to roundoff.
         let below = Quat::from_rotvec(&Vec3::new(0.999_999_9e-6, 0.0, 0.0));
         let above = Quat::from_rotvec(&Vec3::new(1.000_000_1e-6, 0.0, 0.0));

@@ -678,3 +678,141 @@ impl Mechanization for LocalLevel {
         self.renorm_in = RENORM_EVERY;
     }
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::math::{c_b_n_from_euler, Euler, Mat3};
+    use std::{vec, vec::Vec};
+    use crate::nav::{transport_matrix, AlgorithmKind, AlgorithmSpec, AnyMechanization};
+
+    #[test]
+    fn transport_factors_into_elementary_rotations() {
+        // T(L, Δ) of S1 eq. (32) = R_y(L) R_x(−Δ) R_y(−L0), as quaternions of half angles
+        let (l0, l, delta) = (0.65_f64, 0.7_f64, 0.31_f64);
+        let t = transport_matrix(l, l0.sin(), l0.cos(), delta);
+        let (s0, c0) = (0.5 * l0).sin_cos();
+        let (sl, cl) = (0.5 * l).sin_cos();
+        let (sd, cd) = (0.5 * delta).sin_cos();
+        let q = y_mul(sl, cl, &x_mul(-sd, cd, &y_mul(-s0, c0, &Quat::IDENTITY)));
+        assert!((q.to_dcm() - t).abs().max() < 1e-15);
+        let (s, c) = full_angle(sl, cl);
+        assert!((s - l.sin()).abs() < 2e-16 && (c - l.cos()).abs() < 2e-16);
+    }
+
+    fn init() -> InitialState {
+        InitialState {
+            lat_rad: 0.61,
+            lon_rad: 2.2,
+            h_m: 300.0,
+            v_n_mps: Vec3::new(180.0, -240.0, 2.0),
+            c_b_n: c_b_n_from_euler(&Euler::new(0.05, -0.1, 2.3)),
+        }
+    }
+
+    /// A rotating, accelerating body: increments of a slow coning plus a turn.
+    fn increments(count: usize, dt: f64) -> Vec<Increment> {
+        (0..count)
+            .map(|k| {
+                let t = k as f64 * dt;
+                Increment::new(
+                    Vec3::new(
+                        1e-3 * (3.0 * t).sin(),
+                        1e-3 * (3.0 * t).cos(),
+                        0.05 + 1e-3 * t.sin(),
+                    ) * dt,
+                    Vec3::new(0.5 * t.cos(), 0.2, -9.8 + 0.1 * t.sin()) * dt,
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn update_many_gives_the_states_of_update_and_state() {
+        // every instance (the three defaults with 1prev at N = 1 and three_poly at N = 3,
+        // the general one with other options and the flat model) hands over the same bits
+        let dt = 0.01;
+        let incs = increments(3000, dt);
+        let mut specs = Vec::new();
+        for n in [1, 2, 3] {
+            for kind in [
+                AlgorithmKind::Savage,
+                AlgorithmKind::SongLee,
+                AlgorithmKind::SongLeeComplete,
+            ] {
+                let mut spec = AlgorithmSpec::new(kind, n);
+                spec.coning = ConingSet::recommended_for(n);
+                specs.push((spec, EarthModel::WGS84));
+                let mut five = spec;
+                five.attitude = Some(AttitudeMode::Five);
+                specs.push((five, EarthModel::WGS84));
+                specs.push((spec, EarthModel::flat(9.80665)));
+            }
+        }
+        for (spec, earth) in specs {
+            let mut a = AnyMechanization::new(&spec, earth, dt, &init());
+            let mut b = a.clone();
+            let n = spec.samples;
+            let one: Vec<NavState> = incs
+                .chunks_exact(n)
+                .map(|c| {
+                    a.update(c);
+                    a.state()
+                })
+                .collect();
+            let mut many = vec![b.state(); 700];
+            let mut done = 0;
+            while done < one.len() {
+                let k = b.update_many(&incs[done * n..], &mut many);
+                assert_eq!(&many[..k], &one[done..done + k], "{spec:?} {earth:?}");
+                done += k;
+            }
+            assert_eq!(b.state(), a.state());
+        }
+    }
+
+    #[test]
+    fn lazy_renormalization_keeps_the_attitude_unit() {
+        let dt = 0.002;
+        let incs = increments(200_000, dt);
+        let mut spec = AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 1);
+        spec.coning = ConingSet::OnePrev;
+        let AnyMechanization::LocalLevel(mut m) =
+            AnyMechanization::new(&spec, EarthModel::WGS84, dt, &init())
+        else {
+            unreachable!()
+        };
+        let mut worst: f64 = 0.0;
+        for c in incs.chunks_exact(1) {
+            m.update(c);
+            worst = worst.max((m.q.norm() - 1.0).abs());
+        }
+        assert!(worst < 1e-15, "{worst:e}");
+        let c = m.state().c_b_n;
+        assert!((c * c.transpose() - Mat3::identity()).abs().max() < 4e-15);
+    }
+
+    #[test]
+    fn correct_state_with_the_own_state_changes_nothing_but_rounding() {
+        let dt = 0.01;
+        let incs = increments(2000, dt);
+        let spec = AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 2);
+        let mut a = AnyMechanization::new(&spec, EarthModel::WGS84, dt, &init());
+        let mut b = a.clone();
+        for (k, c) in incs.chunks_exact(2).enumerate() {
+            a.update(c);
+            b.update(c);
+            if k % 100 == 50 {
+                let s = b.state();
+                b.correct_state(&s);
+                assert_eq!(b.state().c_b_n, s.c_b_n);
+            }
+        }
+        let (sa, sb) = (a.state(), b.state());
+        assert!((sa.c_b_n - sb.c_b_n).abs().max() < 1e-14);
+        assert!((sa.v_n_mps - sb.v_n_mps).norm() < 1e-11);
+        assert!((sa.lat_rad - sb.lat_rad).abs() < 1e-15);
+    }
+}
