@@ -41,7 +41,7 @@ fuzz_target!(|data: &[u8]| {
     let opts = RunOptions {
         algos,
         vertical_hold: pick & 0x80 != 0,
-        every: 1,
+        every_s: None,
         until_s: Some(until_s),
         sensor_run: Some(u64::from(pick)),
     };

@@ -33,6 +33,11 @@ from ._sdins import McState, Scenario, SdinsError
 
 __version__: str = _sdins.__version__
 
+
+def __dir__() -> List[str]:
+    """The public names only (PEP 562): ``dir(sdins)`` lists what ``__all__`` exports."""
+    return sorted(__all__ + ["__version__"])
+
 __all__ = [
     "fuse_files",
     "SdinsError",
@@ -59,6 +64,7 @@ __all__ = [
     "ErrorAnalysis",
     "FuseResult",
     "align",
+    "calibrate",
     "errors",
     "fuse",
     "schuler_share",
@@ -165,6 +171,7 @@ def run(
     until_s: Optional[float] = None,
     ideal: Optional[bool] = None,
     run: Optional[int] = None,
+    grade: Optional[str] = None,
 ) -> RunResult:
     """Run the scenario's exact truth through algorithms side by side (``sdins run``).
 
@@ -173,22 +180,39 @@ def run(
     ``rotvec`` (theta, phi), ``rot3``: as the CLI options; ``vertical``: free or hold
     (default: the scenario's); ``every_s``: output epoch spacing [s] (default 1);
     ``until_s``: stop time [s]; ``ideal``: ignore the scenario's IMU error model;
-    ``run``: sensor-error realisation (default 0). Returns a dict algo → AlgorithmRun
+    ``run``: sensor-error realisation (default 0); ``grade``: an IMU grade preset
+    replacing the scenario's error model (marine, aviation, intermediate, tactical,
+    consumer). Output rows are the updates nearest to 0, every_s, 2·every_s, … s (with
+    their own times) and the last update. Returns a dict algo → AlgorithmRun
     with the errors against the truth at the output epochs (the CLI's err_*.csv) and
     the final and maximum errors (its ``--json``).
     """
     d = _sdins.run(
         _scenario(scenario), algos, samples, coning, attitude, rotvec, rot3,
-        vertical, every_s, until_s, ideal, run,
+        vertical, every_s, until_s, ideal, run, grade,
     )
     return RunResult((k, AlgorithmRun(v)) for k, v in d.items())
 
 
-def read_imu(path: Any, format: Optional[str] = "auto") -> ImuRecord:
+def _imu_format(imu_format: Optional[str], format: Optional[str]) -> Optional[str]:
+    """``imu_format``, the one name of the option (``--imu-format``); ``format`` is its
+    deprecated alias."""
+    if format is not None:
+        import warnings
+
+        warnings.warn("format= is deprecated; use imu_format=", DeprecationWarning, stacklevel=3)
+        if imu_format is not None and imu_format != format:
+            raise SdinsError(f"imu_format={imu_format!r} and format={format!r} disagree: give imu_format only")
+        return format
+    return imu_format
+
+
+def read_imu(path: Any, imu_format: Optional[str] = "auto", format: Optional[str] = None) -> ImuRecord:
     """Read an IMU file: sdins CSV, PSINS ``.imu`` (psins) or trj CSV (psins-csv),
-    KF-GINS text (kfgins), NaveGo CSV (navego); ``format="auto"`` detects it
-    (docs/imu-files.md). Increments are converted to body FRD."""
-    return ImuRecord(_sdins.read_imu(str(path), format))
+    KF-GINS text (kfgins), NaveGo CSV (navego); ``imu_format="auto"`` detects it
+    (docs/imu-files.md; ``format=`` is a deprecated alias). Increments are converted to
+    body FRD."""
+    return ImuRecord(_sdins.read_imu(str(path), _imu_format(imu_format, format)))
 
 
 def allan(dtheta: Any, dv: Any, dt: float) -> AllanResult:
@@ -239,7 +263,7 @@ def merge(states: Iterable[McState], allow_partial: Optional[bool] = None) -> Mc
 def align(
     scenario: Optional[Union[Scenario, str]] = None,
     imu: Optional[Any] = None,
-    format: Optional[str] = None,
+    imu_format: Optional[str] = None,
     method: Optional[str] = None,
     alg: Optional[str] = None,
     start: Optional[str] = None,
@@ -251,10 +275,11 @@ def align(
     sigma_z_mps: Optional[float] = None,
     vrw_ug_per_sqrt_hz: Optional[float] = None,
     arw_deg_per_sqrt_h: Optional[float] = None,
+    format: Optional[str] = None,
 ) -> AlignResult:
     """Initial alignment (``sdins align``) of a scenario (with run ``run`` of its IMU
-    error model, default 0) or an IMU file ``imu`` (``format``: auto (default), sdins,
-    psins, psins-csv, kfgins, navego).
+    error model, default 0) or an IMU file ``imu`` (``imu_format``: auto (default), sdins,
+    psins, psins-csv, kfgins, navego; ``format=`` is a deprecated alias).
 
     ``method``: coarse1, coarse2, i0, fine (default) or multiheading; ``alg``: a
     (default) or b (multi-heading); ``start``: i0 (default) or coarse2 (fine filter
@@ -272,7 +297,7 @@ def align(
     scn = None if scenario is None else _scenario(scenario)
     return AlignResult(
         _sdins.align(
-            scn, None if imu is None else str(imu), format, method, alg, start, lat_deg,
+            scn, None if imu is None else str(imu), _imu_format(imu_format, format), method, alg, start, lat_deg,
             h_m, window_s, duration_s, run, sigma_z_mps, vrw_ug_per_sqrt_hz,
             arw_deg_per_sqrt_h,
         )
@@ -298,6 +323,36 @@ def errors(
     g = None if gyro_bias_dph is None else [float(x) for x in gyro_bias_dph]
     a = None if accel_bias_ug is None else [float(x) for x in accel_bias_ug]
     return ErrorAnalysis(_sdins.errors(grade, g, a, hours, lat_deg, nonlinear))
+
+
+def calibrate(
+    scenario: Union[Scenario, str],
+    imu: Optional[Any] = None,
+    imu_format: Optional[str] = None,
+    run: Optional[int] = None,
+    runs: Optional[int] = None,
+    draw_scale_ppm: Optional[Tuple[float, float]] = None,
+    draw_misalignment_mrad: Optional[Tuple[float, float]] = None,
+    draw: Optional[bool] = None,
+) -> Dict[str, Any]:
+    """Turntable calibration (``sdins calibrate``) of the scenario's schedule: on its
+    simulated IMU (run ``run``, default 0; ``runs`` > 1: a Monte Carlo over runs 0..runs)
+    or on a recorded IMU file ``imu`` (``imu_format``: auto (default), sdins, psins, …).
+
+    ``draw_scale_ppm`` / ``draw_misalignment_mrad``: the (lo, hi) magnitudes of the drawn
+    scale factors and misalignments (default (100, 1000) ppm, (0.1, 1) mrad); ``draw=False``
+    keeps the scenario's own. Returns the ``sdins calibrate --json`` summary as a dict
+    (parameters with estimate, 1σ and truth; NEES; the Monte Carlo summary).
+    """
+    import json
+
+    t = _sdins.calibrate(
+        _scenario(scenario), None if imu is None else str(imu), imu_format, run, runs,
+        None if draw_scale_ppm is None else (float(draw_scale_ppm[0]), float(draw_scale_ppm[1])),
+        None if draw_misalignment_mrad is None else (float(draw_misalignment_mrad[0]), float(draw_misalignment_mrad[1])),
+        draw,
+    )
+    return json.loads(t)
 
 
 def schuler_share() -> List[Dict[str, Any]]:

@@ -68,10 +68,14 @@ def test_navigate_equals_run_state_for_state():
     nav = sdins.navigate(t.dtheta_rad, t.dv_mps, t.dt_s, init, algo="songlee-complete", samples=3)
     run = sdins.run(scn, algos=["songlee-complete"], every_s=3 * t.dt_s, vertical="free", ideal=True)
     rn = run["songlee-complete"].nav
-    assert len(nav) == len(rn) == 5000
+    # run keeps the initial state as its first row (the epoch rule), navigate returns
+    # the state after every update
+    assert len(nav) == 5000 and len(rn) == 5001
+    assert rn.t_s[0] == 0.0
+    assert np.array_equal(nav.t_s, rn.t_s[1:])
     # init through degrees costs ≤ 1 ulp of the angles; the algorithm is the same
-    assert np.max(np.abs(nav.lat_rad - rn.lat_rad)) < 1e-15
-    assert np.max(np.abs(nav.v_ned_mps - rn.v_ned_mps)) < 1e-9
+    assert np.max(np.abs(nav.lat_rad - rn.lat_rad[1:])) < 1e-15
+    assert np.max(np.abs(nav.v_ned_mps - rn.v_ned_mps[1:])) < 1e-9
     # and the complete algorithm is exact to ~1e-10 rad on this case (README table)
     e = run["songlee-complete"].errors
     assert np.max(np.abs(e.att_err_rad)) < 1e-9
@@ -81,7 +85,7 @@ def test_run_defaults_are_the_scenarios():
     r = sdins.run("turn-90dps")
     assert list(r) == sdins.Scenario.builtin("turn-90dps").algos
     a = next(iter(r.values()))
-    assert a.nav_updates == 5000 and len(a.errors) == 30  # 1 s epochs over 30 s
+    assert a.nav_updates == 5000 and len(a.errors) == 31  # 0, 1, …, 30 s
     assert a.errors.t_s[-1] == pytest.approx(30.0)
 
 
@@ -174,3 +178,30 @@ def test_gnss_ins_sim_motion_file_as_scenario(shared_data):
     a = sdins.truth(s, until_s=2.0)
     b = sdins.truth(u, until_s=2.0)
     assert np.array_equal(a.dv_mps, b.dv_mps)
+
+
+def test_docs_list_every_builtin_scenario():
+    """docs/python.md names every built-in scenario (a new one must be documented)."""
+    import pathlib
+    import re
+
+    doc = (pathlib.Path(__file__).parents[2] / "docs" / "python.md").read_text()
+    line = next(l for l in doc.splitlines() if l.startswith("| `sdins.Scenario.builtin(name)`"))
+    listed = set(re.findall(r"`([a-z0-9-]+)`", line.split("|")[2]))
+    names = {n for n, _ in sdins.scenarios()}
+    assert names <= listed, names - listed
+
+
+def test_dir_shows_only_the_public_api():
+    public = set(sdins.__all__) | {"__version__"}
+    assert set(dir(sdins)) == public
+    for hidden in ("Any", "Dict", "np", "Optional"):
+        assert hidden not in dir(sdins)
+
+
+def test_statistics_and_merge_return_one_type():
+    st = sdins.montecarlo("turn-90dps", 2, 1, grade="tactical", until_s=1.0, every_s=0.5)
+    a = st.statistics()
+    b = sdins.merge([st])
+    assert type(a) is type(b) is sdins.McStatistics
+    assert a.sigma.tobytes() == b.sigma.tobytes()

@@ -39,3 +39,28 @@ def test_shards_on_a_local_cluster_merge_bit_for_bit():
     # channel, pos D and vel D, has no spread)
     horizontal = [0, 1, 3, 4, 6, 7, 8]
     assert np.all(merged.sigma[-1, horizontal] > 0)
+
+
+def test_the_documented_dask_example_runs_as_a_script(tmp_path):
+    """docs/montecarlo.md's Dask block, saved as a file and run as `python file.py`
+    (smaller: 16 runs of 60 s in blocks of 2), finishes: the `__main__` guard is there."""
+    import pathlib
+    import re
+    import subprocess
+    import sys
+
+    doc = (pathlib.Path(__file__).parents[2] / "docs" / "montecarlo.md").read_text()
+    section = doc[doc.index("## The same job from Python, on Dask"):]
+    block = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    assert 'if __name__ == "__main__":' in block
+    # 16 runs in blocks of 2: every one of the 8 shards gets a block
+    small = {"1000, 1, shard": "16, 1, shard", "until_s=600.0": "until_s=60.0", "threads=1)": "threads=1, block=2)"}
+    script = block
+    for a, b in small.items():
+        assert a in script, a
+        script = script.replace(a, b)
+    f = tmp_path / "mc_dask.py"
+    f.write_text(script)
+    r = subprocess.run([sys.executable, str(f)], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "t_s" in r.stdout

@@ -56,6 +56,9 @@ impl From<sdins_sim::nav::pipeline::PipelineError> for CliError {
 
 impl From<sdins_sim::scenario::ScenarioError> for CliError {
     fn from(e: sdins_sim::scenario::ScenarioError) -> Self {
-        CliError::BadInput(e.to_string())
+        match e {
+            sdins_sim::scenario::ScenarioError::Cancelled => CliError::Interrupted,
+            other => CliError::BadInput(other.to_string()),
+        }
     }
 }

@@ -6,6 +6,7 @@
 // doc comments of the clap arguments are the --help text: units in [brackets] stay plain
 #![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 
+mod args;
 mod cmd;
 mod csv_out;
 #[allow(dead_code)]
@@ -58,6 +59,8 @@ enum Command {
     Fuse(Box<cmd::fuse::Args>),
     /// Merge Monte Carlo shard states exactly into the statistics of the whole job.
     Merge(cmd::merge::Args),
+    /// GNSS single-point positioning and Doppler velocity from RINEX observation and navigation files.
+    Spp(cmd::spp::Args),
 }
 
 /// Die quietly on a closed stdout (`sdins run --json | head -c1`), like other Unix tools:
@@ -73,6 +76,7 @@ fn restore_sigpipe() {
 
 fn main() -> ExitCode {
     restore_sigpipe();
+    args::warn_deprecated(&std::env::args_os().collect::<Vec<_>>());
     let cli = Cli::parse();
     progress::install_signal_handlers();
     let result = match cli.command {
@@ -88,6 +92,7 @@ fn main() -> ExitCode {
         Command::Montecarlo(a) => cmd::montecarlo::run(a),
         Command::Merge(a) => cmd::merge::run(a),
         Command::Fuse(a) => cmd::fuse::run(*a),
+        Command::Spp(a) => cmd::spp::run(a),
     };
     // a run's outputs all or none: swap the staged files in only if the command succeeded
     let result = output::finish(result);

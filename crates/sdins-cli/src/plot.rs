@@ -1,19 +1,38 @@
 //! Plots (plotters): SVG strings for the self-contained HTML reports and SVG + PNG files
 //! beside them. Text uses the DejaVu Sans font embedded by the `dejavu` crate, so
-//! rendering needs no system fonts.
+//! rendering needs no system fonts; PNGs are drawn by [`raster::Raster`], which places
+//! every glyph exactly (plotters' own font path misplaces flat-topped letters at odd
+//! sizes: "ForWard") and draws thick lines without miter spikes.
 //!
-//! Figure rules (docs/user-guide.md, "Figures"): tick labels formatted for their range
-//! ([`tick_label`]: `1e-3`, `500`, `0.25`), a label count fitted to the panel size so
-//! labels do not overlap, one legend per figure in a strip above the panels (never over
-//! the data), mean ± σ and ±3σ as shaded bands ([`Band`]), and series longer than the
-//! plot width decimated to the minimum and maximum of each pixel column
-//! ([`MinMaxColumns`]) so that short events (a 2 s turn in an hour) stay visible.
+//! Figure rules (docs/user-guide.md, "Figures"): one tick notation per axis chosen from
+//! its range ([`ticks::Ticks`]: plain decimals, or plain mantissas with a shared power of
+//! ten stated in the axis description; every decade of a log axis labelled, top one
+//! included), a label count fitted to the panel size so labels do not overlap, one
+//! legend per figure in a strip above the panels (never over the data), mean ± σ and ±3σ
+//! as shaded bands ([`Band`]) whose legend swatch has their color, everything cut to its
+//! panel ([`clip`]: data beyond the axis range leave the frame, in PNG as in SVG), and
+//! series longer than the plot width decimated to the minimum and maximum of each pixel
+//! column ([`MinMaxColumns`]) so that short events (a 2 s turn in an hour) stay visible.
+
+mod clip;
+mod decimate;
+mod raster;
+mod ticks;
+
+pub use decimate::MinMaxColumns;
 
 use crate::error::CliError;
+use decimate::{decimate, decimate_band};
+use plotters::coord::combinators::LogCoord;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::FontStyle;
+use raster::Raster;
+use std::ops::Range;
 use std::path::Path;
+use ticks::{Axis, Ticks};
 
 /// Y-axis scale of time-series plots (`--plot-scale`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -119,6 +138,9 @@ pub struct Band {
     pub color_of: String,
     /// (x, low, high)
     pub points: Vec<(f64, f64, f64)>,
+    /// also draw the low and high curves as thin lines in the full color, so that
+    /// overlapping bands stay apart (the legend swatch is outlined too)
+    pub outline: bool,
 }
 
 /// One panel: axes, labels, bands and lines.
@@ -146,6 +168,9 @@ pub struct Panel {
     pub bands: Vec<Band>,
     /// the lines
     pub series: Vec<Series>,
+    /// a remark written in grey across the middle of the plotting area (e.g. why a channel
+    /// is zero); empty: none
+    pub note: String,
 }
 
 /// A figure of panels (`cols` per row) under one legend strip.
@@ -174,21 +199,32 @@ const COLORS: [RGBColor; 8] = [
 /// than name a quantity: drawn in grey, they take no palette color.
 pub const STYLE_KEY: &str = "\u{0}style";
 
-/// A legend-only entry in grey explaining what shaded bands mean.
-pub fn band_note(label: &str) -> Band {
-    Band {
-        name: label.into(),
-        color_of: STYLE_KEY.into(),
-        points: Vec::new(),
-    }
-}
-
 /// A legend-only entry in grey explaining what dashed lines mean.
 pub fn dashed_note(label: &str) -> Series {
     Series::dashed(label, Vec::new()).colored_as(STYLE_KEY)
 }
 
 const GREY: RGBColor = RGBColor(0x70, 0x70, 0x70);
+
+/// Opacity of band fills and their legend swatches.
+const BAND_ALPHA: f64 = 0.22;
+/// Opacity of the fill of outlined bands ([`Band::outline`]): lighter, so that where
+/// bands overlap the outlines still tell them apart.
+const OUTLINED_BAND_ALPHA: f64 = 0.12;
+/// Opacity of the fill of a band (and of its legend swatch).
+fn band_alpha(outline: bool) -> f64 {
+    if outline {
+        OUTLINED_BAND_ALPHA
+    } else {
+        BAND_ALPHA
+    }
+}
+/// Opacity of the edge lines of outlined bands ([`Band::outline`]).
+const OUTLINE_ALPHA: f64 = 0.8;
+/// Opacity of bars.
+const BAR_ALPHA: f64 = 0.8;
+/// Radius of point markers [px].
+const MARKER_PX: i32 = 3;
 
 /// Tick label font size [px].
 const LABEL_PX: u32 = 14;
@@ -205,215 +241,6 @@ pub fn register_font() -> Result<(), CliError> {
         .map_err(|_| CliError::Other("cannot load the embedded DejaVu Sans font".into()))
 }
 
-/// Remove trailing zeros of a decimal fraction (`"2.500"` → `"2.5"`, `"3.000"` → `"3"`).
-fn trim_fraction(s: &str) -> String {
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s.to_string()
-    }
-}
-
-/// A tick label formatted for its axis: `step` is the distance between ticks (for a log
-/// axis pass the value itself). Values in [0.01, 10⁵) are written as decimals with just
-/// the digits the step needs (`500`, `0.25`, `12.5`); others in shortest scientific form
-/// (`1e-3`, `2.5e-4`, `3e6`); zero (or a value below 10⁻⁹ steps) is `0`.
-pub fn tick_label(v: f64, step: f64) -> String {
-    if !v.is_finite() {
-        return String::new();
-    }
-    let step = step.abs();
-    if v == 0.0 || (step > 0.0 && v.abs() < 1e-9 * step) {
-        return "0".into();
-    }
-    let step = if step > 0.0 && step.is_finite() {
-        step
-    } else {
-        v.abs()
-    };
-    let mag = v.abs();
-    if (1e-2..1e5).contains(&mag) {
-        let decimals = (-(step.log10().floor()) + 1.0).clamp(0.0, 12.0) as usize;
-        let s = trim_fraction(&format!("{v:.decimals$}"));
-        if s == "-0" {
-            "0".into()
-        } else {
-            s
-        }
-    } else {
-        let digits = ((mag / step).log10().ceil() + 1.0).clamp(1.0, 8.0) as usize;
-        let s = format!("{v:.digits$e}");
-        match s.split_once('e') {
-            Some((m, e)) => format!("{}e{e}", trim_fraction(m)),
-            None => s,
-        }
-    }
-}
-
-/// Tick count that fits `len_px` pixels of axis with `px_per_label` per label.
-fn label_count(len_px: u32, px_per_label: u32) -> usize {
-    ((len_px / px_per_label.max(1)) as usize).clamp(2, 10)
-}
-
-/// The step between "nice" ticks (1, 2, 5 × 10ᵏ) for `n` labels over `span`.
-fn nice_step(span: f64, n: usize) -> f64 {
-    let raw = span.abs() / n.max(1) as f64;
-    if !(raw > 0.0 && raw.is_finite()) {
-        return 1.0;
-    }
-    let p = 10f64.powf(raw.log10().floor());
-    let m = raw / p;
-    let k = if m <= 1.0 {
-        1.0
-    } else if m <= 2.0 {
-        2.0
-    } else if m <= 5.0 {
-        5.0
-    } else {
-        10.0
-    };
-    k * p
-}
-
-/// (x, y) of the minimum and (x, y) of the maximum of one column.
-type MinMax = ((f64, f64), (f64, f64));
-
-/// Online min/max-per-column decimation of one or more channels sharing an x axis: the
-/// x range `[x0, x1]` is cut into `cols` columns and each column keeps, per channel, the
-/// sample with the smallest and the one with the largest y. Drawing the kept points in
-/// x order gives, at `cols` pixel columns or fewer, the same picture as all samples:
-/// every column's vertical extent is preserved exactly. Non-finite values are skipped.
-#[derive(Clone, Debug)]
-pub struct MinMaxColumns {
-    x0: f64,
-    width: f64,
-    cols: usize,
-    channels: usize,
-    /// per column and channel: ((x, y) of the minimum, (x, y) of the maximum)
-    cells: Vec<Option<MinMax>>,
-}
-
-impl MinMaxColumns {
-    /// `cols` columns over `[x0, x1]` for `channels` channels.
-    pub fn new(x0: f64, x1: f64, cols: usize, channels: usize) -> Self {
-        let cols = cols.max(1);
-        let width = if x1 > x0 { x1 - x0 } else { 1.0 };
-        Self {
-            x0,
-            width,
-            cols,
-            channels,
-            cells: vec![None; cols * channels],
-        }
-    }
-
-    fn column(&self, x: f64) -> usize {
-        let k = ((x - self.x0) / self.width * self.cols as f64).floor();
-        if k.is_finite() {
-            (k.max(0.0) as usize).min(self.cols - 1)
-        } else {
-            0
-        }
-    }
-
-    /// Add one sample at `x` of every channel (`ys.len()` = channels; extra values are
-    /// ignored).
-    pub fn push(&mut self, x: f64, ys: &[f64]) {
-        if !x.is_finite() {
-            return;
-        }
-        let c = self.column(x);
-        for (ch, &y) in ys.iter().enumerate().take(self.channels) {
-            if !y.is_finite() {
-                continue;
-            }
-            let cell = &mut self.cells[c * self.channels + ch];
-            match cell {
-                None => *cell = Some(((x, y), (x, y))),
-                Some((lo, hi)) => {
-                    if y < lo.1 {
-                        *lo = (x, y);
-                    }
-                    if y > hi.1 {
-                        *hi = (x, y);
-                    }
-                }
-            }
-        }
-    }
-
-    /// The kept points of channel `ch` in x order (one or two per non-empty column).
-    pub fn series(&self, ch: usize) -> Vec<(f64, f64)> {
-        let mut out = Vec::new();
-        for c in 0..self.cols {
-            if let Some(Some((lo, hi))) = self.cells.get(c * self.channels + ch) {
-                if lo == hi {
-                    out.push(*lo);
-                } else if lo.0 <= hi.0 {
-                    out.extend([*lo, *hi]);
-                } else {
-                    out.extend([*hi, *lo]);
-                }
-            }
-        }
-        out
-    }
-}
-
-/// Decimate `points` (in x order) to at most two per column of `cols` columns over
-/// `[x0, x1]`, keeping each column's minimum and maximum ([`MinMaxColumns`]); series of
-/// at most `2 cols` points are returned unchanged.
-pub fn decimate(points: &[(f64, f64)], x0: f64, x1: f64, cols: usize) -> Vec<(f64, f64)> {
-    if points.len() <= 2 * cols {
-        return points.to_vec();
-    }
-    let mut m = MinMaxColumns::new(x0, x1, cols, 1);
-    for &(x, y) in points {
-        m.push(x, &[y]);
-    }
-    m.series(0)
-}
-
-/// Decimate a band: per column the lowest low and the highest high.
-fn decimate_band(
-    points: &[(f64, f64, f64)],
-    x0: f64,
-    x1: f64,
-    cols: usize,
-) -> Vec<(f64, f64, f64)> {
-    if points.len() <= 2 * cols {
-        return points.to_vec();
-    }
-    let mut m = MinMaxColumns::new(x0, x1, cols, 2);
-    for &(x, lo, hi) in points {
-        m.push(x, &[lo, hi]);
-    }
-    let lo = m.series(0);
-    let hi = m.series(1);
-    // one point per column: column center, min of lows, max of highs
-    let mut out = Vec::new();
-    let (mut i, mut j) = (0, 0);
-    for c in 0..m.cols {
-        let in_col = |x: f64| m.column(x) == c;
-        let mut l = f64::INFINITY;
-        let mut h = f64::NEG_INFINITY;
-        let mut xs = f64::NAN;
-        while i < lo.len() && in_col(lo[i].0) {
-            l = l.min(lo[i].1);
-            xs = lo[i].0;
-            i += 1;
-        }
-        while j < hi.len() && in_col(hi[j].0) {
-            h = h.max(hi[j].1);
-            j += 1;
-        }
-        if l.is_finite() && h.is_finite() {
-            out.push((xs, l, h));
-        }
-    }
-    out
-}
-
 /// Legend entries of a figure in order of first appearance: (label, color, kind).
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Key {
@@ -421,6 +248,7 @@ enum Key {
     Dashed,
     Points,
     Band,
+    OutlinedBand,
 }
 
 struct Legend {
@@ -446,7 +274,12 @@ impl Legend {
             }
             for b in &p.bands {
                 let c = l.color(&b.color_of);
-                l.add(&b.name, c, Key::Band);
+                let k = if b.outline {
+                    Key::OutlinedBand
+                } else {
+                    Key::Band
+                };
+                l.add(&b.name, c, k);
             }
         }
         l
@@ -550,10 +383,20 @@ impl Legend {
                             c.stroke_width(1),
                         )))?;
                     }
-                    Key::Band => e(area.draw(&Rectangle::new(
-                        [(x, y - 7), (x + 28, y + 7)],
-                        c.mix(0.25).filled(),
-                    )))?,
+                    Key::Band | Key::OutlinedBand => {
+                        e(area.draw(&Rectangle::new(
+                            [(x, y - 7), (x + 28, y + 7)],
+                            c.mix(band_alpha(*k == Key::OutlinedBand)).filled(),
+                        )))?;
+                        if *k == Key::OutlinedBand {
+                            for yy in [y - 7, y + 7] {
+                                e(area.draw(&PathElement::new(
+                                    vec![(x, yy), (x + 28, yy)],
+                                    c.mix(OUTLINE_ALPHA).stroke_width(1),
+                                )))?;
+                            }
+                        }
+                    }
                 }
                 e(area.draw(&Text::new(
                     label.clone(),
@@ -643,42 +486,105 @@ fn bounds(p: &Panel) -> Option<(f64, f64, f64, f64)> {
     Some((x0, x1, y0, y1))
 }
 
+/// Pixel rectangle of a panel's plotting area in the figure: x range, y range (ends
+/// exclusive).
+pub type PixelRect = (Range<i32>, Range<i32>);
+
+/// Error of a drawing step as text.
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// The remark of a panel in grey on a white box, centred a quarter of the way down
+/// `area` (clear of a zero line in the middle).
+fn draw_note<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, note: &str) -> Result<(), String> {
+    if note.is_empty() {
+        return Ok(());
+    }
+    let (w, h) = area.dim_in_pixel();
+    let style = ("sans-serif", DESC_PX)
+        .into_font()
+        .color(&GREY)
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    let (tw, th) = area.estimate_text_size(note, &style).map_err(err)?;
+    let (cx, cy) = (w as i32 / 2, h as i32 / 4);
+    let (hw, hh) = (tw as i32 / 2 + 6, th as i32 / 2 + 4);
+    area.draw(&Rectangle::new(
+        [(cx - hw, cy - hh), (cx + hw, cy + hh)],
+        WHITE.filled(),
+    ))
+    .map_err(err)?;
+    area.draw(&Text::new(note.to_string(), (cx, cy), style))
+        .map_err(err)
+}
+
+/// Draw one panel; returns its plotting area (`None`: no drawable data).
+///
+/// Everything is cut to the plotting area ([`clip`]) in coordinates that are linear in
+/// the panel (log₁₀ of log axes): lines and error bars where they leave it, bands along
+/// its edges, markers at its border. Data beyond the axis range leave the frame; they
+/// are not flattened along its edge.
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     p: &Panel,
     legend: &Legend,
-) -> Result<(), String> {
+) -> Result<Option<PixelRect>, String> {
     let Some((x0, x1, y0, y1)) = bounds(p) else {
-        area.titled(&format!("{} (no data)", p.title), ("sans-serif", TITLE_PX))
-            .map_err(|e| e.to_string())?;
-        return Ok(());
+        let title = if p.note.is_empty() {
+            format!("{} (no data)", p.title)
+        } else {
+            p.title.clone()
+        };
+        let inner = area.titled(&title, ("sans-serif", TITLE_PX)).map_err(err)?;
+        draw_note(&inner, &p.note)?;
+        return Ok(None);
     };
     let (w, h) = area.dim_in_pixel();
     let y_area = 80;
     let x_area = 48;
     let plot_w = w.saturating_sub(y_area + 20).max(50);
     let plot_h = h.saturating_sub(x_area + TITLE_PX + 30).max(50);
-    let nx = label_count(plot_w, 95);
-    let ny = label_count(plot_h, 42);
-    let x_step = nice_step(x1 - x0, nx);
-    let y_step = nice_step(y1 - y0, ny);
-    let cols = plot_w as usize;
-    let clip_y = |y: f64| y.clamp(y0, y1);
-    let ok = |x: f64, y: f64| {
-        x.is_finite() && y.is_finite() && (!p.log_x || x > 0.0) && (!p.log_y || y > 0.0)
-    };
     let (log_x, log_y) = (p.log_x, p.log_y);
-    let x_fmt = move |v: &f64| tick_label(*v, if log_x { *v } else { x_step });
-    let y_fmt = move |v: &f64| tick_label(*v, if log_y { *v } else { y_step });
+    let xt = if log_x {
+        Ticks::log(x0, x1, (plot_w / 70) as usize)
+    } else {
+        Ticks::linear(x0, x1, ticks::label_count(plot_w, 95))
+    };
+    let yt = if log_y {
+        Ticks::log(y0, y1, (plot_h / 24) as usize)
+    } else {
+        Ticks::linear(y0, y1, ticks::label_count(plot_h, 42))
+    };
+    let x_desc = xt.describe(&p.x_label);
+    let y_desc = yt.describe(&p.y_label);
+    let cols = plot_w as usize;
+    // panel-linear coordinates (log₁₀ of log axes) and back
+    let fx = move |x: f64| if log_x { x.log10() } else { x };
+    let fy = move |y: f64| if log_y { y.log10() } else { y };
+    let gx = move |u: f64| if log_x { 10f64.powf(u) } else { u };
+    let gy = move |v: f64| if log_y { 10f64.powf(v) } else { v };
+    let frame = clip::Rect {
+        x0: fx(x0),
+        x1: fx(x1),
+        y0: fy(y0),
+        y1: fy(y1),
+    };
+    let back = move |pts: Vec<clip::P>| -> Vec<(f64, f64)> {
+        pts.into_iter().map(|(u, v)| (gx(u), gy(v))).collect()
+    };
+    let ok = |x: f64, y: f64| {
+        x.is_finite() && y.is_finite() && (!log_x || x > 0.0) && (!log_y || y > 0.0)
+    };
+    let x_fmt = |v: &f64| xt.label(*v);
+    let y_fmt = |v: &f64| yt.label(*v);
+    let plot_rect;
     macro_rules! body {
         ($chart:expr) => {{
             let mut chart = $chart;
             chart
                 .configure_mesh()
-                .x_desc(p.x_label.as_str())
-                .y_desc(p.y_label.as_str())
-                .x_labels(nx)
-                .y_labels(ny)
+                .x_desc(x_desc.as_str())
+                .y_desc(y_desc.as_str())
                 .label_style(("sans-serif", LABEL_PX))
                 .axis_desc_style(("sans-serif", DESC_PX))
                 .light_line_style(RGBColor(0xee, 0xee, 0xee))
@@ -686,7 +592,8 @@ fn draw_panel<DB: DrawingBackend>(
                 .x_label_formatter(&x_fmt)
                 .y_label_formatter(&y_fmt)
                 .draw()
-                .map_err(|e| e.to_string())?;
+                .map_err(err)?;
+            let rect = chart.plotting_area().get_pixel_range();
             for b in &p.bands {
                 let color = legend.color_of(&b.color_of);
                 let pts: Vec<(f64, f64, f64)> = b
@@ -694,65 +601,122 @@ fn draw_panel<DB: DrawingBackend>(
                     .iter()
                     .copied()
                     .filter(|&(x, lo, hi)| ok(x, lo) && ok(x, hi))
+                    .map(|(x, lo, hi)| (fx(x), fy(lo), fy(hi)))
                     .collect();
-                let pts = decimate_band(&pts, x0, x1, cols);
+                let pts = decimate_band(&pts, frame.x0, frame.x1, cols);
                 if pts.len() < 2 {
                     continue;
                 }
-                let mut poly: Vec<(f64, f64)> =
-                    pts.iter().map(|&(x, lo, _)| (x, clip_y(lo))).collect();
-                poly.extend(pts.iter().rev().map(|&(x, _, hi)| (x, clip_y(hi))));
-                chart
-                    .draw_series(std::iter::once(Polygon::new(
-                        poly,
-                        color.mix(0.22).filled(),
-                    )))
-                    .map_err(|e| e.to_string())?;
+                let lows: Vec<clip::P> = pts.iter().map(|&(u, lo, _)| (u, lo)).collect();
+                let highs: Vec<clip::P> = pts.iter().map(|&(u, _, hi)| (u, hi)).collect();
+                let mut ring = lows.clone();
+                ring.extend(highs.iter().rev());
+                let poly = clip::polygon(&ring, frame);
+                if poly.len() >= 3 {
+                    chart
+                        .draw_series(std::iter::once(Polygon::new(
+                            back(poly),
+                            color.mix(band_alpha(b.outline)).filled(),
+                        )))
+                        .map_err(err)?;
+                }
+                if b.outline {
+                    for edge in [lows, highs] {
+                        for piece in clip::polyline(&edge, frame) {
+                            chart
+                                .draw_series(std::iter::once(PathElement::new(
+                                    back(piece),
+                                    color.mix(OUTLINE_ALPHA).stroke_width(1),
+                                )))
+                                .map_err(err)?;
+                        }
+                    }
+                }
             }
             for s in &p.series {
                 let color = legend.color_of(s.color_key());
-                let pts: Vec<(f64, f64)> = s
+                let pts: Vec<clip::P> = s
                     .points
                     .iter()
                     .copied()
                     .filter(|&(x, y)| ok(x, y))
-                    .map(|(x, y)| (x, clip_y(y)))
+                    .map(|(x, y)| (fx(x), fy(y)))
                     .collect();
                 match s.style {
-                    Style::Line => {
-                        let pts = decimate(&pts, x0, x1, cols);
-                        chart
-                            .draw_series(LineSeries::new(pts, color.stroke_width(2)))
-                            .map_err(|e| e.to_string())?;
-                    }
-                    Style::Dashed => {
-                        let pts = decimate(&pts, x0, x1, cols);
-                        chart
-                            .draw_series(DashedLineSeries::new(pts, 8, 5, color.stroke_width(2)))
-                            .map_err(|e| e.to_string())?;
+                    Style::Line | Style::Dashed => {
+                        let pts = decimate(&pts, frame.x0, frame.x1, cols);
+                        for piece in clip::polyline(&pts, frame) {
+                            let piece = back(piece);
+                            if s.style == Style::Line {
+                                chart
+                                    .draw_series(LineSeries::new(piece, color.stroke_width(2)))
+                                    .map_err(err)?;
+                            } else {
+                                chart
+                                    .draw_series(DashedLineSeries::new(
+                                        piece,
+                                        8,
+                                        5,
+                                        color.stroke_width(2),
+                                    ))
+                                    .map_err(err)?;
+                            }
+                        }
                     }
                     Style::Points => {
                         for (k, &(x, y)) in s.points.iter().enumerate() {
-                            if !ok(x, y) {
+                            let Some(&(lo, hi)) = s.y_err.get(k) else {
+                                continue;
+                            };
+                            if !(ok(x, y) && ok(x, lo) && ok(x, hi)) {
                                 continue;
                             }
-                            if let Some(&(lo, hi)) = s.y_err.get(k) {
-                                if ok(x, lo) && ok(x, hi) {
-                                    chart
-                                        .draw_series(std::iter::once(PathElement::new(
-                                            vec![(x, clip_y(lo)), (x, clip_y(hi))],
-                                            color.stroke_width(1),
-                                        )))
-                                        .map_err(|e| e.to_string())?;
-                                }
+                            let bar = clip::segment((fx(x), fy(lo)), (fx(x), fy(hi)), frame);
+                            if let Some((a, b)) = bar {
+                                chart
+                                    .draw_series(std::iter::once(PathElement::new(
+                                        back(vec![a, b]),
+                                        color.stroke_width(1),
+                                    )))
+                                    .map_err(err)?;
+                            }
+                        }
+                        // whole discs inside the frame; discs on its border cut
+                        let (mut whole, mut cut) = (Vec::new(), Vec::new());
+                        for &q in pts.iter().filter(|q| frame.contains(**q)) {
+                            let q = (gx(q.0), gy(q.1));
+                            let c = chart.backend_coord(&q);
+                            let m = MARKER_PX + 1;
+                            if c.0 - m >= rect.0.start - 1
+                                && c.0 + m <= rect.0.end
+                                && c.1 - m >= rect.1.start - 1
+                                && c.1 + m <= rect.1.end
+                            {
+                                whole.push(q);
+                            } else {
+                                cut.push(c);
                             }
                         }
                         chart
-                            .draw_series(pts.iter().map(|&q| Circle::new(q, 3, color.filled())))
-                            .map_err(|e| e.to_string())?;
+                            .draw_series(
+                                whole
+                                    .into_iter()
+                                    .map(|q| Circle::new(q, MARKER_PX, color.filled())),
+                            )
+                            .map_err(err)?;
+                        let pa = chart.plotting_area().strip_coord_spec();
+                        let base = chart.plotting_area().get_base_pixel();
+                        for c in cut {
+                            let poly = clip::disc(c, MARKER_PX, &rect, base);
+                            if poly.len() >= 3 {
+                                pa.draw(&Polygon::new(poly, color.filled())).map_err(err)?;
+                            }
+                        }
                     }
                 }
             }
+            draw_note(&chart.plotting_area().strip_coord_spec(), &p.note)?;
+            plot_rect = Some(rect);
         }};
     }
     let mut b = ChartBuilder::on(area);
@@ -761,25 +725,31 @@ fn draw_panel<DB: DrawingBackend>(
         .margin_right(20)
         .x_label_area_size(x_area)
         .y_label_area_size(y_area);
-    match (p.log_x, p.log_y) {
+    let lin = |lo: f64, hi: f64, t: &Ticks| Axis::new(RangedCoordf64::from(lo..hi), t);
+    let log = |lo: f64, hi: f64, t: &Ticks| Axis::new(LogCoord::from((lo..hi).log_scale()), t);
+    match (log_x, log_y) {
         (false, false) => body!(b
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| e.to_string())?),
+            .build_cartesian_2d(lin(x0, x1, &xt), lin(y0, y1, &yt))
+            .map_err(err)?),
         (false, true) => body!(b
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-            .map_err(|e| e.to_string())?),
+            .build_cartesian_2d(lin(x0, x1, &xt), log(y0, y1, &yt))
+            .map_err(err)?),
         (true, false) => body!(b
-            .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
-            .map_err(|e| e.to_string())?),
+            .build_cartesian_2d(log(x0, x1, &xt), lin(y0, y1, &yt))
+            .map_err(err)?),
         (true, true) => body!(b
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(|e| e.to_string())?),
+            .build_cartesian_2d(log(x0, x1, &xt), log(y0, y1, &yt))
+            .map_err(err)?),
     }
-    Ok(())
+    Ok(plot_rect)
 }
 
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, f: &Figure) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+/// Draw a figure; returns the plotting area of each panel.
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    f: &Figure,
+) -> Result<Vec<Option<PixelRect>>, String> {
+    root.fill(&WHITE).map_err(err)?;
     let legend = Legend::of(&f.panels);
     let lh = legend.height(f.size.0);
     let (top, grid) = root.split_vertically(lh);
@@ -787,10 +757,12 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, f: &Figure) -> Result<
     let cols = f.cols.max(1);
     let rows = f.panels.len().div_ceil(cols).max(1);
     let areas = grid.split_evenly((rows, cols));
+    let mut rects = Vec::new();
     for (p, a) in f.panels.iter().zip(areas.iter()) {
-        draw_panel(a, p, &legend)?;
+        rects.push(draw_panel(a, p, &legend)?);
     }
-    root.present().map_err(|e| e.to_string())
+    root.present().map_err(err)?;
+    Ok(rects)
 }
 
 impl Figure {
@@ -807,6 +779,12 @@ impl Figure {
 
     /// Write the figure as a PNG file (temporary file, then rename).
     pub fn png(&self, dest: &Path) -> Result<(), CliError> {
+        self.png_rects(dest).map(|_| ())
+    }
+
+    /// Write the figure as a PNG file and return the plotting area of each panel in it
+    /// (`None`: a panel without data).
+    pub fn png_rects(&self, dest: &Path) -> Result<Vec<Option<PixelRect>>, CliError> {
         write_png(dest, self.size, |root| draw(root, self))
     }
 
@@ -826,62 +804,83 @@ pub struct Bars {
     pub title: String,
     /// y-axis label with unit
     pub y_label: String,
-    /// (label, value) per bar
+    /// (label, value) per bar; a non-finite value draws no bar
     pub bars: Vec<(String, f64)>,
     /// width, height in pixels
     pub size: (u32, u32),
 }
 
-fn draw_bars<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, b: &Bars) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+/// The y range of a bar chart: from 0 (or the lowest negative bar) to the highest bar,
+/// with 15 % headroom.
+fn bar_range(bars: &[(String, f64)]) -> (f64, f64) {
+    let vals = bars.iter().map(|b| b.1).filter(|v| v.is_finite());
+    let (lo, hi) = vals.fold((0.0_f64, 0.0_f64), |(a, b), v| (a.min(v), b.max(v)));
+    let (lo, hi) = (lo * 1.15, hi * 1.15);
+    if hi - lo > 0.0 {
+        (lo, hi)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+fn draw_bars<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    b: &Bars,
+) -> Result<PixelRect, String> {
+    root.fill(&WHITE).map_err(err)?;
     let n = b.bars.len().max(1);
-    let ymax = b
-        .bars
-        .iter()
-        .map(|x| x.1)
-        .filter(|v| v.is_finite())
-        .fold(0.0_f64, f64::max)
-        .max(1e-300)
-        * 1.15;
-    let ny = label_count(b.size.1.saturating_sub(100), 42);
-    let step = nice_step(ymax, ny);
+    let (y0, y1) = bar_range(&b.bars);
+    let yt = Ticks::linear(y0, y1, ticks::label_count(b.size.1.saturating_sub(100), 42));
+    let y_desc = yt.describe(&b.y_label);
+    // one slot per bar, labelled at its centre
+    let centres: Vec<f64> = (0..n).map(|i| i as f64 + 0.5).collect();
     let mut chart = ChartBuilder::on(&root)
         .caption(b.title.as_str(), ("sans-serif", TITLE_PX))
         .margin(10)
         .margin_right(20)
         .x_label_area_size(40)
         .y_label_area_size(80)
-        .build_cartesian_2d((0..n).into_segmented(), 0.0..ymax)
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d(
+            Axis::labelled(RangedCoordf64::from(0.0..n as f64), centres),
+            Axis::new(RangedCoordf64::from(y0..y1), &yt),
+        )
+        .map_err(err)?;
     let labels: Vec<String> = b.bars.iter().map(|x| x.0.clone()).collect();
     chart
         .configure_mesh()
         .disable_x_mesh()
-        .y_desc(b.y_label.as_str())
-        .x_labels(n)
-        .y_labels(ny)
-        .x_label_formatter(&|v| match v {
-            SegmentValue::CenterOf(i) => labels.get(*i).cloned().unwrap_or_default(),
-            _ => String::new(),
+        .y_desc(y_desc.as_str())
+        .x_label_formatter(&|v| {
+            let i = v.floor();
+            if i >= 0.0 {
+                labels.get(i as usize).cloned().unwrap_or_default()
+            } else {
+                String::new()
+            }
         })
-        .y_label_formatter(&|v| tick_label(*v, step))
+        .y_label_formatter(&|v| yt.label(*v))
         .label_style(("sans-serif", LABEL_PX))
         .axis_desc_style(("sans-serif", DESC_PX))
+        .light_line_style(RGBColor(0xee, 0xee, 0xee))
+        .bold_line_style(RGBColor(0xd8, 0xd8, 0xd8))
         .draw()
-        .map_err(|e| e.to_string())?;
+        .map_err(err)?;
     for (i, (_, v)) in b.bars.iter().enumerate() {
+        if !v.is_finite() {
+            continue;
+        }
         let color = COLORS[i % COLORS.len()];
+        let (lo, hi) = (v.min(0.0).max(y0), v.max(0.0).min(y1));
         chart
             .draw_series(std::iter::once(Rectangle::new(
-                [
-                    (SegmentValue::Exact(i), 0.0),
-                    (SegmentValue::Exact(i + 1), *v),
-                ],
-                color.mix(0.8).filled(),
+                [(i as f64 + 0.12, lo), (i as f64 + 0.88, hi)],
+                color.mix(BAR_ALPHA).filled(),
             )))
-            .map_err(|e| e.to_string())?;
+            .map_err(err)?;
     }
-    root.present().map_err(|e| e.to_string())
+    let rect = chart.plotting_area().get_pixel_range();
+    root.present().map_err(err)?;
+    Ok(rect)
 }
 
 impl Bars {
@@ -898,6 +897,11 @@ impl Bars {
 
     /// Write the chart as a PNG file (temporary file, then rename).
     pub fn png(&self, dest: &Path) -> Result<(), CliError> {
+        self.png_rect(dest).map(|_| ())
+    }
+
+    /// Write the chart as a PNG file and return its plotting area in it.
+    pub fn png_rect(&self, dest: &Path) -> Result<PixelRect, CliError> {
         write_png(dest, self.size, |root| draw_bars(root, self))
     }
 
@@ -910,13 +914,15 @@ impl Bars {
     }
 }
 
-/// Draw a bitmap with `draw` into a temporary PNG next to `dest` and rename it into place
-/// (the output-file rule of `crate::output`: a complete file or none).
-pub fn write_png(
+/// Draw a bitmap with `draw` ([`raster::Raster`]: plotters' bitmap backend with exact
+/// glyph placement and joint-safe thick lines) into a temporary PNG next to `dest` and
+/// rename it into place (the output-file rule of `crate::output`: a complete file or
+/// none).
+fn write_png<T>(
     dest: &Path,
     size: (u32, u32),
-    draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
-) -> Result<(), CliError> {
+    draw: impl FnOnce(DrawingArea<Raster<'_>, Shift>) -> Result<T, String>,
+) -> Result<T, CliError> {
     register_font()?;
     let dest = &crate::output::route(dest)?;
     if let Some(dir) = dest.parent() {
@@ -932,135 +938,24 @@ pub fn write_png(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = dest.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
-    let result = draw(BitMapBackend::new(&tmp, size).into_drawing_area());
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(CliError::Other(format!("PNG plot {}: {e}", dest.display())));
+    let result = Raster::new(BitMapBackend::new(&tmp, size), dejavu::sans::regular())
+        .and_then(|backend| draw(backend.into_drawing_area()));
+    match result {
+        Ok(v) => {
+            std::fs::rename(&tmp, dest).map_err(|source| CliError::Io {
+                path: dest.to_path_buf(),
+                source,
+            })?;
+            Ok(v)
+        }
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(CliError::Other(format!("PNG plot {}: {e}", dest.display())))
+        }
     }
-    std::fs::rename(&tmp, dest).map_err(|source| CliError::Io {
-        path: dest.to_path_buf(),
-        source,
-    })
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used, clippy::expect_used)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn tick_labels_are_formatted_for_their_range() {
-        assert_eq!(tick_label(500.0, 100.0), "500");
-        assert_eq!(tick_label(0.25, 0.05), "0.25");
-        assert_eq!(tick_label(0.30000000000000004, 0.1), "0.3");
-        assert_eq!(tick_label(12.5, 2.5), "12.5");
-        assert_eq!(tick_label(-1500.0, 500.0), "-1500");
-        assert_eq!(tick_label(0.0, 0.1), "0");
-        assert_eq!(tick_label(1e-17, 0.1), "0");
-        // log axes: the value is its own step
-        assert_eq!(tick_label(1e-3, 1e-3), "1e-3");
-        assert_eq!(tick_label(1e-6, 1e-6), "1e-6");
-        assert_eq!(tick_label(100.0, 100.0), "100");
-        assert_eq!(tick_label(1e6, 1e6), "1e6");
-        // small steps in scientific form keep the digits that tell ticks apart
-        assert_eq!(tick_label(2.5e-4, 5e-5), "2.5e-4");
-        assert_eq!(tick_label(-3e-4, 1e-4), "-3e-4");
-        assert_eq!(tick_label(1.0002e5, 1e1), "1.0002e5");
-        // no "1.0e-3", no "500.0"
-        for (v, s) in [(1e-3, 1e-3), (500.0, 100.0), (2e5, 1e5), (0.05, 0.01)] {
-            let t = tick_label(v, s);
-            assert!(!t.contains(".0e") && !t.ends_with(".0"), "{t}");
-        }
-    }
-
-    #[test]
-    fn nice_steps_are_1_2_5() {
-        assert_eq!(nice_step(10.0, 5), 2.0);
-        assert_eq!(nice_step(1.0, 4), 0.5);
-        assert!((nice_step(3e-4, 3) - 1e-4).abs() < 1e-18);
-    }
-
-    /// The decimation keeps, per column, exactly the minimum and the maximum of the
-    /// samples falling in it (so the drawn vertical extent of every column is exact).
-    #[test]
-    fn decimation_preserves_min_and_max_per_column() {
-        let n = 100_000;
-        let (x0, x1, cols) = (0.0, 100.0, 700);
-        // a noisy sine plus one 2-sample spike at t = 50.005
-        let pts: Vec<(f64, f64)> = (0..n)
-            .map(|i| {
-                let x = x1 * i as f64 / n as f64;
-                let noise = (((i as u64).wrapping_mul(2_654_435_761) % 1000) as f64) * 1e-3;
-                let spike = if (50_005..50_007).contains(&i) {
-                    40.0
-                } else {
-                    0.0
-                };
-                (x, (x * 0.3).sin() + noise + spike)
-            })
-            .collect();
-        let d = decimate(&pts, x0, x1, cols);
-        assert!(d.len() <= 2 * cols, "{}", d.len());
-        assert!(d.windows(2).all(|w| w[0].0 <= w[1].0), "x order kept");
-        let col = |x: f64| ((x - x0) / (x1 - x0) * cols as f64).floor() as usize;
-        for c in 0..cols {
-            let inside: Vec<f64> = pts.iter().filter(|p| col(p.0) == c).map(|p| p.1).collect();
-            let kept: Vec<f64> = d.iter().filter(|p| col(p.0) == c).map(|p| p.1).collect();
-            let lo = inside.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = inside.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let klo = kept.iter().copied().fold(f64::INFINITY, f64::min);
-            let khi = kept.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            assert_eq!((lo, hi), (klo, khi), "column {c}");
-        }
-        assert!(d.iter().any(|p| p.1 > 40.0), "the spike survives");
-        // short series are untouched
-        assert_eq!(decimate(&pts[..10], x0, x1, cols), pts[..10].to_vec());
-    }
-
-    #[test]
-    fn online_columns_match_batch_decimation_per_channel() {
-        let mut m = MinMaxColumns::new(0.0, 10.0, 5, 2);
-        for i in 0..100 {
-            let x = i as f64 * 0.1;
-            m.push(x, &[x, -x]);
-        }
-        m.push(f64::NAN, &[1.0, 1.0]);
-        m.push(3.0, &[f64::NAN, f64::INFINITY]);
-        let s0 = m.series(0);
-        assert_eq!(s0.len(), 10);
-        assert_eq!(s0[0], (0.0, 0.0));
-        assert!((s0[9].1 - 9.9).abs() < 1e-12);
-        let s1 = m.series(1);
-        assert!((s1[9].1 + 9.9).abs() < 1e-12);
-    }
-
-    #[test]
-    fn legend_is_outside_the_panels_and_figures_render() {
-        register_font().unwrap();
-        let f = Figure {
-            panels: vec![Panel {
-                title: "p".into(),
-                x_label: "time [s]".into(),
-                y_label: "y [m]".into(),
-                bands: vec![Band {
-                    name: "a ± σ".into(),
-                    color_of: "a".into(),
-                    points: (0..50).map(|i| (i as f64, -1.0, 1.0)).collect(),
-                }],
-                series: vec![
-                    Series::line("a", (0..50).map(|i| (i as f64, (i as f64).sin())).collect()),
-                    Series::dashed("true", vec![(0.0, 0.5), (49.0, 0.5)]),
-                ],
-                ..Panel::default()
-            }],
-            cols: 1,
-            size: (600, 400),
-        };
-        let l = Legend::of(&f.panels);
-        assert_eq!(l.entries.len(), 3);
-        assert_eq!(l.height(600), LEGEND_ROW_PX + 8);
-        let svg = f.svg().unwrap();
-        assert!(svg.contains("a ± σ") && svg.contains("true"));
-        assert!(!svg.contains("<script"));
-    }
-}
+mod figure_tests;
+#[cfg(test)]
+mod tests;

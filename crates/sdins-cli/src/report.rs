@@ -252,6 +252,7 @@ mod tests {
                     name: "b".into(),
                     color_of: "a".into(),
                     points: vec![(0.0, 0.0, 2.0), (1.0, 1.0, 3.0)],
+                    outline: false,
                 }],
                 ..Panel::default()
             }],

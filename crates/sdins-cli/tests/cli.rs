@@ -301,6 +301,7 @@ fn nav_bad_inputs_exit_2() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn nav_psins_trj10ms_through_the_cli() {
     // Issue 3 external check through `sdins nav --format psins`: PSINS's own truth at 900 s
     // (attitude ≤ 0.1″, velocity ≤ 1 mm/s, horizontal position ≤ 0.5 m).

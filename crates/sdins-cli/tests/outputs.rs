@@ -311,3 +311,46 @@ fn output_size_caps_are_checked_before_writing() {
     let _ = std::fs::remove_dir_all(&d);
     let _ = std::fs::remove_dir_all(d.with_extension("in"));
 }
+
+/// The epoch rule (docs/conventions.md §"Output epochs") end to end: `sdins run
+/// mach1-east --every-s 1` writes 5 401 rows, row k within 3 ms of k s (Δt = 6 ms), the
+/// last at 5400.000 s, each with its update's own time.
+#[test]
+#[ignore = "5400 s at 500 Hz: release mode with --ignored"]
+fn run_rows_fall_on_the_grid_without_drift() {
+    let dir = std::env::temp_dir().join(format!("sdins-epochs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args([
+            "run",
+            "mach1-east",
+            "--algo",
+            "savage",
+            "--every-s",
+            "1",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&dir)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let text = std::fs::read_to_string(dir.join("err_savage.csv")).unwrap();
+    let times: Vec<f64> = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("t_s"))
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(times.len(), 5401);
+    for (k, t) in times.iter().enumerate() {
+        assert!((t - k as f64).abs() <= 0.003 + 1e-9, "row {k}: t = {t}");
+        // the update's own time: a multiple of Δt = 6 ms
+        let j = t / 0.006;
+        assert!(
+            (j - j.round()).abs() < 1e-6,
+            "row {k}: t = {t} is not an update time"
+        );
+    }
+    assert_eq!(*times.last().unwrap(), 5400.0);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -59,6 +59,7 @@ pub mod aiding;
 pub mod align;
 pub mod coning;
 pub mod earth;
+pub mod gnss;
 pub mod math;
 pub mod nav;
 

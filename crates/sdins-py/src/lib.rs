@@ -37,6 +37,7 @@ fn _sdins(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mc::merge, m)?)?;
     m.add_function(wrap_pyfunction!(align::align, m)?)?;
     m.add_function(wrap_pyfunction!(align::errors, m)?)?;
+    m.add_function(wrap_pyfunction!(align::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(fuse::fuse, m)?)?;
     m.add_function(wrap_pyfunction!(fuse::fuse_files, m)?)?;
     m.add_function(wrap_pyfunction!(align::schuler_share_json, m)?)?;

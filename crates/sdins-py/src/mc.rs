@@ -9,9 +9,8 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use sdins_sim::analysis::montecarlo::{mc_options, McChoice};
-use sdins_sim::analysis::montecarlo::{run_shard, McState as State, Shard, CHANNELS};
-use sdins_sim::nav::options;
+use sdins_sim::analysis::montecarlo::{plan as mc_plan, McChoice, McRequest};
+use sdins_sim::analysis::montecarlo::{McState as State, Shard, CHANNELS};
 
 /// Accumulator state of a Monte Carlo job or shard (picklable).
 #[pyclass(module = "sdins", frozen)]
@@ -48,9 +47,13 @@ impl McState {
         serde_json::to_string(&self.state).map_err(err)
     }
 
-    /// Statistics of the blocks present (dict of arrays; see `sdins.merge`).
-    fn statistics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        stats_dict(py, &self.state)
+    /// Statistics of the blocks present: an `sdins.McStatistics`, the type `sdins.merge`
+    /// returns.
+    fn statistics<'py>(slf: &Bound<'py, Self>, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let d = stats_dict(py, &slf.borrow().state)?;
+        py.import("sdins._results")?
+            .getattr("McStatistics")?
+            .call1((d, slf.clone()))
     }
 
     /// Block indices not yet computed.
@@ -71,7 +74,7 @@ impl McState {
         d.set_item("runs", j.runs)?;
         d.set_item("seed", j.seed)?;
         d.set_item("block", j.block)?;
-        d.set_item("every", j.every)?;
+        d.set_item("every_s", j.every_s)?;
         d.set_item("until_s", j.until_s)?;
         d.set_item("vertical_hold", j.vertical_hold)?;
         Ok(d)
@@ -146,13 +149,8 @@ pub fn montecarlo(
     block: Option<u64>,
     threads: Option<usize>,
 ) -> PyResult<McState> {
-    let mut scn = scenario.scn.clone();
-    if let Some(g) = &grade {
-        options::apply_grade(&mut scn, g).map_err(err)?;
-    }
-    let opts = mc_options(
-        &scn,
-        &McChoice {
+    let req = McRequest {
+        choice: McChoice {
             runs,
             seed,
             algo,
@@ -162,29 +160,14 @@ pub fn montecarlo(
             vertical,
             block,
         },
-    )
-    .map_err(err)?;
-    let shard = match shard {
-        None => Shard::ALL,
-        Some((index, count)) => Shard { index, count },
+        grade,
+        shard: shard.map(|(index, count)| Shard { index, count }),
+        threads,
     };
-    let pool = match threads {
-        Some(0) => return Err(err("threads 0: expected at least 1")),
-        Some(t) => Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .map_err(err)?,
-        ),
-        None => None,
-    };
+    let plan = mc_plan(scenario.scn.clone(), &req).map_err(err)?;
     let result = interrupt::run(py, |tok| {
         let cancelled = || tok.is_cancelled();
-        let compute = || run_shard(&scn, &opts, shard, &|| {}, &cancelled);
-        match &pool {
-            Some(p) => p.install(compute),
-            None => compute(),
-        }
+        plan.run(&|| {}, &cancelled)
     })?;
     Ok(McState {
         state: result.map_err(err)?,

@@ -10,8 +10,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sdins_core::nav::{InitialState, NavState};
 use sdins_sim::nav::options::{self, AlgoChoice};
-use sdins_sim::nav::pipeline::{run_cancellable, NavError, RunOptions};
+use sdins_sim::nav::pipeline::{NavError, RunObserver};
 use sdins_sim::nav::recorded;
+use sdins_sim::nav::run::{self as run_lib, RunRequest, SensorRun};
+use sdins_sim::truth::TruthSample;
 
 /// Navigation-state columns.
 #[derive(Default)]
@@ -187,9 +189,19 @@ pub fn navigate<'py>(
     Ok(d)
 }
 
+/// The output rows of a run, per algorithm.
+struct Columns(Vec<(States, Errors)>);
+
+impl RunObserver for Columns {
+    fn epoch(&mut self, i: usize, st: &NavState, _tr: &TruthSample, e: &NavError) {
+        self.0[i].0.push(e.t_s, st);
+        self.0[i].1.push(e);
+    }
+}
+
 /// Run a scenario's exact truth through algorithms side by side (see the wrapper).
 #[pyfunction]
-#[pyo3(signature = (scenario, algos=None, samples=None, coning=None, attitude=None, rotvec=None, rot3=None, vertical=None, every_s=None, until_s=None, ideal=None, run=None))]
+#[pyo3(signature = (scenario, algos=None, samples=None, coning=None, attitude=None, rotvec=None, rot3=None, vertical=None, every_s=None, until_s=None, ideal=None, run=None, grade=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn run<'py>(
     py: Python<'py>,
@@ -205,8 +217,8 @@ pub fn run<'py>(
     until_s: Option<f64>,
     ideal: Option<bool>,
     run: Option<u64>,
+    grade: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let scn = &scenario.scn;
     let algos = match algos {
         None => None,
         Some(a) => Some(match a.extract::<String>() {
@@ -219,70 +231,35 @@ pub fn run<'py>(
                 .join(","),
         }),
     };
-    let choice = AlgoChoice {
-        algos,
-        samples,
-        coning,
-        attitude,
-        rotvec,
-        rot3: rot3.unwrap_or(false),
-    };
-    let specs = options::algorithms(&choice, &scn.nav).map_err(err)?;
-    if specs.is_empty() {
-        return Err(err("--algo: no algorithm given"));
-    }
-    let hold = options::vertical_hold(vertical, scn.nav.vertical_hold).map_err(err)?;
-    let dt_u = scn.imu.dt_s() * specs[0].samples as f64;
-    let every =
-        options::every_updates(every_s.unwrap_or(options::DEFAULT_EVERY_S), dt_u).map_err(err)?;
-    if let Some(u) = until_s {
-        if !(u.is_finite() && u > 0.0) {
-            return Err(err(format!("--until-s {u}: expected > 0")));
-        }
-    }
-    // as `sdins run`: observe every update (so `max_abs` is over every update, as the
-    // CLI's), keep every `every`-th one and the last one as the output series
-    let opts = RunOptions {
-        algos: specs.clone(),
-        vertical_hold: hold,
-        every: 1,
-        until_s,
-        sensor_run: if ideal.unwrap_or(false) {
-            None
-        } else {
-            Some(run.unwrap_or(0))
+    let req = RunRequest {
+        algos: AlgoChoice {
+            algos,
+            samples,
+            coning,
+            attitude,
+            rotvec,
+            rot3: rot3.unwrap_or(false),
         },
+        vertical: vertical.map(str::to_string),
+        every_s: every_s.unwrap_or(options::DEFAULT_EVERY_S),
+        until_s,
+        sensors: if ideal.unwrap_or(false) {
+            SensorRun::Ideal
+        } else {
+            SensorRun::Run(run.unwrap_or(0))
+        },
+        grade,
     };
-    let k = specs.len();
+    let plan = run_lib::plan(scenario.scn.clone(), &req).map_err(err)?;
+    let k = plan.options.algos.len();
     let (cols, sums) = interrupt::run(py, |tok| {
-        let mut cols: Vec<(States, Errors)> = (0..k)
-            .map(|_| (States::default(), Errors::default()))
-            .collect();
-        let mut updates = vec![0_u64; k];
-        let mut pending = vec![None; k];
-        let r = run_cancellable(
-            scn,
-            &opts,
-            tok,
-            |i, st, _tr, e| {
-                updates[i] += 1;
-                if updates[i] % every == 0 {
-                    pending[i] = None;
-                    cols[i].0.push(e.t_s, st);
-                    cols[i].1.push(e);
-                } else {
-                    pending[i] = Some((*st, *e));
-                }
-            },
-            |_, _| {},
+        let mut cols = Columns(
+            (0..k)
+                .map(|_| (States::default(), Errors::default()))
+                .collect(),
         );
-        for (i, p) in pending.into_iter().enumerate() {
-            if let Some((st, e)) = p {
-                cols[i].0.push(e.t_s, &st);
-                cols[i].1.push(&e);
-            }
-        }
-        (cols, r)
+        let r = run_lib::run_plan(&plan, tok, &mut cols);
+        (cols.0, r)
     })?;
     let sums = sums.map_err(|_| err("interrupted"))?;
     let out = PyDict::new(py);

@@ -6,9 +6,9 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use sdins_core::coning::Increment;
 use sdins_core::math::{euler_from_c_b_n, Quat};
-use sdins_sim::cancel::{CancelToken, Cancelled};
-use sdins_sim::truth::{TruthConfig, TruthGenerator, TruthSample};
+use sdins_sim::nav::truth_rows::{self, TruthObserver, TruthRequest, TruthRow};
 
 /// The columns, filled in place: every array is allocated once at its final length
 /// and handed to numpy without a copy.
@@ -64,64 +64,25 @@ impl Columns {
     }
 }
 
-fn generate(
-    scn: &sdins_sim::scenario::Scenario,
-    until_s: Option<f64>,
-    every: u64,
-    imu: bool,
-    cancel: &CancelToken,
-) -> Result<Columns, Cancelled> {
-    let cfg = TruthConfig {
-        earth: scn.nav.earth.model(),
-        dt_s: scn.imu.dt_s(),
-        lat0_rad: scn.start.lat_rad,
-        lon0_rad: scn.start.lon_rad,
-        h0_m: scn.start.h_m,
-        substeps: scn.nav.substeps,
-    };
-    let gen = TruthGenerator::new(&scn.trajectory, cfg);
-    let mut n = gen.len_samples();
-    if let Some(u) = until_s {
-        n = n.min((u / cfg.dt_s).round() as u64);
+impl TruthObserver for Columns {
+    fn imu(&mut self, t_s: f64, i: &Increment) {
+        self.imu_t_s.push(t_s);
+        self.dtheta_rad
+            .extend_from_slice(&[i.dtheta_b_rad.x, i.dtheta_b_rad.y, i.dtheta_b_rad.z]);
+        self.dv_mps
+            .extend_from_slice(&[i.dv_b_mps.x, i.dv_b_mps.y, i.dv_b_mps.z]);
     }
-    let n = n as usize;
-    let init = gen.initial_state();
-    let mut c = Columns::with_capacity(1 + n / every as usize, if imu { n } else { 0 });
-    let v0 = init.v_n_mps;
-    c.push_row(
-        0.0,
-        init.lat_rad,
-        init.lon_rad,
-        init.h_m,
-        [v0.x, v0.y, v0.z],
-        &init.c_b_n,
-    );
-    for (k, s) in gen.take(n).enumerate() {
-        let s: TruthSample = s;
-        if imu {
-            let i = &s.inc;
-            c.imu_t_s.push(s.t_s);
-            c.dtheta_rad
-                .extend_from_slice(&[i.dtheta_b_rad.x, i.dtheta_b_rad.y, i.dtheta_b_rad.z]);
-            c.dv_mps
-                .extend_from_slice(&[i.dv_b_mps.x, i.dv_b_mps.y, i.dv_b_mps.z]);
-        }
-        if (k as u64 + 1) % every == 0 {
-            let v = s.v_n_mps;
-            c.push_row(
-                s.t_s,
-                s.lat_rad,
-                s.lon_rad,
-                s.h_m,
-                [v.x, v.y, v.z],
-                &s.c_b_n,
-            );
-        }
-        if k % 65536 == 0 {
-            cancel.check()?;
-        }
+    fn row(&mut self, r: &TruthRow) {
+        let v = r.v_n_mps;
+        self.push_row(
+            r.t_s,
+            r.lat_rad,
+            r.lon_rad,
+            r.h_m,
+            [v.x, v.y, v.z],
+            &r.c_b_n,
+        );
     }
-    Ok(c)
 }
 
 /// Exact truth of `scenario` (see `sdins.truth` in python/sdins/__init__.py for the
@@ -135,20 +96,20 @@ pub fn truth<'py>(
     every: Option<u64>,
     imu: Option<bool>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let every = every.unwrap_or(1);
-    if every == 0 {
-        return Err(err("every: must be at least 1"));
-    }
-    if let Some(u) = until_s {
-        if !(u.is_finite() && u > 0.0) {
-            return Err(err(format!(
-                "until_s {u}: expected a positive number of seconds"
-            )));
-        }
-    }
+    let req = TruthRequest {
+        every: every.unwrap_or(1),
+        until_s,
+        imu: imu.unwrap_or(true),
+        ..TruthRequest::default()
+    };
     let scn = &scenario.scn;
+    let plan = truth_rows::plan(scn, req).map_err(err)?;
     let c = interrupt::run(py, |tok| {
-        generate(scn, until_s, every, imu.unwrap_or(true), tok)
+        let mut c = Columns::with_capacity(
+            plan.rows as usize,
+            if req.imu { plan.samples as usize } else { 0 },
+        );
+        truth_rows::run(scn, &plan, tok, &mut c).map(|()| c)
     })?
     .map_err(|_| err("interrupted"))?;
     let d = PyDict::new(py);

@@ -15,7 +15,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let opts = RunOptions {
         algos,
         vertical_hold: false,
-        every: 500,
+        every_s: Some(1.0),
         until_s: None,
         sensor_run: None,
     };

@@ -24,7 +24,7 @@
 //!         AlgorithmSpec::new(AlgorithmKind::DualQuat, 3),
 //!     ],
 //!     vertical_hold: false,
-//!     every: 100,          // observe every 100 updates (0.6 s)
+//!     every_s: Some(0.6),  // output rows every 0.6 s (the updates nearest to k·0.6 s)
 //!     until_s: Some(10.0), // through the turn
 //!     sensor_run: None,    // ideal sensors: the errors are the algorithms' own
 //! };

@@ -783,6 +783,7 @@ fn t7_multiheading_aviation_noise_monte_carlo() {
 /// along (measured ≤ 0.0025°), and a heading near +90° NED (PSINS header: −90.6°
 /// counter-clockwise). The 1-step coarse values are reported.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn lasergyro_real_data_alignment() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/psins");
     let path = std::path::Path::new(dir).join("lasergyro.imu");

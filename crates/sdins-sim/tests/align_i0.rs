@@ -30,6 +30,7 @@ fn lasergyro() -> Option<(sdins_sim::io::imu_file::ImuData, Site)> {
 /// Issue acceptance: the i0 heading over each successive 300 s window of the lasergyro
 /// record spreads by at most 0.1° (max − min); the 2-step heading is printed beside it.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn lasergyro_i0_heading_over_300s_windows() {
     let Some((data, site)) = lasergyro() else {
         return;
@@ -211,6 +212,7 @@ fn i0_error_free_disturbed_base() {
 /// lands within 0.1° of the whole-record i0 heading and varies by at most 0.05° with the
 /// start window; its heading σ is printed beside the 300 s window-to-window i0 spread.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn lasergyro_fine_from_i0_is_start_independent() {
     use sdins_core::align::fine::reference_config;
     use sdins_sim::align::experiment::fine_from_i0;

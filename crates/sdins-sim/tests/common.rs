@@ -57,7 +57,7 @@ pub fn run_at(
     let opts = RunOptions {
         algos,
         vertical_hold: hold,
-        every: 1,
+        every_s: None,
         sensor_run: None,
         until_s: Some(until),
     };

@@ -179,7 +179,7 @@ proptest! {
                 let opts = RunOptions {
                     algos: vec![AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 2)],
                     vertical_hold: false,
-                    every: 1,
+                    every_s: None,
                     until_s: None,
                     sensor_run: None,
                 };

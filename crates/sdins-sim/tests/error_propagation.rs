@@ -201,7 +201,6 @@ fn t9_free_inertial_24h_matches_closed_form() {
 fn linear_vs_nonlinear(scn: &Scenario, until_s: f64) -> [f64; 7] {
     let algo = AlgorithmSpec::from_name("songlee-complete", scn.nav.samples).unwrap();
     let every_s = 10.0;
-    let every = (every_s / (scn.imu.dt_s() * scn.nav.samples as f64)).round() as u64;
     let collect = |sensor: Option<u64>| {
         let mut v: Vec<NavError> = Vec::new();
         run_pipeline(
@@ -209,7 +208,7 @@ fn linear_vs_nonlinear(scn: &Scenario, until_s: f64) -> [f64; 7] {
             &RunOptions {
                 algos: vec![algo],
                 vertical_hold: true,
-                every,
+                every_s: Some(every_s),
                 until_s: Some(until_s),
                 sensor_run: sensor,
             },

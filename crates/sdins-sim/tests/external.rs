@@ -84,6 +84,7 @@ fn check_psins(e: &NavError, what: &str) {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn psins_trj10ms_at_900s() {
     for spec in [slc1(), {
         let mut d = slc1();
@@ -99,6 +100,7 @@ fn psins_trj10ms_at_900s() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn psins_trj_transfer_at_end() {
     let Some(errs) = psins_case("trj_transfer", slc1()) else {
         return;
@@ -126,6 +128,7 @@ fn read_csv(path: &PathBuf) -> (Vec<String>, Vec<Vec<f64>>) {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn smsfusion_coning_sculling_attitude_at_8s() {
     // 200 Hz rates on a flat NED earth with g = 9.80665; increments by the trapezoid rule
     // (its error O(δt³ω̈) ≈ 1e-8 rad per sample here), truth from the fixture.
@@ -186,6 +189,7 @@ fn smsfusion_coning_sculling_attitude_at_8s() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn broad_mems_gyro_only_attitude_at_10s() {
     // Real MEMS (BROAD trials 02, 07): gyro-only attitude over the first 10 s of optical
     // truth, the gyro bias being the mean of the second of gyro data just before (at rest),

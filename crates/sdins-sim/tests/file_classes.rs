@@ -7,6 +7,7 @@ use sdins_sim::io::truth_file::{parse_truth_str, MAX_TRUTH_STEP_S};
 use std::path::Path;
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn psins_trajectory_csv_is_detected_as_rfu() {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/data/csv/psins/trj10ms_imu.csv");

@@ -23,6 +23,7 @@ fn data(sub: &str) -> Option<PathBuf> {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn navego_params_files() {
     let Some(d) = data("csv/navego") else { return };
     let i1 = read_navego_imu_params(&d.join("imu1_params.txt")).unwrap();
@@ -49,6 +50,7 @@ fn navego_params_files() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn navego_gnss_csv() {
     let Some(d) = data("csv/navego") else { return };
     let path = d.join("gnss.csv");
@@ -79,6 +81,7 @@ fn navego_gnss_csv() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn kfgins_gnss_text() {
     let Some(d) = data("kfgins") else { return };
     let path = d.join("GNSS-RTK.txt");
@@ -109,6 +112,7 @@ fn kfgins_gnss_text() {
 /// = 1.5 %; the band is ±5 standard errors (7.6 %). The noise is white, so the mean must be
 /// within 5 σ/√n.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn navego_fixes_have_the_stated_noise() {
     let Some(d) = data("csv/navego") else { return };
     let g = read_gnss_file(

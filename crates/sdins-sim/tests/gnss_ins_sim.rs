@@ -107,7 +107,7 @@ fn check_file(path: &Path) {
     let opts = RunOptions {
         algos: vec![AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 2)],
         vertical_hold: false,
-        every: 1,
+        every_s: None,
         until_s: None,
         sensor_run: None,
     };
@@ -140,6 +140,7 @@ fn check_file(path: &Path) {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn every_motion_file_imports_round_trips_and_runs() {
     // all eleven, the 2234 s long drive included (0.2 s of work at 10 Hz)
     let f = files();
@@ -162,6 +163,7 @@ fn wrap(x: f64) -> f64 {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn constant_euler_rates_integrate_exactly() {
     // motion_def-90deg_turn: 1 s straight, 15 deg/s of yaw for 6 s, 3 s straight, from
     // yaw 315 deg: yaw = 315 + 15·(t − 1) deg during the turn and 45 deg after, to rounding
@@ -182,6 +184,7 @@ fn constant_euler_rates_integrate_exactly() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn absolute_commands_reach_and_hold_and_keep_the_limits() {
     // motion_def.csv, command 2 (type 5, pitch +45 deg, vx 10 m/s, 250 s from t = 10 s):
     // pitch is rate-limited, T_c = max(2·45/2, √(2π·45/0.5)) = 45 s, vx needs 2·10/1 = 20 s;
@@ -206,6 +209,7 @@ fn absolute_commands_reach_and_hold_and_keep_the_limits() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn limits_are_honoured_and_zero_lateral_body_velocity_is_exact() {
     // At every sample instant of every file: the Euler-angle rates, their second
     // derivatives and the body-velocity rates of the commands of types 2–5 stay within the
@@ -310,6 +314,7 @@ fn gauss_vs_rk4(scn: &Scenario, mult: usize, rk4: bool, windows: &[(f64, f64)]) 
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn gauss_matches_rk4_at_smooth_step_ends_inside_samples() {
     // Holland tunnel: the smooth-step ends t0 + T_c of the attitude channels fall inside
     // samples, where the Gauss panels are split; 1.5 s around each of the first eight such
@@ -352,6 +357,7 @@ fn gauss_matches_rk4_at_smooth_step_ends_inside_samples() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn gauss_matches_rk4_reference_on_imported_3d_motion() {
     // The Gauss truth against the RK4 reference at twice the substeps over the whole 3-D
     // motion (130 s at 100 Hz): the bounds of the scenario tests of tests/truth.rs
@@ -391,6 +397,7 @@ fn gauss_matches_rk4_reference_on_imported_3d_motion() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn scenario_command_errors_are_located() {
     let Some(d) = data_dir() else {
         return;

@@ -147,6 +147,7 @@ fn envelope_sees_the_vibration() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn vib_psd_csv_power_report() {
     let Some(d) = data_dir() else { return };
     let t = PsdTable::read_csv(&d.join("vib_psd.csv")).unwrap();

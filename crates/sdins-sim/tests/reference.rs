@@ -51,7 +51,7 @@ fn round_trip(file: &std::path::Path, rate_hz: f64) -> RoundTrip {
     let ro = RunOptions {
         algos: vec![AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 3)],
         vertical_hold: false,
-        every: 1,
+        every_s: None,
         until_s: None,
         sensor_run: None,
     };
@@ -125,6 +125,7 @@ fn psins_trj10ms_round_trip() {
 /// ref: the start, the first turn entry (58–60 s, where the interpolant turns a rate step
 /// within one row) and a steady turn.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn gauss_matches_rk4_on_a_reference() {
     let Some(f) = data("csv/navego/ref.csv") else {
         return;

@@ -36,7 +36,7 @@ fn sweep(scn: &Scenario, n: usize, until: f64) -> Vec<(f64, f64, f64, f64)> {
     let opts = RunOptions {
         algos,
         vertical_hold: false,
-        every: 1,
+        every_s: None,
         until_s: Some(until),
         sensor_run: None,
     };
@@ -156,11 +156,10 @@ fn stationary_72h_vertical_hold_matches_closed_form() {
     };
     let cf = StationaryClosedForm::new(lat, &errors, params);
     let algos = vec![spec(K::SongLeeComplete, 4), spec(K::DualQuat, 4)];
-    let every = 15_000; // 600 s
     let opts = RunOptions {
         algos,
         vertical_hold: true,
-        every,
+        every_s: Some(600.0),
         until_s: None,
         sensor_run: Some(0),
     };

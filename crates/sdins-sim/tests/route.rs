@@ -336,7 +336,7 @@ fn route_truth_refines_and_navigates() {
         let opts = RunOptions {
             algos: vec![AlgorithmSpec::new(AlgorithmKind::SongLee, 2)],
             vertical_hold: false,
-            every: 1000,
+            every_s: Some(2000.0 / rate),
             until_s: None,
             sensor_run: None,
         };

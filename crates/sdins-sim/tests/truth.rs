@@ -162,6 +162,7 @@ fn classical_coning_increments_closed_form() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
 fn psins_trj10ms_stationary_rows() {
     // External: PSINS trj10ms starts at rest at 34.25N, 380 m. With the PSINS constant set
     // and RFU/ENU converted to FRD/NED at the edge, our stationary increments equal

@@ -393,7 +393,7 @@ fn nav_max(scn: &sdins_sim::scenario::Scenario) -> sdins_sim::nav::pipeline::Nav
     let opts = sdins_sim::nav::pipeline::RunOptions {
         algos: vec![AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 3)],
         vertical_hold: false,
-        every: 1,
+        every_s: None,
         until_s: None,
         sensor_run: None,
     };

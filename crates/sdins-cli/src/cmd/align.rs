@@ -14,6 +14,7 @@
 //! μg and °/h.
 
 use super::align_plot::{write_plots, HistRow};
+use crate::args::{ImuFormatArg, OutArg};
 use crate::error::CliError;
 use crate::output::write_string;
 use sdins_core::align::fine::FineConfig;
@@ -26,7 +27,7 @@ use sdins_sim::align::run::{
     align, check_options, check_site, AlignInput, AlignMethod, AlignOptions, AlignOutcome,
     AlignRunError, FineStart, MultiheadingAlg,
 };
-use sdins_sim::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFileError};
 use sdins_sim::scenario::Scenario;
 use sdins_sim::sensors::imu_error::{DPH, DPSH, UG};
 use std::fmt::Write as _;
@@ -73,7 +74,7 @@ pub enum Start {
 #[derive(clap::Args, Debug)]
 #[command(
     after_help = "Examples:\n  sdins align alignment --method fine --run 3 --json\n  \
-    sdins align --imu lasergyro.imu --format psins --method coarse2 --window-s 300\n  \
+    sdins align --imu lasergyro.imu --imu-format psins --method coarse2 --window-s 300\n  \
     sdins align moored-ship --method i0 --window-s 300\n  \
     sdins align --observability"
 )]
@@ -83,9 +84,8 @@ pub struct Args {
     /// IMU file (sdins CSV, PSINS .imu, KF-GINS text, ...)
     #[arg(long)]
     pub imu: Option<PathBuf>,
-    /// IMU file format: auto, sdins, psins, psins-csv, kfgins, navego
-    #[arg(long, default_value = "auto", value_parser = parse_format)]
-    pub format: ImuFormat,
+    #[command(flatten)]
+    pub imu_format: ImuFormatArg,
     /// method
     #[arg(long, value_enum, default_value = "fine")]
     pub method: Method,
@@ -121,9 +121,9 @@ pub struct Args {
     /// filter: ARW [°/√h] (default: the scenario's, else aviation grade 0.002)
     #[arg(long)]
     pub arw: Option<f64>,
-    /// output folder for align_result.csv and align_history.csv
-    #[arg(long)]
-    pub out: Option<PathBuf>,
+    /// output folder for align_result.csv, align_history.csv, plots and report
+    #[command(flatten)]
+    pub out: OutArg,
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
@@ -131,10 +131,6 @@ pub struct Args {
     /// §"Observability at one heading") and exit
     #[arg(long)]
     pub observability: bool,
-}
-
-fn parse_format(s: &str) -> Result<ImuFormat, String> {
-    s.parse()
 }
 
 fn file_error(e: ImuFileError) -> CliError {
@@ -190,7 +186,7 @@ fn load(args: &Args) -> Result<AlignInput, CliError> {
             AlignInput::from_scenario(&scn, args.run, args.lat).map_err(run_error)
         }
         (None, Some(path)) => {
-            let data = read_imu_file(path, args.format).map_err(file_error)?;
+            let data = read_imu_file(path, args.imu_format.imu_format).map_err(file_error)?;
             AlignInput::from_imu_data(&path.display().to_string(), data, args.lat, args.h)
                 .map_err(run_error)
         }
@@ -280,103 +276,122 @@ pub fn run(args: Args) -> Result<(), CliError> {
         println!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
     }
     let (hist, rows) = history(&res)?;
-    let dt = inp.dt_s;
-    let t_end = res.samples as f64 * dt;
-    let phi = res.phi_true;
-    let e = res.euler;
-    if let Some(dir) = &args.out {
-        crate::output::claim(dir)?;
-        write_string(&dir.join("align_result.csv"), &result_csv(&res, &e, phi)?)?;
-        let mut svgs = None;
-        if res.has_history {
-            write_string(&dir.join("align_history.csv"), &hist)?;
-            if rows.len() >= 2 {
-                let tb = inp.true_bias.map(|(ba, bg)| {
-                    let a = |v: Vec3, u: f64| [v.x / u, v.y / u, v.z / u];
-                    (a(ba, UG), a(bg, DPH))
-                });
-                svgs = Some(write_plots(dir, &rows, tb)?);
-            } else {
-                eprintln!(
-                    "note: {} Kalman cycle(s): too short for the alignment plots",
-                    rows.len()
-                );
-            }
-        }
-        write_report(dir, &args, &inp, &res, &e, phi, svgs.as_ref())?;
-        write_align_toml(dir, &args, &inp, &res.config)?;
+    let (e, phi) = (res.euler, res.phi_true);
+    if let Some(dir) = &args.out.out {
+        write_outputs(dir, &args, &inp, &res, &hist, &rows)?;
     }
     if args.json {
         println!("{}", result_json(&res, &e, phi, inp.true_bias));
     } else {
-        println!(
-            "{}: {} samples, dt {} s, {:.1} s, latitude {:.6}°, g {:.6} m/s²",
-            inp.name,
-            res.samples,
-            dt,
-            t_end,
-            inp.site.lat_rad.to_degrees(),
-            inp.site.g_mps2
-        );
-        println!(
-            "method {}: roll {:.6}°, pitch {:.6}°, yaw {:.6}° (NED, clockwise from north)",
-            res.method,
-            e.roll_rad.to_degrees(),
-            e.pitch_rad.to_degrees(),
-            e.yaw_rad.to_degrees()
-        );
-        if let Some(s) = res.attitude_sigma {
-            println!(
-                "  1σ φ N/E/D: {:.1} / {:.1} / {:.1} μrad (includes the unobservable part)",
-                s.x / 1e-6,
-                s.y / 1e-6,
-                s.z / 1e-6
-            );
-        }
-        if let Some((b, s)) = res.accel_bias {
-            let (b, s) = (b / UG, s / UG);
-            println!(
-                "  accel bias [μg]: {:.2} ± {:.2}, {:.2} ± {:.2}, {:.2} ± {:.2}",
-                b.x, s.x, b.y, s.y, b.z, s.z
-            );
-        }
-        if let Some((b, s)) = res.gyro_bias {
-            let (b, s) = (b / DPH, s / DPH);
-            println!(
-                "  gyro bias [°/h]: {:.5} ± {:.5}, {:.5} ± {:.5}, {:.5} ± {:.5}",
-                b.x, s.x, b.y, s.y, b.z, s.z
-            );
-        }
-        if let Some(p) = phi {
-            println!(
-                "  attitude error φ (G, NED) vs truth: {:.2}, {:.2}, {:.2} μrad",
-                p.x / 1e-6,
-                p.y / 1e-6,
-                p.z / 1e-6
-            );
-        }
-        if let Some((ba, bg)) = inp.true_bias {
-            println!(
-                "  true biases: accel {:.2?} μg, gyro {:.5?} °/h",
-                (ba / UG).as_slice(),
-                (bg / DPH).as_slice()
-            );
-        }
-        if let Some(d) = &args.out {
-            if rows.len() >= 2 {
-                println!(
-                    "wrote {0}/align_result.csv, {0}/align_history.csv, plots {0}/align_attitude.svg/.png, {0}/align_bias.svg/.png, {0}/report.html, {0}/run.toml",
-                    d.display()
-                );
-            } else {
-                println!(
-                    "wrote {0}/align_result.csv, {0}/report.html, {0}/run.toml",
-                    d.display()
-                );
-            }
-        }
+        print_text(&args, &inp, &res, rows.len());
     }
     Ok(())
+}
+
+/// `align_result.csv`, `align_history.csv` with its plots, the report and run.toml.
+fn write_outputs(
+    dir: &std::path::Path,
+    args: &Args,
+    inp: &AlignInput,
+    res: &AlignOutcome,
+    hist: &str,
+    rows: &[HistRow],
+) -> Result<(), CliError> {
+    let (e, phi) = (res.euler, res.phi_true);
+    crate::output::claim(dir)?;
+    write_string(&dir.join("align_result.csv"), &result_csv(res, &e, phi)?)?;
+    let mut svgs = None;
+    if res.has_history {
+        write_string(&dir.join("align_history.csv"), hist)?;
+        if rows.len() >= 2 {
+            let tb = inp.true_bias.map(|(ba, bg)| {
+                let a = |v: Vec3, u: f64| [v.x / u, v.y / u, v.z / u];
+                (a(ba, UG), a(bg, DPH))
+            });
+            svgs = Some(write_plots(dir, rows, tb)?);
+        } else {
+            eprintln!(
+                "note: {} Kalman cycle(s): too short for the alignment plots",
+                rows.len()
+            );
+        }
+    }
+    write_report(dir, args, inp, res, &e, phi, svgs.as_ref())?;
+    write_align_toml(dir, args, inp, &res.config)?;
+    Ok(())
+}
+
+/// The plain-text summary of an alignment.
+fn print_text(args: &Args, inp: &AlignInput, res: &AlignOutcome, history_rows: usize) {
+    let (dt, e, phi) = (inp.dt_s, res.euler, res.phi_true);
+    let t_end = res.samples as f64 * dt;
+    let rows_len = history_rows;
+    println!(
+        "{}: {} samples, dt {} s, {:.1} s, latitude {:.6}°, g {:.6} m/s²",
+        inp.name,
+        res.samples,
+        dt,
+        t_end,
+        inp.site.lat_rad.to_degrees(),
+        inp.site.g_mps2
+    );
+    println!(
+        "method {}: roll {:.6}°, pitch {:.6}°, yaw {:.6}° (NED, clockwise from north)",
+        res.method,
+        e.roll_rad.to_degrees(),
+        e.pitch_rad.to_degrees(),
+        e.yaw_rad.to_degrees()
+    );
+    if let Some(s) = res.attitude_sigma {
+        println!(
+            "  1σ φ N/E/D: {:.1} / {:.1} / {:.1} μrad (includes the unobservable part)",
+            s.x / 1e-6,
+            s.y / 1e-6,
+            s.z / 1e-6
+        );
+    }
+    if let Some((b, s)) = res.accel_bias {
+        let (b, s) = (b / UG, s / UG);
+        println!(
+            "  accel bias [μg]: {:.2} ± {:.2}, {:.2} ± {:.2}, {:.2} ± {:.2}",
+            b.x, s.x, b.y, s.y, b.z, s.z
+        );
+    }
+    if let Some((b, s)) = res.gyro_bias {
+        let (b, s) = (b / DPH, s / DPH);
+        println!(
+            "  gyro bias [°/h]: {:.5} ± {:.5}, {:.5} ± {:.5}, {:.5} ± {:.5}",
+            b.x, s.x, b.y, s.y, b.z, s.z
+        );
+    }
+    if let Some(p) = phi {
+        println!(
+            "  attitude error φ (G, NED) vs truth: {:.2}, {:.2}, {:.2} μrad",
+            p.x / 1e-6,
+            p.y / 1e-6,
+            p.z / 1e-6
+        );
+    }
+    if let Some((ba, bg)) = inp.true_bias {
+        println!(
+            "  true biases: accel {:.2?} μg, gyro {:.5?} °/h",
+            (ba / UG).as_slice(),
+            (bg / DPH).as_slice()
+        );
+    }
+    if let Some(d) = &args.out.out {
+        if rows_len >= 2 {
+            println!(
+                "wrote {0}/align_result.csv, {0}/align_history.csv, plots {0}/align_attitude.svg/.png, {0}/align_bias.svg/.png, {0}/report.html, {0}/run.toml",
+                d.display()
+            );
+        } else {
+            println!(
+                "wrote {0}/align_result.csv, {0}/report.html, {0}/run.toml",
+                d.display()
+            );
+        }
+    }
 }
 
 /// `report.html` of an alignment: input, result tables and (filters) the ±3σ plots.
@@ -457,7 +472,7 @@ fn write_report(
         );
         r.svg(
             bias,
-            "Bias estimates (solid) with ±3σ (shaded) and, for scenarios, the true bias (dashed), body axes (align_bias.svg, align_bias.png).",
+            "Bias estimates (solid) with ±3σ (shaded and outlined in the estimate's color) and, for scenarios, the true bias (dashed), body axes; the states the record does not observe (σ not reduced below 90 % of its start) in their own panels (align_bias.svg, align_bias.png).",
         );
     }
     r.write(&dir.join("report.html"))
@@ -486,7 +501,10 @@ fn write_align_toml(
     if let Some(p) = &args.imu {
         let abs = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
         t.insert("imu_file".into(), abs.display().to_string().into());
-        t.insert("imu_format".into(), args.format.name().into());
+        t.insert(
+            "imu_format".into(),
+            args.imu_format.imu_format.name().into(),
+        );
     }
     if let Some(f) = inp.format {
         t.insert("imu_format_read".into(), f.name().into());

@@ -6,13 +6,19 @@
 //!   μrad, with the filter's `±3σ = ±3 √P_φφ` as a shaded band in the same color. Without a truth
 //!   (IMU files) only the `±3σ` band is drawn.
 //! * `align_bias.svg/.png`: accelerometer (μg) and gyro (°/h) bias estimates in body
-//!   axes, `b̂ ± 3σ` shaded in the same color, and the true bias (scenarios) dashed.
-//!   σ is the body-frame 1σ of the bias state (docs/theory/alignment.md §"Fine alignment" NED
-//!   states rotated with `Ĉᵀ P Ĉ`, or the body-frame states of Algorithm A).
+//!   axes, each in its own color with `b̂ ± 3σ` shaded and outlined in that color (its own
+//!   legend entry), and the true bias (scenarios) dashed. σ is the body-frame 1σ of the
+//!   bias state (docs/theory/alignment.md §"Fine alignment" NED states rotated with
+//!   `Ĉᵀ P Ĉ`, or the body-frame states of Algorithm A). Per sensor two panels: the
+//!   states the record observes, and, apart, those it does not (σ at the end still
+//!   ≥ [`UNOBSERVABLE_SHARE`] of σ at the start; in a stationary fine alignment the level
+//!   accelerometer biases and the east gyro bias), whose P0-sized bands would otherwise
+//!   dwarf the estimates. The panel titles name the states in each.
 //!
 //! The y range is fitted to the last 90 % of the record (the first Kalman cycles carry
 //! the P0 bounds of docs/theory/alignment.md §"Fine alignment", up to 30 mrad in heading, which
-//! would flatten the converged part); values outside it are clipped to the frame. Drawn by
+//! would flatten the converged part); values outside it leave the frame (cut at its edge).
+//! Drawn by
 //! [`crate::plot::Figure`] (legend above the panels, tick labels for their range).
 
 use crate::error::CliError;
@@ -39,6 +45,7 @@ pub struct HistRow {
 }
 
 const SIZE: (u32, u32) = (1500, 520);
+const BIAS_SIZE: (u32, u32) = (1500, 900);
 
 /// True biases when known (scenarios): accelerometer [μg] and gyro [°/h], body axes.
 pub type TrueBias = ([f64; 3], [f64; 3]);
@@ -87,6 +94,7 @@ fn attitude_panels(rows: &[HistRow]) -> Vec<Panel> {
                         .iter()
                         .map(|r| (r.t_s, -3.0 * r.sig_phi_urad[i], 3.0 * r.sig_phi_urad[i]))
                         .collect(),
+                    outline: false,
                 }],
                 series,
                 ..Panel::default()
@@ -95,19 +103,41 @@ fn attitude_panels(rows: &[HistRow]) -> Vec<Panel> {
         .collect()
 }
 
+/// A bias state counts as unobservable in the record when its σ at the end is still at
+/// least this share of its σ at the start (a stationary alignment cannot separate the
+/// level accelerometer biases from tilt, nor the east gyro bias from heading, in
+/// docs/theory/alignment.md §"Fine alignment").
+pub const UNOBSERVABLE_SHARE: f64 = 0.9;
+
+/// Whether axis `i` of the bias picked by `pick` is unobservable ([`UNOBSERVABLE_SHARE`]).
+fn unobservable(rows: &[HistRow], pick: fn(&HistRow) -> ([f64; 3], [f64; 3]), i: usize) -> bool {
+    let sigma = |r: &HistRow| Some(pick(r).1[i]).filter(|v| v.is_finite() && *v > 0.0);
+    match (
+        rows.iter().find_map(sigma),
+        rows.iter().rev().find_map(sigma),
+    ) {
+        (Some(first), Some(last)) => last >= UNOBSERVABLE_SHARE * first,
+        _ => false,
+    }
+}
+
+/// Bias panels, two per sensor: the states the record observes, scaled to them, and the
+/// unobservable ones (σ barely reduced, [`UNOBSERVABLE_SHARE`]) apart, so that their
+/// wide bands neither hide the estimates nor blur with the others. Each estimate has its
+/// own color; its ±3σ band takes that color, outlined, with its own legend entry.
 fn bias_panels(rows: &[HistRow], truth: Option<TrueBias>) -> Vec<Panel> {
     type Pick = fn(&HistRow) -> ([f64; 3], [f64; 3]);
     type Spec<'a> = (&'a str, &'a str, &'a str, Pick, Option<[f64; 3]>);
     let specs: [Spec; 2] = [
         (
-            "Accelerometer bias estimates (body)",
+            "Accelerometer bias (body)",
             "accelerometer bias [μg]",
             "a",
             |r| (r.ba_ug, r.sig_ba_ug),
             truth.map(|t| t.0),
         ),
         (
-            "Gyro bias estimates (body)",
+            "Gyro bias (body)",
             "gyro bias [°/h]",
             "g",
             |r| (r.bg_dph, r.sig_bg_dph),
@@ -118,19 +148,27 @@ fn bias_panels(rows: &[HistRow], truth: Option<TrueBias>) -> Vec<Panel> {
         rows.first().map_or(0.0, |r| r.t_s),
         rows.last().map_or(0.0, |r| r.t_s),
     );
-    specs
-        .iter()
-        .map(|(title, y_desc, s, pick, tb)| {
+    let share = format!("σ ≥ {:.0} % of its start", UNOBSERVABLE_SHARE * 100.0);
+    let mut panels = Vec::new();
+    for (title, y_desc, s, pick, tb) in specs {
+        let hidden: Vec<bool> = (0..3).map(|i| unobservable(rows, pick, i)).collect();
+        for group_unobservable in [false, true] {
+            let axes: Vec<usize> = (0..3)
+                .filter(|&i| hidden[i] == group_unobservable)
+                .collect();
+            let names: Vec<String> = axes
+                .iter()
+                .map(|&i| format!("b{s}_{}", ["x", "y", "z"][i]))
+                .collect();
             let mut series = Vec::new();
             let mut bands = Vec::new();
-            for (i, ax) in ["x", "y", "z"].iter().enumerate() {
-                let name = format!("b{s}_{ax}");
+            for (&i, name) in axes.iter().zip(&names) {
                 series.push(Series::line(
                     name.clone(),
                     rows.iter().map(|r| (r.t_s, pick(r).0[i])).collect(),
                 ));
                 bands.push(Band {
-                    name: String::new(),
+                    name: format!("{name} ± 3σ"),
                     color_of: name.clone(),
                     points: rows
                         .iter()
@@ -139,29 +177,49 @@ fn bias_panels(rows: &[HistRow], truth: Option<TrueBias>) -> Vec<Panel> {
                             (r.t_s, b[i] - 3.0 * sd[i], b[i] + 3.0 * sd[i])
                         })
                         .collect(),
+                    outline: true,
                 });
                 if let Some(tb) = tb {
                     series.push(
                         Series::dashed(String::new(), vec![(t0, tb[i]), (t1, tb[i])])
-                            .colored_as(name),
+                            .colored_as(name.clone()),
                     );
                 }
             }
-            bands.push(crate::plot::band_note("estimate ± 3σ"));
-            if tb.is_some() {
+            if tb.is_some() && !axes.is_empty() {
                 series.push(crate::plot::dashed_note("true bias"));
             }
-            Panel {
-                title: title.to_string(),
+            let (what, note) = match (group_unobservable, names.is_empty()) {
+                (false, false) => (format!("observed: {}", names.join(", ")), String::new()),
+                (true, false) => (
+                    format!("unobservable here ({share}): {}", names.join(", ")),
+                    String::new(),
+                ),
+                (false, true) => (
+                    "observed".to_string(),
+                    format!("none: every σ stays ≥ {:.0} %", UNOBSERVABLE_SHARE * 100.0),
+                ),
+                (true, true) => (
+                    "unobservable here".to_string(),
+                    format!(
+                        "none: every σ fell below {:.0} % of its start",
+                        UNOBSERVABLE_SHARE * 100.0
+                    ),
+                ),
+            };
+            panels.push(Panel {
+                title: format!("{title}, {what}"),
                 x_label: "time [s]".into(),
                 y_label: y_desc.to_string(),
                 y_fit_from_x: fit_from(rows),
                 bands,
                 series,
+                note,
                 ..Panel::default()
-            }
-        })
-        .collect()
+            });
+        }
+    }
+    panels
 }
 
 fn figure(panels: Vec<Panel>) -> Figure {
@@ -169,6 +227,15 @@ fn figure(panels: Vec<Panel>) -> Figure {
         cols: panels.len().max(1),
         panels,
         size: SIZE,
+    }
+}
+
+/// The bias figure: a 2 × 2 grid (accelerometer, gyro) × (observed, unobservable).
+fn bias_figure(panels: Vec<Panel>) -> Figure {
+    Figure {
+        cols: 2,
+        panels,
+        size: BIAS_SIZE,
     }
 }
 
@@ -193,7 +260,7 @@ pub fn write_plots(
     }
     Ok([
         figure(attitude_panels(rows)).save(dir, "align_attitude")?,
-        figure(bias_panels(rows, truth)).save(dir, "align_bias")?,
+        bias_figure(bias_panels(rows, truth)).save(dir, "align_bias")?,
     ])
 }
 
@@ -233,7 +300,11 @@ mod tests {
         assert!(s.contains("<polygon"), "shaded ±3σ bands");
         let s = svg(&bias_panels(&r, None)).unwrap();
         assert!(s.contains("accelerometer bias [μg]") && s.contains("gyro bias [°/h]"));
-        assert!(s.contains("estimate ± 3σ") && !s.contains("true bias"));
+        // each estimate's band has its own legend entry; the record's unobservable
+        // states (σ not reduced: ba_x, ba_y, bg_x, bg_y here) have their own panels
+        assert!(s.contains("ba_z ± 3σ") && s.contains("bg_x ± 3σ") && !s.contains("true bias"));
+        assert!(s.contains("observed: ba_z") && s.contains("unobservable here"));
+        assert!(s.contains("ba_x, ba_y") && s.contains("observed: bg_z"));
         let without = s.len();
         let s = svg(&bias_panels(
             &r,

@@ -8,10 +8,11 @@
 //!
 //! Example: `sdins allan --imu lasergyro.imu --out allan_lasergyro`
 
+use crate::args::ImuFormatArg;
 use crate::error::CliError;
 use crate::output::write_string;
 use sdins_sim::analysis::allan::{AllanCurve, AllanFit};
-use sdins_sim::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use sdins_sim::io::imu_file::{read_imu_file, ImuFileError};
 use sdins_sim::sensors::imu_error::{
     ARCSEC, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H, UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ,
 };
@@ -21,25 +22,20 @@ use std::path::{Path, PathBuf};
 /// Arguments of `sdins allan`.
 #[derive(clap::Args, Debug)]
 #[command(
-    after_help = "Example: sdins allan --imu lasergyro.imu --format psins --out allan_lasergyro"
+    after_help = "Example: sdins allan --imu lasergyro.imu --imu-format psins --out allan_lasergyro"
 )]
 pub struct Args {
     /// IMU file (sdins CSV, PSINS .imu or trj CSV, KF-GINS text, NaveGo CSV)
     #[arg(long)]
     pub imu: PathBuf,
-    /// file format: auto, sdins, psins, psins-csv, kfgins, navego
-    #[arg(long, default_value = "auto", value_parser = parse_format)]
-    pub format: ImuFormat,
+    #[command(flatten)]
+    pub imu_format: ImuFormatArg,
     /// output folder for allan.csv, allan.svg and allan.png
     #[arg(long, default_value = ".")]
     pub out: PathBuf,
     /// print a JSON summary on stdout
     #[arg(long)]
     pub json: bool,
-}
-
-fn parse_format(s: &str) -> Result<ImuFormat, String> {
-    s.parse()
 }
 
 /// Channel names, in order.
@@ -58,7 +54,7 @@ fn file_error(e: ImuFileError) -> CliError {
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let data = read_imu_file(&args.imu, args.format).map_err(file_error)?;
+    let data = read_imu_file(&args.imu, args.imu_format.imu_format).map_err(file_error)?;
     let n = data.increments.len();
     if n < 20 {
         return Err(CliError::bad(format!(
@@ -347,6 +343,7 @@ pub fn plot_png(r: &AllanReport, dest: &Path) -> Result<(), CliError> {
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
+    use sdins_sim::io::imu_file::ImuFormat;
     use sdins_sim::sensors::imu_error::{ImuErrorModel, ImuErrorState};
 
     #[test]
@@ -382,7 +379,9 @@ mod tests {
         let out = dir.join("out");
         crate::output::finish(run(Args {
             imu: file.clone(),
-            format: ImuFormat::Auto,
+            imu_format: crate::args::ImuFormatArg {
+                imu_format: ImuFormat::Auto,
+            },
             out: out.clone(),
             json: true,
         }))
@@ -415,7 +414,9 @@ mod tests {
         .unwrap();
         let e = crate::output::finish(run(Args {
             imu: dir.join("bad.csv"),
-            format: ImuFormat::Auto,
+            imu_format: crate::args::ImuFormatArg {
+                imu_format: ImuFormat::Auto,
+            },
             out: out.clone(),
             json: false,
         }))
@@ -426,6 +427,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
     fn lasergyro_runs_and_reports_fits() {
         // real navigation-grade RLG IMU, parked (shared data; skipped if absent)
         let p = Path::new(concat!(

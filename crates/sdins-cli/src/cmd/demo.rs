@@ -39,6 +39,7 @@ pub fn run_args(scenario: &str, algo: &str, out: PathBuf, quiet: bool) -> RunArg
         until_s: None,
         every_s: 1.0,
         ideal: false,
+        grade: None,
         run: 0,
         plot_scale: crate::plot::PlotScale::Log,
         json: false,
@@ -100,15 +101,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let out = args.out.unwrap_or_else(|| PathBuf::from("sdins-out/demo"));
     crate::output::claim(&out)?;
     let mut r = Report::new("sdins demo: the papers' comparisons reproduced against exact truth");
+    song_lee_table1(&mut r, &out, args.quiet)?;
+    turn_90dps(&mut r, &out, args.quiet)?;
+    dq_paper(&mut r, &out, args.quiet)?;
+    alignment(&mut r)?;
+    schuler_share(&mut r)?;
+    let dest = out.join("report.html");
+    r.write(&dest)?;
+    println!("\nreport: {}", dest.display());
+    Ok(())
+}
 
-    // 1. Song–Lee Table 1
+/// Section 1: Song–Lee Table 1 (Mach 1 due east, 90 min).
+fn song_lee_table1(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), CliError> {
     println!("== 1. Song-Lee Table 1: Mach 1 due east, 90 min, 2 ms samples, 6 ms updates (docs/validation.md) ==");
-    let a1 = execute_full(&run_args(
-        "mach1-east",
-        ALL,
-        out.join("mach1-east"),
-        args.quiet,
-    ))?;
+    let a1 = execute_full(&run_args("mach1-east", ALL, out.join("mach1-east"), quiet))?;
     print_table(&a1.scn, &a1.sums);
     println!("paper (S1 Table 1, reconstructed magnitudes):");
     println!(
@@ -178,28 +185,26 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ]),
     ];
     section(
-        &mut r,
+        r,
         "1. Song–Lee Table 1: Mach 1 due east for 90 minutes",
         &a1,
         &t1_header,
         &t1_rows,
         &ratio_text,
     )?;
+    Ok(())
+}
 
-    // 2. 90°/s turn
+/// Section 2: the 90°/s turn at Mach 1.
+fn turn_90dps(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), CliError> {
     println!("\n== 2. 90 deg/s turn from east to south at Mach 1 (docs/validation.md) ==");
     // every update is an output epoch here, so that the end of the turn (the update
     // nearest t = 8 s; 8 s is not a multiple of ΔT = 6 ms) is in the series
-    let mut a2_args = run_args("turn-90dps", ALL, out.join("turn-90dps"), args.quiet);
+    let mut a2_args = run_args("turn-90dps", ALL, out.join("turn-90dps"), quiet);
     a2_args.every_s = 0.006;
     let a2 = execute_full(&a2_args)?;
     print_table(&a2.scn, &a2.sums);
-    let mut five = run_args(
-        "turn-90dps",
-        "songlee",
-        out.join("turn-90dps-five"),
-        args.quiet,
-    );
+    let mut five = run_args("turn-90dps", "songlee", out.join("turn-90dps-five"), quiet);
     five.attitude = Some("five".into());
     five.every_s = 0.006;
     let a2five = execute_full(&five)?;
@@ -251,17 +256,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     }
     section(
-        &mut r,
+        r,
         "2. 90°/s turn from east to south at Mach 1",
         &a2,
         &["attitude option", "|ε| at 8 s [μrad] (sdins)", "reference", "S1"],
         &att_rows,
         "The transport-matrix attitude (S1 eq. 6) keeps the attitude error at the end of the turn near 1e-3 μrad; the (5)-method reproduces S1's 0.3 μrad. Position errors during the turn are the trapezoid rule's transient (ΔT²/12)(a(t) − a(t0)), which vanishes when the turn ends.",
     )?;
+    Ok(())
+}
 
-    // 3. dual-quaternion paper case
+/// Section 3: the dual-quaternion paper's case.
+fn dq_paper(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), CliError> {
     println!("\n== 3. Dual-quaternion paper case: stationary, accelerate, S-turn, 1 Hz coning, 100 Hz IMU, 2 samples (docs/validation.md) ==");
-    let b = execute_full(&run_args("dq-paper", ALL, out.join("dq-paper"), args.quiet))?;
+    let b = execute_full(&run_args("dq-paper", ALL, out.join("dq-paper"), quiet))?;
     print_table(&b.scn, &b.sums);
     let mut timing = String::new();
     if let (Some(sav), Some(dq)) = (find(&b, "savage"), find(&b, "dualquat")) {
@@ -315,15 +323,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     }
     section(
-        &mut r,
+        r,
         "3. The dual-quaternion paper's case (accuracy and execution time, its Figures 1–4)",
         &b,
         &["algorithm", "height error [m] (sdins)", "reference", "v_D error [m/s] (sdins)", "reference"],
         &b_rows,
         &format!("S2 found the dual-quaternion algorithm better in north/down velocity and height: reproduced. {timing}"),
     )?;
+    Ok(())
+}
 
-    // 4. alignment
+/// Section 4: initial alignment on the built-in `alignment` scenario.
+fn alignment(r: &mut Report) -> Result<(), CliError> {
     println!("\n== 4. Initial alignment: 37.5N, roll/pitch/yaw 2/-3/40 deg, aviation-grade IMU (docs/theory/alignment.md) ==");
     let align_rows = alignment_summary()?;
     for row in &align_rows {
@@ -338,7 +349,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &["method", "φ N [μrad]", "φ E [μrad]", "φ D [μrad]", "note"],
         &align_rows,
     );
+    Ok(())
+}
 
+/// Section 5: the Schuler share by sensor grade.
+fn schuler_share(r: &mut Report) -> Result<(), CliError> {
     // 5. Schuler share (docs/theory/error-analysis.md §"The Schuler share")
     println!(
         "\n== 5. Schuler share of the position error by sensor grade ([P2] Table 1, docs/theory/error-analysis.md) =="
@@ -372,10 +387,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ],
         &share_rows,
     );
-
-    let dest = out.join("report.html");
-    r.write(&dest)?;
-    println!("\nreport: {}", dest.display());
     Ok(())
 }
 

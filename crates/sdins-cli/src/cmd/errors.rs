@@ -154,6 +154,7 @@ fn write_folder(
                     (h(p.0), p.2.dp_n_m[axis] - s, p.2.dp_n_m[axis] + s)
                 })
                 .collect(),
+            outline: false,
         }],
         series: vec![
             line("closed form", &|p| p.1.dp_n[axis]),

@@ -135,6 +135,7 @@ pub fn write(dir: &Path, d: &FuseReportData<'_>) -> Result<(), CliError> {
                 name: "±3σ".into(),
                 color_of: "error".into(),
                 points: band,
+                outline: false,
             }];
             for (k, (a, b)) in gaps.iter().enumerate() {
                 bands.push(Band {
@@ -145,6 +146,7 @@ pub fn write(dir: &Path, d: &FuseReportData<'_>) -> Result<(), CliError> {
                     },
                     color_of: crate::plot::STYLE_KEY.into(),
                     points: vec![(*a, -ymax, ymax), (*b, -ymax, ymax)],
+                    outline: false,
                 });
             }
             panels.push(Panel {
@@ -167,7 +169,7 @@ pub fn write(dir: &Path, d: &FuseReportData<'_>) -> Result<(), CliError> {
             &fig,
             dir,
             stem,
-            &format!("{title}: error (estimate − reference) per axis, shaded ±3σ of the filter's covariance; the first 30 s are outside the y range"),
+            &format!("{title}: error (estimate − reference) per axis, shaded ±3σ of the filter's covariance; the y range is fitted to t ≥ 30 s after the start, so the initial transient leaves the frame (cut at its edge, not flattened along it)"),
         )?;
     }
     // innovations: NIS per GNSS fix with its 99.9 % gate
@@ -218,6 +220,7 @@ pub fn write(dir: &Path, d: &FuseReportData<'_>) -> Result<(), CliError> {
                 },
                 color_of: crate::plot::STYLE_KEY.into(),
                 points: vec![(*a, lo, hi), (*b, lo, hi)],
+                outline: false,
             });
         }
         let fig = Figure {

@@ -15,4 +15,5 @@ pub mod montecarlo;
 pub mod nav;
 pub mod run;
 pub mod scenarios;
+pub mod spp;
 pub mod truth;

@@ -10,15 +10,13 @@
 //! With `--shard i/n` only the blocks of shard i are computed (see `docs/montecarlo.md`);
 //! `mc_stats.csv` then covers that shard's runs only.
 
+use crate::args::GradeArg;
 use crate::error::CliError;
 use crate::output::write_string;
 use crate::progress::Progress;
 use sdins_sim::analysis::montecarlo;
-use sdins_sim::analysis::montecarlo::runner::shard_runs;
-use sdins_sim::analysis::montecarlo::{run_shard, McError, McState, McStats, Shard};
-use sdins_sim::nav::options;
+use sdins_sim::analysis::montecarlo::{McError, McRequest, McState, McStats, Shard};
 use sdins_sim::scenario::Scenario;
-use sdins_sim::sensors::imu_error::ImuErrorModel;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -45,9 +43,9 @@ pub struct Args {
     /// IMU samples per navigation update (default: the scenario's)
     #[arg(long)]
     pub samples: Option<usize>,
-    /// IMU grade preset replacing the scenario's error model (marine, aviation, intermediate, tactical, consumer)
-    #[arg(long)]
-    pub grade: Option<String>,
+    /// IMU grade preset replacing the scenario's error model
+    #[command(flatten)]
+    pub grade: GradeArg,
     /// compute shard i of n (0-based, e.g. 2/8); shards are whole blocks of runs
     #[arg(long)]
     pub shard: Option<String>,
@@ -99,50 +97,69 @@ pub fn write_outputs(dir: &Path, state: &McState, stats: &McStats) -> Result<(),
     write_report(dir, state, stats)
 }
 
-/// Envelopes per channel group: mean (line) and mean ± σ (shaded band) of the N and E
-/// errors over the runs (the percentiles are in the table and the CSV). Attitude errors
-/// in μrad (the unit of free-inertial attitude errors in every report, docs/user-guide.md).
-fn envelope_figure(stats: &McStats) -> crate::plot::Figure {
+/// Envelopes of every channel the statistics hold: position, velocity and attitude
+/// error (rows) in N, E, D (columns), each with the mean over the runs (line), mean ± σ
+/// (shaded band) and the 5th and 95th percentiles (dashed). A channel that is exactly
+/// zero in every run says so on its panel: with the vertical channel held (`--vertical
+/// hold`, the Monte Carlo default) the down position and velocity errors are zero by
+/// construction. Attitude errors in μrad (the unit of free-inertial attitude errors in
+/// every report, docs/user-guide.md).
+fn envelope_figure(stats: &McStats, vertical_hold: bool) -> crate::plot::Figure {
     use crate::plot::{Band, Figure, Panel, Series};
-    let panel = |title: &str, unit: &str, first: usize, scale: f64| {
-        let mut series = Vec::new();
-        let mut bands = Vec::new();
-        for (k, axis) in ["N", "E"].iter().enumerate() {
+    let groups = [
+        ("position error", "δp", "m", 0, 1.0),
+        ("velocity error", "δv", "m/s", 3, 1.0),
+        ("attitude error", "ε", "μrad", 6, 1e6),
+    ];
+    let mut panels = Vec::new();
+    for (what, sym, unit, first, scale) in groups {
+        for (k, axis) in ["N", "E", "D"].iter().enumerate() {
             let c = first + k;
             let rows = || stats.times_s.iter().zip(&stats.cells);
-            let mean = format!("{axis} mean");
-            series.push(Series::line(
-                mean.clone(),
-                rows().map(|(t, row)| (*t, row[c].mean * scale)).collect(),
-            ));
-            bands.push(Band {
-                name: format!("{axis} mean ± σ"),
-                color_of: mean,
-                points: rows()
-                    .map(|(t, row)| {
-                        let x = &row[c];
-                        (*t, (x.mean - x.sigma) * scale, (x.mean + x.sigma) * scale)
-                    })
-                    .collect(),
+            let pick = |f: fn(&montecarlo::ChannelStats) -> f64| -> Vec<(f64, f64)> {
+                rows().map(|(t, row)| (*t, f(&row[c]) * scale)).collect()
+            };
+            let zero = rows().all(|(_, row)| {
+                let x = &row[c];
+                [x.mean, x.sigma, x.p05, x.p50, x.p95]
+                    .iter()
+                    .all(|v| *v == 0.0)
+            });
+            let note = match (zero, vertical_hold && k == 2 && first < 6) {
+                (false, _) => String::new(),
+                (true, true) => "≡ 0: vertical channel held (--vertical hold)".to_string(),
+                (true, false) => "≡ 0 in every run".to_string(),
+            };
+            panels.push(Panel {
+                title: format!("{what}, {axis}"),
+                x_label: "time [s]".into(),
+                y_label: format!("{sym}_{axis} [{unit}]"),
+                min_y_span: if zero { 1.0 } else { 0.0 },
+                series: vec![
+                    Series::line("mean", pick(|x| x.mean)),
+                    Series::dashed("p05, p95", pick(|x| x.p05)).colored_as("mean"),
+                    Series::dashed("p05, p95", pick(|x| x.p95)).colored_as("mean"),
+                ],
+                bands: vec![Band {
+                    name: "mean ± σ".into(),
+                    color_of: "mean".into(),
+                    points: rows()
+                        .map(|(t, row)| {
+                            let x = &row[c];
+                            (*t, (x.mean - x.sigma) * scale, (x.mean + x.sigma) * scale)
+                        })
+                        .collect(),
+                    outline: false,
+                }],
+                note,
+                ..Panel::default()
             });
         }
-        Panel {
-            title: title.to_string(),
-            x_label: "time [s]".into(),
-            y_label: unit.to_string(),
-            series,
-            bands,
-            ..Panel::default()
-        }
-    };
+    }
     Figure {
-        panels: vec![
-            panel("position error", "error [m]", 0, 1.0),
-            panel("velocity error", "error [m/s]", 3, 1.0),
-            panel("attitude error", "error [μrad]", 6, 1e6),
-        ],
+        panels,
         cols: 3,
-        size: (1800, 560),
+        size: (1500, 1150),
     }
 }
 
@@ -177,8 +194,8 @@ fn write_report(dir: &Path, state: &McState, stats: &McStats) -> Result<(), CliE
         r.para(&format!("Statistics at the last epoch, t = {t} s:"));
         r.table(&["channel", "mean", "σ", "p05", "p50", "p95"], &rows);
     }
-    let fig = envelope_figure(stats);
-    r.figure_file(&fig, dir, "envelopes", "North and east error envelopes over the runs: mean (line) and mean ± σ (band); percentiles in the table and mc_stats.csv.")?;
+    let fig = envelope_figure(stats, job.vertical_hold);
+    r.figure_file(&fig, dir, "envelopes", "Error envelopes over the runs, position, velocity and attitude in N, E, D: mean (line), mean ± σ (band), 5th and 95th percentiles (dashed); all statistics in the table and mc_stats.csv.")?;
     r.write(&dir.join("report.html"))?;
     let mut t = toml::Table::new();
     t.insert("scenario".into(), job.scenario.clone().into());
@@ -250,22 +267,14 @@ pub fn print_summary(state: &McState, stats: &McStats, out: &Path) {
     println!("files in {}", out.display());
 }
 
-/// Run the command.
-pub fn run(args: Args) -> Result<(), CliError> {
-    let mut scn = Scenario::load(&args.scenario)?;
-    let bad = |e: options::OptionError| CliError::BadInput(e.to_string());
-    if let Some(g) = &args.grade {
-        options::apply_grade(&mut scn, g).map_err(bad)?;
-    }
-    if scn.imu.model == ImuErrorModel::ideal() && !args.quiet {
-        eprintln!(
-            "sdins: warning: scenario {} has ideal sensors (no [imu] grade/errors and no --grade): every run is the same",
-            scn.name
-        );
-    }
-    let opts = montecarlo::mc_options(
-        &scn,
-        &montecarlo::McChoice {
+/// The job as the library takes it.
+fn request(args: &Args) -> Result<McRequest, CliError> {
+    let shard = match &args.shard {
+        None => None,
+        Some(s) => Some(Shard::parse(s).map_err(|e| CliError::bad(format!("--shard: {e}")))?),
+    };
+    Ok(McRequest {
+        choice: montecarlo::McChoice {
             runs: args.runs,
             seed: args.seed,
             algo: Some(args.algo.clone()),
@@ -275,28 +284,30 @@ pub fn run(args: Args) -> Result<(), CliError> {
             vertical: Some(args.vertical.clone()),
             block: Some(args.block),
         },
-    )
-    .map_err(bad)?;
-    let shard = match &args.shard {
-        None => Shard::ALL,
-        Some(s) => Shard::parse(s).map_err(|e| CliError::bad(format!("--shard: {e}")))?,
-    };
+        grade: args.grade.grade.clone(),
+        shard,
+        threads: args.threads,
+    })
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let scn = Scenario::load(&args.scenario)?;
+    let plan =
+        montecarlo::plan(scn, &request(&args)?).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let name = &plan.scenario.name;
+    if plan.ideal_sensors() && !args.quiet {
+        eprintln!(
+            "sdins: warning: scenario {name} has ideal sensors (no [imu] grade/errors and no --grade): every run is the same"
+        );
+    }
     let out = args.out.clone().unwrap_or_else(|| match args.shard {
-        None => crate::output::default_dir("mc-", &scn.name),
-        Some(_) => crate::output::default_dir("mc-", &format!("{}-shard{}", scn.name, shard.index)),
+        None => crate::output::default_dir("mc-", name),
+        Some(_) => crate::output::default_dir("mc-", &format!("{name}-shard{}", plan.shard.index)),
     });
-    crate::output::check_size(
-        "mc_stats.csv",
-        opts.until_s
-            .map_or(scn.duration_s(), |t| t.min(scn.duration_s()))
-            / opts.every_s
-            + 1.0,
-        400.0,
-        "raise --every-s",
-    )?;
+    crate::output::check_size("mc_stats.csv", plan.epochs as f64, 400.0, "raise --every-s")?;
     crate::output::claim(&out)?;
-    let total = shard_runs(&opts, shard);
-    let bar = Mutex::new((Progress::new(total, "runs", args.quiet), 0_u64));
+    let bar = Mutex::new((Progress::new(plan.runs, "runs", args.quiet), 0_u64));
     let on_run = || {
         if let Ok(mut g) = bar.lock() {
             g.1 += 1;
@@ -304,21 +315,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             g.0.set(done);
         }
     };
-    let cancelled = crate::progress::interrupted;
-    let compute = || run_shard(&scn, &opts, shard, &on_run, &cancelled);
-    if let Some(t) = args.threads {
-        if !(1..=1024).contains(&t) {
-            return Err(CliError::bad(format!("--threads {t}: expected 1 … 1024")));
-        }
-    }
-    let result = match args.threads {
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .map_err(|e| CliError::Other(e.to_string()))?
-            .install(compute),
-        None => compute(),
-    };
+    let result = plan.run(&on_run, &crate::progress::interrupted);
     if let Ok(g) = bar.lock() {
         g.0.finish();
     }

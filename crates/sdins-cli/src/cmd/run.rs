@@ -5,10 +5,12 @@ use crate::error::CliError;
 use crate::output::AtomicFile;
 use crate::plot::PlotScale;
 use crate::progress::Progress;
-use sdins_core::nav::{AlgorithmSpec, NavState};
+use sdins_core::nav::NavState;
 use sdins_sim::nav::options::{self, AlgoChoice};
-use sdins_sim::nav::pipeline::{run_cancellable as run_pipeline, NavError, RunOptions, RunSummary};
+use sdins_sim::nav::pipeline::{NavError, RunObserver, RunSummary};
+use sdins_sim::nav::run::{self, RunRequest, SensorRun};
 use sdins_sim::scenario::Scenario;
+use sdins_sim::truth::TruthSample;
 use std::path::PathBuf;
 
 /// Arguments of `sdins run`.
@@ -48,12 +50,17 @@ pub struct Args {
     /// stop after this many seconds of the scenario (default: its whole duration)
     #[arg(long)]
     pub until_s: Option<f64>,
-    /// output epoch spacing in seconds for the CSV files (default 1 s)
+    /// output epoch spacing in seconds for the CSV files (default 1 s): the rows are the
+    /// updates nearest to 0, every, 2·every, … s, with their own times, and the last update
     #[arg(long, default_value_t = options::DEFAULT_EVERY_S)]
     pub every_s: f64,
     /// ignore the scenario's IMU error model (ideal sensors)
     #[arg(long)]
     pub ideal: bool,
+    /// IMU grade preset replacing the scenario's error model: marine, aviation,
+    /// intermediate, tactical, consumer (docs/imu-errors.md)
+    #[arg(long)]
+    pub grade: Option<String>,
     /// run index of the sensor-error random stream (seed from the scenario)
     #[arg(long, default_value_t = 0)]
     pub run: u64,
@@ -68,17 +75,27 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Build the algorithm list from the arguments.
-pub fn algorithms(args: &Args, scn: &Scenario) -> Result<Vec<AlgorithmSpec>, CliError> {
-    let choice = AlgoChoice {
-        algos: args.algo.clone(),
-        samples: args.samples,
-        coning: args.coning.clone(),
-        attitude: args.attitude.clone(),
-        rotvec: args.rotvec.clone(),
-        rot3: args.rot3,
-    };
-    options::algorithms(&choice, &scn.nav).map_err(|e| CliError::BadInput(e.to_string()))
+/// The run as the library takes it.
+pub fn request(args: &Args) -> RunRequest {
+    RunRequest {
+        algos: AlgoChoice {
+            algos: args.algo.clone(),
+            samples: args.samples,
+            coning: args.coning.clone(),
+            attitude: args.attitude.clone(),
+            rotvec: args.rotvec.clone(),
+            rot3: args.rot3,
+        },
+        vertical: args.vertical.clone(),
+        every_s: args.every_s,
+        until_s: args.until_s,
+        sensors: if args.ideal {
+            SensorRun::Ideal
+        } else {
+            SensorRun::Run(args.run)
+        },
+        grade: args.grade.clone(),
+    }
 }
 
 /// Error-norm time series of one algorithm, at the output epochs:
@@ -191,70 +208,21 @@ pub fn execute(args: &Args) -> Result<(Scenario, Vec<RunSummary>, PathBuf), CliE
     Ok((o.scn, o.sums, o.out))
 }
 
-/// Run, write the CSV files, the report and run.toml, and return everything.
-pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
-    let scn = Scenario::load(&args.scenario)?;
-    crate::report::print_vibration(&scn);
-    let algos = algorithms(args, &scn)?;
-    if algos.is_empty() {
-        return Err(CliError::bad("--algo: no algorithm given"));
-    }
-    let bad = |e: options::OptionError| CliError::BadInput(e.to_string());
-    let hold =
-        options::vertical_hold(args.vertical.as_deref(), scn.nav.vertical_hold).map_err(bad)?;
-    if let Some(t) = args.until_s {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(CliError::bad(format!(
-                "--until-s {t}: expected a positive number of seconds"
-            )));
-        }
-    }
-    let t_end_s = args
-        .until_s
-        .map_or(scn.duration_s(), |t| t.min(scn.duration_s()));
-    let n = algos[0].samples;
-    let dt_u = scn.imu.dt_s() * n as f64;
-    let every = options::every_updates(args.every_s, dt_u).map_err(bad)?;
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| crate::output::default_dir("run-", &scn.name));
-    crate::output::check_size(
-        "each nav_*.csv and err_*.csv",
-        t_end_s / (dt_u * every as f64) + 1.0,
-        250.0,
-        "raise --every-s or lower --until-s",
-    )?;
-    crate::output::claim(&out)?;
-    let mut nav_files = Vec::new();
-    let mut err_files = Vec::new();
-    for a in &algos {
-        nav_files.push(AtomicFile::create(
-            &out.join(format!("nav_{}.csv", a.kind.name())),
-        )?);
-        err_files.push(AtomicFile::create(
-            &out.join(format!("err_{}.csv", a.kind.name())),
-        )?);
-    }
-    let mut nav_csv = nav_files
-        .iter_mut()
-        .map(|f| CsvOut::new(f, &NAV_HEADER))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut err_csv = err_files
-        .iter_mut()
-        .map(|f| CsvOut::with_comments(f, &[ERR_COMMENT], &ERR_HEADER))
-        .collect::<Result<Vec<_>, _>>()?;
-    let total = (t_end_s / dt_u).round() as u64; // for the progress bar
-    let mut bar = Progress::new(total, "navigate", args.quiet);
-    let mut io_error = None;
-    let mut series: Vec<ErrSeries> = vec![Vec::new(); algos.len()];
-    let mut plot = PlotData::new(algos.len(), t_end_s);
-    let log = args.plot_scale == PlotScale::Log;
-    let earth = scn.nav.earth.model();
-    let mut updates = vec![0_u64; algos.len()];
-    let mut pending: Vec<Option<(NavState, NavError)>> = vec![None; algos.len()];
-    // one CSV row of each file and one point of the epoch series
-    let mut write_epoch = |i: usize, st: &NavState, e: &NavError| -> Result<(), CliError> {
+/// The CSV files and figure data of a run, written as the library reports rows and
+/// updates.
+struct Sink<'f> {
+    nav_csv: Vec<CsvOut<'f>>,
+    err_csv: Vec<CsvOut<'f>>,
+    series: Vec<ErrSeries>,
+    plot: PlotData,
+    log: bool,
+    earth: sdins_core::earth::EarthModel,
+    bar: Progress,
+    io_error: Option<CliError>,
+}
+
+impl RunObserver for Sink<'_> {
+    fn epoch(&mut self, i: usize, st: &NavState, _tr: &TruthSample, e: &NavError) {
         let (p, v, a, u) = (
             e.pos_err_ned_m,
             e.vel_err_ned_mps,
@@ -262,9 +230,8 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
             e.euler_err_rad,
         );
         let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-        series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
-        nav_csv[i].row(&nav_row(e.t_s, st))?;
-        err_csv[i].row(&[
+        self.series[i].push((e.t_s, p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)));
+        let row = [
             e.t_s,
             p[0],
             p[1],
@@ -279,70 +246,104 @@ pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
             u[0],
             u[1],
             u[2],
-        ])
-    };
-    // the figures take every update; the CSV files and the series every `every`
-    let opts = RunOptions {
-        algos: algos.clone(),
-        vertical_hold: hold,
-        every: 1,
-        until_s: args.until_s,
-        sensor_run: if args.ideal { None } else { Some(args.run) },
-    };
-    let summaries = run_pipeline(
-        &scn,
-        &opts,
-        &crate::progress::token(),
-        |i, st, tr, e| {
-            let (p, v, a) = (e.pos_err_ned_m, e.vel_err_ned_mps, e.att_err_rad);
-            let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-            let norms = [p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)];
-            let mut ch = [0.0; ERR_CHANNELS];
-            ch[..4].copy_from_slice(&norms);
-            for k in 0..3 {
-                let f = |x: f64| if log { x.abs() } else { x };
-                ch[4 + k] = f(a[k] * 1e6);
-                ch[7 + k] = f(v[k]);
-                ch[10 + k] = f(p[k]);
-            }
-            plot.errors[i].push(e.t_s, &ch);
-            if i == 0 {
-                plot.push_truth(&earth, tr);
-            }
-            updates[i] += 1;
-            if updates[i] % every == 0 {
-                pending[i] = None;
-                if let Err(err) = write_epoch(i, st, e) {
-                    io_error.get_or_insert(err);
-                }
-            } else {
-                // the last update is an output epoch too: written after the run
-                pending[i] = Some((*st, *e));
-            }
-        },
-        |done, _| bar.set(done),
-    );
-    bar.finish();
-    for (i, p) in pending.iter().enumerate() {
-        if let Some((st, e)) = p {
-            if let Err(err) = write_epoch(i, st, e) {
-                io_error.get_or_insert(err);
-            }
+        ];
+        let r = self.nav_csv[i]
+            .row(&nav_row(e.t_s, st))
+            .and_then(|()| self.err_csv[i].row(&row));
+        if let Err(err) = r {
+            self.io_error.get_or_insert(err);
         }
     }
-    if let Some(e) = io_error {
-        return Err(e);
+
+    fn update(&mut self, i: usize, _st: &NavState, tr: &TruthSample, e: &NavError) {
+        let (p, v, a) = (e.pos_err_ned_m, e.vel_err_ned_mps, e.att_err_rad);
+        let n3 = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        let mut ch = [0.0; ERR_CHANNELS];
+        ch[..4].copy_from_slice(&[p[0].hypot(p[1]), p[2].abs(), n3(v), n3(a)]);
+        let log = self.log;
+        let f = |x: f64| if log { x.abs() } else { x };
+        for k in 0..3 {
+            ch[4 + k] = f(a[k] * 1e6);
+            ch[7 + k] = f(v[k]);
+            ch[10 + k] = f(p[k]);
+        }
+        self.plot.errors[i].push(e.t_s, &ch);
+        if i == 0 {
+            self.plot.push_truth(&self.earth, tr);
+        }
     }
-    let summaries = summaries?;
-    for c in nav_csv.into_iter().chain(err_csv) {
-        c.finish()?;
+
+    fn wants_updates(&self) -> bool {
+        true
     }
-    for f in nav_files.into_iter().chain(err_files) {
+
+    fn progress(&mut self, done: u64, _total: u64) {
+        self.bar.set(done);
+    }
+}
+
+/// Run, write the CSV files, the report and run.toml, and return everything.
+pub fn execute_full(args: &Args) -> Result<Outcome, CliError> {
+    let scn = Scenario::load(&args.scenario)?;
+    crate::report::print_vibration(&scn);
+    let plan = run::plan(scn, &request(args)).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| crate::output::default_dir("run-", &plan.scenario.name));
+    crate::output::check_size(
+        "each nav_*.csv and err_*.csv",
+        plan.rows as f64,
+        250.0,
+        "raise --every-s or lower --until-s",
+    )?;
+    crate::output::claim(&out)?;
+    let algos = &plan.options.algos;
+    let mut files = Vec::new();
+    for a in algos {
+        for stem in ["nav", "err"] {
+            files.push(AtomicFile::create(
+                &out.join(format!("{stem}_{}.csv", a.kind.name())),
+            )?);
+        }
+    }
+    let total = (plan.t_end_s / plan.dt_update_s).round() as u64; // for the progress bar
+    let (summaries, series, plot) = {
+        let (mut nav_csv, mut err_csv) = (Vec::new(), Vec::new());
+        for (k, f) in files.iter_mut().enumerate() {
+            if k % 2 == 0 {
+                nav_csv.push(CsvOut::new(f, &NAV_HEADER)?);
+            } else {
+                err_csv.push(CsvOut::with_comments(f, &[ERR_COMMENT], &ERR_HEADER)?);
+            }
+        }
+        let mut sink = Sink {
+            nav_csv,
+            err_csv,
+            series: vec![Vec::new(); algos.len()],
+            plot: PlotData::new(algos.len(), plan.t_end_s),
+            log: args.plot_scale == PlotScale::Log,
+            earth: plan.scenario.nav.earth.model(),
+            bar: Progress::new(total, "navigate", args.quiet),
+            io_error: None,
+        };
+        let summaries = run::run_plan(&plan, &crate::progress::token(), &mut sink);
+        sink.bar.finish();
+        if let Some(e) = sink.io_error {
+            return Err(e);
+        }
+        let summaries = summaries?;
+        for c in sink.nav_csv.into_iter().chain(sink.err_csv) {
+            c.finish()?;
+        }
+        (summaries, sink.series, sink.plot)
+    };
+    for f in files {
         f.commit()?;
     }
-    write_run_toml(&out, &scn, args)?;
+    write_run_toml(&out, &plan.scenario, args)?;
     let outcome = Outcome {
-        scn,
+        scn: plan.scenario,
         sums: summaries,
         out,
         series,

@@ -4,10 +4,12 @@ use crate::csv_out::CsvOut;
 use crate::error::CliError;
 use crate::output::AtomicFile;
 use crate::progress::Progress;
-use sdins_core::math::{euler_from_c_b_n, Mat3, Quat, Vec3};
+use sdins_core::coning::Increment;
+use sdins_core::math::{euler_from_c_b_n, Quat};
+use sdins_sim::io::imu_file::SDINS_INCREMENT_HEADER;
 use sdins_sim::io::truth_file::SDINS_TRUTH_HEADER as TRUTH_HEADER;
+use sdins_sim::nav::truth_rows::{self, TruthObserver, TruthRequest, TruthRow};
 use sdins_sim::scenario::Scenario;
-use sdins_sim::truth::TruthGenerator;
 use std::path::PathBuf;
 
 /// Arguments of `sdins truth`.
@@ -46,54 +48,33 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Run the command.
-pub fn run(args: Args) -> Result<(), CliError> {
-    let (scn, t_offset) = match (&args.from_reference, &args.scenario) {
-        (Some(file), _) => from_reference(file, &args)?,
-        (None, Some(name)) => (Scenario::load(name)?, 0.0),
-        (None, None) => return Err(CliError::bad("give a scenario or --from-reference FILE")),
-    };
-    crate::report::print_vibration(&scn);
-    if args.every == 0 {
-        return Err(CliError::bad("--every: must be at least 1"));
+/// `truth.csv` and `imu.csv` as the library reports their rows.
+struct Sink<'f> {
+    truth: CsvOut<'f>,
+    imu: CsvOut<'f>,
+    bar: Progress,
+    error: Option<CliError>,
+}
+
+impl TruthObserver for Sink<'_> {
+    fn imu(&mut self, t_s: f64, i: &Increment) {
+        let (a, v) = (i.dtheta_b_rad, i.dv_b_mps);
+        if let Err(e) = self.imu.row(&[t_s, a.x, a.y, a.z, v.x, v.y, v.z]) {
+            self.error.get_or_insert(e);
+        }
     }
-    let out = args
-        .out
-        .unwrap_or_else(|| crate::output::default_dir("truth-", &scn.name));
-    crate::output::claim(&out)?;
-    let mut gen = TruthGenerator::new(&scn.trajectory, scn.truth_config());
-    // truth.csv stays at the vehicle reference point; imu.csv is sensed at the IMU
-    let init = gen.initial_state();
-    if let Some(m) = scn.mounting.imu {
-        gen = gen.with_mount(m);
-        eprintln!("note: imu.csv is sensed at the IMU lever arm and mounting ([mounting]); truth.csv is at the vehicle reference point");
-    }
-    let total = gen.len_samples();
-    crate::output::check_size(
-        "imu.csv",
-        total as f64,
-        160.0,
-        "shorten the scenario or lower imu.rate_hz",
-    )?;
-    crate::output::check_size(
-        "truth.csv",
-        total as f64 / args.every as f64,
-        280.0,
-        "raise --every",
-    )?;
-    let mut truth = AtomicFile::create(&out.join("truth.csv"))?;
-    let mut imu = AtomicFile::create(&out.join("imu.csv"))?;
-    let mut truth_csv = CsvOut::new(&mut truth, &TRUTH_HEADER)?;
-    let mut imu_csv = CsvOut::new(&mut imu, &sdins_sim::io::imu_file::SDINS_INCREMENT_HEADER)?;
-    let d = 180.0 / std::f64::consts::PI;
-    let truth_row = |t_s: f64, lat: f64, lon: f64, h: f64, v: &Vec3, c: &Mat3| {
-        let e = euler_from_c_b_n(c);
-        let q = Quat::from_dcm(c);
-        [
-            t_s,
-            lat * d,
-            lon * d,
-            h,
+    fn row(&mut self, r: &TruthRow) {
+        let d = 180.0 / std::f64::consts::PI;
+        let (e, q, v) = (
+            euler_from_c_b_n(&r.c_b_n),
+            Quat::from_dcm(&r.c_b_n),
+            r.v_n_mps,
+        );
+        let row = [
+            r.t_s,
+            r.lat_rad * d,
+            r.lon_rad * d,
+            r.h_m,
             v.x,
             v.y,
             v.z,
@@ -104,55 +85,65 @@ pub fn run(args: Args) -> Result<(), CliError> {
             q.x,
             q.y,
             q.z,
-        ]
-    };
-    truth_csv.row(&truth_row(
-        t_offset,
-        init.lat_rad,
-        init.lon_rad,
-        init.h_m,
-        &init.v_n_mps,
-        &init.c_b_n,
-    ))?;
-    let mut bar = Progress::new(total, "truth", args.quiet);
-    for (k, s) in gen.enumerate() {
-        let i = &s.inc;
-        imu_csv.row(&[
-            s.t_s + t_offset,
-            i.dtheta_b_rad.x,
-            i.dtheta_b_rad.y,
-            i.dtheta_b_rad.z,
-            i.dv_b_mps.x,
-            i.dv_b_mps.y,
-            i.dv_b_mps.z,
-        ])?;
-        if (k as u64 + 1).is_multiple_of(args.every) {
-            truth_csv.row(&truth_row(
-                s.t_s + t_offset,
-                s.lat_rad,
-                s.lon_rad,
-                s.h_m,
-                &s.v_n_mps,
-                &s.c_b_n,
-            ))?;
-        }
-        if k % 65536 == 0 {
-            bar.set(k as u64);
-            if crate::progress::interrupted() {
-                return Err(CliError::Interrupted);
-            }
+        ];
+        if let Err(e) = self.truth.row(&row) {
+            self.error.get_or_insert(e);
         }
     }
-    truth_csv.finish()?;
-    imu_csv.finish()?;
-    bar.finish();
+    fn progress(&mut self, done: u64, _total: u64) {
+        self.bar.set(done);
+    }
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let (scn, t_offset) = match (&args.from_reference, &args.scenario) {
+        (Some(file), _) => from_reference(file, &args)?,
+        (None, Some(name)) => (Scenario::load_with(name, &crate::progress::token())?, 0.0),
+        (None, None) => return Err(CliError::bad("give a scenario or --from-reference FILE")),
+    };
+    crate::report::print_vibration(&scn);
+    let req = TruthRequest {
+        every: args.every,
+        t_offset_s: t_offset,
+        ..TruthRequest::default()
+    };
+    let plan = truth_rows::plan(&scn, req).map_err(|e| CliError::bad(e.to_string()))?;
+    let out = args
+        .out
+        .unwrap_or_else(|| crate::output::default_dir("truth-", &scn.name));
+    let tip = "shorten the scenario or lower imu.rate_hz";
+    crate::output::check_size("imu.csv", plan.samples as f64, 160.0, tip)?;
+    crate::output::check_size("truth.csv", plan.rows as f64, 280.0, "raise --every")?;
+    crate::output::claim(&out)?;
+    if plan.imu_mounted {
+        eprintln!("note: imu.csv is sensed at the IMU lever arm and mounting ([mounting]); truth.csv is at the vehicle reference point");
+    }
+    let mut truth = AtomicFile::create(&out.join("truth.csv"))?;
+    let mut imu = AtomicFile::create(&out.join("imu.csv"))?;
+    {
+        let mut sink = Sink {
+            truth: CsvOut::new(&mut truth, &TRUTH_HEADER)?,
+            imu: CsvOut::new(&mut imu, &SDINS_INCREMENT_HEADER)?,
+            bar: Progress::new(plan.samples, "truth", args.quiet),
+            error: None,
+        };
+        truth_rows::run(&scn, &plan, &crate::progress::token(), &mut sink)
+            .map_err(|_| CliError::Interrupted)?;
+        if let Some(e) = sink.error {
+            return Err(e);
+        }
+        sink.truth.finish()?;
+        sink.imu.finish()?;
+        sink.bar.finish();
+    }
     truth.commit()?;
     imu.commit()?;
     eprintln!(
         "wrote {} and {} ({} samples at {} Hz, {} s)",
         out.join("truth.csv").display(),
         out.join("imu.csv").display(),
-        total,
+        plan.samples,
         scn.imu.rate_hz,
         scn.duration_s()
     );

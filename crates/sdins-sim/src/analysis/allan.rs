@@ -457,6 +457,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
     fn navego_imu1_minus_imu2_recovers_combined_arw_vrw() {
         use crate::io::imu_file::{read_imu_file, ImuFormat};
         let (Some(f1), Some(f2), Some(p1), Some(p2)) = (

@@ -415,7 +415,7 @@ pub fn read_gnss_file(
         file: path.to_path_buf(),
         source,
     })?;
-    let text = String::from_utf8_lossy(&bytes);
+    let text = crate::input::text_lossy(bytes);
     let resolved = match format {
         GnssFormat::Auto => detect(path, &text)?.0,
         f => f,

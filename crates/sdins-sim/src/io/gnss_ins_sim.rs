@@ -7,7 +7,10 @@
 //! m/s²), duration (s), GPS visibility (0/1)`. The motion is compiled by
 //! [`crate::truth::body_motion`]; the GPS-visibility column becomes `[gnss] outages_s`.
 
-use crate::truth::body_motion::{BodyCommand, BodyMotion, BodyStart, CommandKind, MotionLimits};
+use crate::cancel::{CancelToken, Cancelled, POLL_EVERY_SAMPLES};
+use crate::truth::body_motion::{
+    BodyCommand, BodyMotion, BodyStart, CommandKind, MotionLimits, MAX_COMMANDS,
+};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -41,6 +44,9 @@ pub enum GisError {
     /// The motion limits (`mode`) are not three finite positive numbers.
     #[error("mode: {0}")]
     Limits(String),
+    /// Stopped through the cancellation token.
+    #[error("cancelled")]
+    Cancelled(#[from] Cancelled),
 }
 
 /// A parsed motion-definition file.
@@ -67,6 +73,16 @@ pub struct MotionFile {
 
 /// Parse the text of a motion-definition file (`file` names it in errors).
 pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> {
+    parse_motion_def_with(text, file, &CancelToken::new())
+}
+
+/// [`parse_motion_def`], polling `cancel` every [`POLL_EVERY_SAMPLES`] lines; at most
+/// [`MAX_COMMANDS`] commands (the next one is refused naming its line and the limit).
+pub fn parse_motion_def_with(
+    text: &str,
+    file: &str,
+    cancel: &CancelToken,
+) -> Result<MotionFile, GisError> {
     let err = |line: usize, column: usize, message: String| GisError::Invalid {
         file: file.to_string(),
         line,
@@ -75,12 +91,24 @@ pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> 
     };
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     // (1-based line, fields) of the non-empty lines
-    let rows: Vec<(usize, Vec<&str>)> = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(i, l)| (i + 1, l.split(',').map(str::trim).collect()))
-        .collect();
+    let mut rows: Vec<(usize, Vec<&str>)> = Vec::new();
+    for (i, l) in text.lines().enumerate() {
+        if (i as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
+            cancel.check()?;
+        }
+        if l.trim().is_empty() {
+            continue;
+        }
+        // two header lines and the initial state before the commands
+        if rows.len() == MAX_COMMANDS + 3 {
+            return Err(err(
+                i + 1,
+                1,
+                format!("more than {MAX_COMMANDS} commands (the limit of one motion file): split the motion"),
+            ));
+        }
+        rows.push((i + 1, l.split(',').map(str::trim).collect()));
+    }
     if rows.len() < 4 {
         let line = rows.last().map_or(1, |r| r.0 + 1);
         return Err(err(line, 1, format!("expected a header line, the initial-state line, a header line and at least one command line; found {} non-empty lines", rows.len())));
@@ -142,7 +170,10 @@ pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> 
     let mut gps_visible = Vec::new();
     let mut lines = Vec::new();
     let mut raw = vec![ini];
-    for row in &rows[3..] {
+    for (k, row) in rows[3..].iter().enumerate() {
+        if (k as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
+            cancel.check()?;
+        }
         let c = numbers(row)?;
         let line = row.0;
         let kind = if c[0].fract() == 0.0 {
@@ -194,6 +225,11 @@ pub fn parse_motion_def(text: &str, file: &str) -> Result<MotionFile, GisError> 
 
 /// Read and parse a motion-definition file.
 pub fn read_motion_def(path: &Path) -> Result<MotionFile, GisError> {
+    read_motion_def_with(path, &CancelToken::new())
+}
+
+/// [`read_motion_def`], polling `cancel` ([`parse_motion_def_with`]).
+pub fn read_motion_def_with(path: &Path, cancel: &CancelToken) -> Result<MotionFile, GisError> {
     let file = path.display().to_string();
     let bytes = crate::input::read_capped(path).map_err(|e| GisError::Read {
         file: file.clone(),
@@ -203,7 +239,7 @@ pub fn read_motion_def(path: &Path) -> Result<MotionFile, GisError> {
         file: file.clone(),
         reason: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
     })?;
-    parse_motion_def(&text, &file)
+    parse_motion_def_with(&text, &file, cancel)
 }
 
 /// Whether a text looks like a gnss-ins-sim motion-definition file (its first line is the
@@ -281,6 +317,17 @@ pub fn to_scenario_toml(
     file: &str,
     opts: &ImportOptions,
 ) -> Result<String, GisError> {
+    to_scenario_toml_with(mf, name, file, opts, &CancelToken::new())
+}
+
+/// [`to_scenario_toml`], polling `cancel` every [`POLL_EVERY_SAMPLES`] commands.
+pub fn to_scenario_toml_with(
+    mf: &MotionFile,
+    name: &str,
+    file: &str,
+    opts: &ImportOptions,
+    cancel: &CancelToken,
+) -> Result<String, GisError> {
     if !opts.limits.is_valid() {
         return Err(GisError::Limits(
             "the three limits must be finite numbers > 0".into(),
@@ -310,7 +357,7 @@ pub fn to_scenario_toml(
             ..*c
         })
         .collect();
-    let body = BodyMotion::compile(mf.start, &commands, opts.limits, dt);
+    let body = BodyMotion::compile_with(mf.start, &commands, opts.limits, dt, cancel)?;
     let g = |x: f64| fmt_f64(x);
     let mut s = String::new();
     let [a, aa, ar] = opts.limits.to_mode();
@@ -352,6 +399,9 @@ pub fn to_scenario_toml(
     let ext: std::collections::HashMap<usize, f64> =
         body.extended.iter().map(|e| (e.index, e.used_s)).collect();
     for (i, (c, &line)) in mf.commands.iter().zip(&mf.lines).enumerate() {
+        if (i as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
+            cancel.check()?;
+        }
         let _ = writeln!(s, "\n[[command]] # line {line}");
         let _ = writeln!(s, "type = {}", c.kind.number());
         let row = mf.raw.get(i + 1).copied().unwrap_or([0.0; COLUMNS]);
@@ -423,11 +473,20 @@ fn toml_str(s: &str) -> String {
 /// Read a motion file and return the scenario TOML ([`to_scenario_toml`]), named after the
 /// file stem.
 pub fn import_file(path: &Path, opts: &ImportOptions) -> Result<String, GisError> {
-    let mf = read_motion_def(path)?;
+    import_file_with(path, opts, &CancelToken::new())
+}
+
+/// [`import_file`], polling `cancel` ([`parse_motion_def_with`], [`to_scenario_toml_with`]).
+pub fn import_file_with(
+    path: &Path,
+    opts: &ImportOptions,
+    cancel: &CancelToken,
+) -> Result<String, GisError> {
+    let mf = read_motion_def_with(path, cancel)?;
     let name = path
         .file_stem()
         .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned());
-    to_scenario_toml(&mf, &name, &path.display().to_string(), opts)
+    to_scenario_toml_with(&mf, &name, &path.display().to_string(), opts, cancel)
 }
 
 #[cfg(test)]

@@ -399,11 +399,22 @@ pub enum ImuFileError {
 
 /// Read an IMU file (see the module docs for formats and checks).
 pub fn read_imu_file(path: &Path, format: ImuFormat) -> Result<ImuData, ImuFileError> {
-    let bytes = crate::input::read_capped(path).map_err(|source| ImuFileError::Io {
-        file: path.to_path_buf(),
-        source,
+    // the format is told by line 1: checked before the rest is read
+    let check = |first: &str| {
+        let first = first.strip_prefix('\u{feff}').unwrap_or(first);
+        match format {
+            ImuFormat::Auto if !first.trim().is_empty() => detect(path, 1, first).map(|_| ()),
+            _ => Ok(()),
+        }
+    };
+    let bytes = crate::input::read_capped_with(path, check).map_err(|e| match e {
+        crate::input::Refused::Io(source) => ImuFileError::Io {
+            file: path.to_path_buf(),
+            source,
+        },
+        crate::input::Refused::Header(e) => e,
     })?;
-    let text = String::from_utf8_lossy(&bytes);
+    let text = crate::input::text_lossy(bytes);
     parse_imu_str(path, &text, format)
 }
 

@@ -1,7 +1,7 @@
 //! Readers (and parsers) of outside formats: IMU records ([`imu_file`]), GNSS solutions
 //! ([`gnss_file`]), reference trajectories ([`truth_file`], [`reference_file`]), NaveGo
 //! parameter files ([`navego_params`]), gnss-ins-sim motion files ([`gnss_ins_sim`]) and
-//! initial states ([`initial`]). Readers never import the scenario format: the scenario
+//! initial states ([`initial`]), RINEX GNSS observations and ephemerides ([`rinex`]). Readers never import the scenario format: the scenario
 //! loader calls them.
 
 pub mod gnss_file;
@@ -10,4 +10,5 @@ pub mod imu_file;
 pub mod initial;
 pub mod navego_params;
 pub mod reference_file;
+pub mod rinex;
 pub mod truth_file;

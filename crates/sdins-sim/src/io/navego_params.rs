@@ -205,7 +205,7 @@ fn read(path: &Path) -> Result<String, ParamsError> {
         file: path.to_path_buf(),
         source,
     })?;
-    Ok(String::from_utf8_lossy(&bytes).into_owned())
+    Ok(crate::input::text_lossy(bytes))
 }
 
 /// Range class of a field.

@@ -318,7 +318,7 @@ pub fn read_reference(
                 file: path.into(),
                 source,
             })?;
-            parse_generic(path, &String::from_utf8_lossy(&bytes), map)
+            parse_generic(path, &crate::input::text_lossy(bytes), map)
         }
     }
 }

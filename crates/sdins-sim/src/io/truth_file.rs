@@ -274,12 +274,29 @@ pub fn read_sdins_truth(path: &Path) -> Result<Vec<TruthSample>, TruthFileError>
     parse_sdins_truth(path, &read_text(path)?)
 }
 
+/// The file's text, its header line checked before the rest is read (a first line that
+/// is neither blank nor a `#` comment must be the header of one of the formats).
 fn read_text(path: &Path) -> Result<String, TruthFileError> {
-    let bytes = crate::input::read_capped(path).map_err(|source| TruthFileError::Io {
-        file: path.into(),
-        source,
+    let check = |first: &str| {
+        let first = first.strip_prefix('\u{feff}').unwrap_or(first);
+        if first.trim().is_empty() || first.starts_with('#') {
+            return Ok(());
+        }
+        match parse_truth_str(path, first) {
+            // "header only": the header itself is right
+            Ok(_) => Ok(()),
+            Err(TruthFileError::Invalid { field, .. }) if field == "(header)" => Ok(()),
+            Err(e) => Err(e),
+        }
+    };
+    let bytes = crate::input::read_capped_with(path, check).map_err(|e| match e {
+        crate::input::Refused::Io(source) => TruthFileError::Io {
+            file: path.into(),
+            source,
+        },
+        crate::input::Refused::Header(e) => e,
     })?;
-    Ok(String::from_utf8_lossy(&bytes).into_owned())
+    Ok(crate::input::text_lossy(bytes))
 }
 
 /// Column names of a PSINS `*_avp.csv`.

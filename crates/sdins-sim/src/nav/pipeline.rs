@@ -5,6 +5,7 @@
 //! (the `wall_s` of `sdins run --json`).
 
 use crate::cancel::{CancelToken, Cancelled};
+use crate::nav::epochs::{EpochCursor, EpochGrid};
 use crate::scenario::Scenario;
 use crate::sensors::imu_error::{ImuErrorModel, ImuErrorState};
 use crate::truth::{lon_diff, TruthConfig, TruthGenerator, TruthSample};
@@ -147,7 +148,8 @@ pub struct RunSummary {
     /// errors at the last update
     #[serde(rename = "final")]
     pub final_err: NavError,
-    /// maximum absolute errors over the run
+    /// maximum absolute errors over every update of the run (not only the output epochs:
+    /// the same for every observer and every `every_s`)
     pub max_abs: NavError,
 }
 
@@ -158,8 +160,10 @@ pub struct RunOptions {
     pub algos: Vec<AlgorithmSpec>,
     /// vertical channel held to the truth
     pub vertical_hold: bool,
-    /// output decimation: call the observer every `every` updates (and at the end)
-    pub every: u64,
+    /// output rows every `every_s` seconds by the rule of [`crate::nav::epochs`] (the
+    /// update nearest to `k·every_s`, the initial state and the last update included);
+    /// `None`: every navigation update (not the initial state)
+    pub every_s: Option<f64>,
     /// stop after this time \[s\] (None: whole scenario)
     pub until_s: Option<f64>,
     /// apply the scenario's IMU error model as run number `run` (None: ideal sensors)
@@ -199,6 +203,9 @@ pub enum PipelineError {
     /// `until_s` is not a positive finite time.
     #[error("until_s = {0}: expected a positive finite time [s]")]
     BadUntil(f64),
+    /// The output spacing.
+    #[error("{0}")]
+    BadEvery(String),
 }
 
 /// Check the algorithm list of a run: non-empty, one N in 1..=4 shared by all, coning sets
@@ -236,9 +243,38 @@ pub fn check_algorithms(algos: &[AlgorithmSpec]) -> Result<usize, PipelineError>
     Ok(n)
 }
 
+/// What a run reports as it goes (see [`run_observed`]).
+pub trait RunObserver {
+    /// An output row of algorithm `algo` (the rows of [`RunOptions::every_s`]).
+    fn epoch(&mut self, algo: usize, state: &NavState, truth: &TruthSample, err: &NavError);
+    /// Every navigation update of algorithm `algo` (figures), when [`Self::wants_updates`].
+    fn update(&mut self, _algo: usize, _state: &NavState, _truth: &TruthSample, _err: &NavError) {}
+    /// Whether [`Self::update`] is wanted (the errors of every update cost time).
+    fn wants_updates(&self) -> bool {
+        false
+    }
+    /// Progress: `done` of `total` updates, once per block.
+    fn progress(&mut self, _done: u64, _total: u64) {}
+}
+
+struct Closures<O, P>(O, P);
+
+impl<O, P> RunObserver for Closures<O, P>
+where
+    O: FnMut(usize, &NavState, &TruthSample, &NavError),
+    P: FnMut(u64, u64),
+{
+    fn epoch(&mut self, algo: usize, state: &NavState, truth: &TruthSample, err: &NavError) {
+        (self.0)(algo, state, truth, err)
+    }
+    fn progress(&mut self, done: u64, total: u64) {
+        (self.1)(done, total)
+    }
+}
+
 /// Run the scenario's truth through every algorithm; `observe(i, state, truth, err)` is
-/// called every `opts.every` updates for algorithm `i`. `progress(done, total)` is
-/// called once per block. Not cancellable: see [`run_cancellable`].
+/// called at the output rows of algorithm `i` ([`RunOptions::every_s`]). `progress(done,
+/// total)` is called once per block. Not cancellable: see [`run_cancellable`].
 pub fn run(
     scn: &Scenario,
     opts: &RunOptions,
@@ -253,8 +289,18 @@ pub fn run_cancellable(
     scn: &Scenario,
     opts: &RunOptions,
     cancel: &CancelToken,
-    mut observe: impl FnMut(usize, &NavState, &TruthSample, &NavError),
-    mut progress: impl FnMut(u64, u64),
+    observe: impl FnMut(usize, &NavState, &TruthSample, &NavError),
+    progress: impl FnMut(u64, u64),
+) -> Result<Vec<RunSummary>, PipelineError> {
+    run_observed(scn, opts, cancel, &mut Closures(observe, progress))
+}
+
+/// The run, reporting to `obs`: its output rows, optionally every update, and progress.
+pub fn run_observed(
+    scn: &Scenario,
+    opts: &RunOptions,
+    cancel: &CancelToken,
+    obs: &mut impl RunObserver,
 ) -> Result<Vec<RunSummary>, PipelineError> {
     let n = check_algorithms(&opts.algos)?;
     if let Some(u) = opts.until_s {
@@ -270,6 +316,13 @@ pub fn run_cancellable(
         lon0_rad: scn.start.lon_rad,
         h0_m: scn.start.h_m,
         substeps: scn.nav.substeps,
+    };
+    let grid = match opts.every_s {
+        Some(e) => Some(
+            EpochGrid::new(e, cfg.dt_s * n as f64)
+                .map_err(|e| PipelineError::BadEvery(e.to_string()))?,
+        ),
+        None => None,
     };
     let mut truth = TruthGenerator::new(&scn.trajectory, cfg);
     if let Some(m) = scn.mounting.imu {
@@ -292,14 +345,28 @@ pub fn run_cancellable(
     if let Some(t) = opts.until_s {
         total_updates = total_updates.min((t / (cfg.dt_s * n as f64)).round() as u64);
     }
+    let mut cursors: Vec<Option<EpochCursor>> = (0..mechs.len())
+        .map(|_| grid.map(|g| g.cursor(total_updates)))
+        .collect();
+    let mut last = vec![NavError::default(); mechs.len()];
+    let mut maxes = vec![NavError::default(); mechs.len()];
+    // the initial state is row 0 of a grid
+    let t0_truth = truth.initial_truth();
+    for (i, m) in mechs.iter().enumerate() {
+        if let Some(c) = cursors[i].as_mut() {
+            if c.is_output(0) {
+                let st = m.state();
+                let e = nav_error(&earth, &st, &t0_truth);
+                last[i] = e;
+                obs.epoch(i, &st, &t0_truth, &e);
+            }
+        }
+    }
     const BLOCK: usize = 2048;
     let mut incs: Vec<Increment> = Vec::with_capacity(BLOCK * n);
     let mut ends: Vec<TruthSample> = Vec::with_capacity(BLOCK);
     let mut wall = vec![0.0_f64; mechs.len()];
-    let mut last = vec![NavError::default(); mechs.len()];
-    let mut maxes = vec![NavError::default(); mechs.len()];
-    let every = opts.every.max(1);
-    let mut epochs: Vec<(usize, NavState)> = Vec::with_capacity(BLOCK);
+    let mut epochs: Vec<(usize, NavState, bool)> = Vec::with_capacity(BLOCK);
     let mut done = 0_u64;
     while done < total_updates {
         cancel.check()?;
@@ -324,9 +391,10 @@ pub fn run_cancellable(
         let count = ends.len();
         for (i, m) in mechs.iter_mut().enumerate() {
             // one timed pass over the block (two clock reads per block, not per epoch: with
-            // every = 1 per-epoch timing measured the clock); the states of the output
-            // epochs are kept and observed after the pass, untimed
+            // every update observed, per-epoch timing measured the clock); the states of the
+            // output epochs are kept and observed after the pass, untimed
             epochs.clear();
+            let cursor = &mut cursors[i];
             let t0 = Instant::now();
             for k in 0..count {
                 m.update(&incs[k * n..(k + 1) * n]);
@@ -334,21 +402,29 @@ pub fn run_cancellable(
                     m.hold_vertical(ends[k].h_m, ends[k].v_n_mps.z);
                 }
                 let finished = done + k as u64 + 1;
-                if finished.is_multiple_of(every) || finished == total_updates {
-                    epochs.push((k, m.state()));
-                }
+                let row = match cursor.as_mut() {
+                    Some(c) => c.is_output(finished),
+                    None => true,
+                };
+                // every update: max_abs covers the whole run whatever the observer wants
+                epochs.push((k, m.state(), row));
             }
             wall[i] += t0.elapsed().as_secs_f64();
-            for (k, st) in &epochs {
+            for (k, st, row) in &epochs {
                 let tr = &ends[*k];
                 let e = nav_error(&earth, st, tr);
                 last[i] = e;
                 maxes[i] = maxes[i].max_abs(&e);
-                observe(i, st, tr, &e);
+                if grid.is_some() && obs.wants_updates() {
+                    obs.update(i, st, tr, &e);
+                }
+                if *row {
+                    obs.epoch(i, st, tr, &e);
+                }
             }
         }
         done += count as u64;
-        progress(done, total_updates);
+        obs.progress(done, total_updates);
         if count == 0 {
             break;
         }
@@ -431,7 +507,7 @@ mod tests {
         let opts = |algos: Vec<AlgorithmSpec>, until_s| RunOptions {
             algos,
             vertical_hold: false,
-            every: 1,
+            every_s: None,
             until_s,
             sensor_run: None,
         };

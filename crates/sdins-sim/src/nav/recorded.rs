@@ -8,15 +8,18 @@
 
 use crate::cancel::{CancelToken, Cancelled};
 use crate::io::imu_file::ImuData;
+use crate::io::imu_file::{read_imu_file, ImuFormat};
 use crate::io::initial::validate_initial_state;
 use crate::io::truth_file::c_b_n_from_psins;
+use crate::io::truth_file::read_truth;
+use crate::nav::options::{algorithms, earth_by_name, recorded_nav_defaults, AlgoChoice};
 use crate::nav::pipeline::{nav_error, NavError};
 use crate::truth::TruthSample;
 use sdins_core::coning::Increment;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::Vec3;
 use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, Mechanization, NavState};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
@@ -207,6 +210,122 @@ pub fn navigate(
         wall_s: wall,
         errors,
     })
+}
+
+/// `sdins nav` as the library takes it (the CLI's options, typed).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NavFileRequest {
+    /// the IMU file
+    pub imu: PathBuf,
+    /// its format (`auto`: told apart by the content)
+    pub imu_format: ImuFormat,
+    /// initial state text (`--init`), else the first reference row or the PSINS header
+    pub init: Option<String>,
+    /// algorithm name
+    pub algo: String,
+    /// samples per update
+    pub samples: usize,
+    /// coning/sculling set name
+    pub coning: Option<String>,
+    /// earth model name
+    pub earth: String,
+    /// reference trajectory file
+    pub truth: Option<PathBuf>,
+}
+
+/// The loaded and checked inputs of a recorded run.
+#[derive(Clone, Debug)]
+pub struct NavFilePlan {
+    /// the request
+    pub request: NavFileRequest,
+    /// the IMU record
+    pub data: ImuData,
+    /// the reference rows
+    pub truth: Option<Vec<TruthSample>>,
+    /// initial state
+    pub init: InitialState,
+    /// the algorithm
+    pub spec: AlgorithmSpec,
+    /// earth model
+    pub earth: EarthModel,
+    /// time of the initial state \[s\] (the file's time base)
+    pub t0_s: f64,
+    /// navigation updates the run will make
+    pub updates: usize,
+}
+
+/// Read and check the inputs of `sdins nav` (messages name the file, line and option).
+pub fn prepare(req: &NavFileRequest) -> Result<NavFilePlan, NavInputError> {
+    let bad = |e: String| NavInputError::Bad(e);
+    let earth = earth_by_name(&req.earth).map_err(|e| bad(e.to_string()))?;
+    let choice = AlgoChoice {
+        algos: Some(req.algo.clone()),
+        samples: Some(req.samples),
+        coning: req.coning.clone(),
+        ..AlgoChoice::default()
+    };
+    let specs = algorithms(&choice, &recorded_nav_defaults()).map_err(|e| bad(e.to_string()))?;
+    let spec = match specs.as_slice() {
+        [s] => *s,
+        [] => return Err(bad("--algo: no algorithm given".into())),
+        _ => return Err(bad("--algo: `nav` runs one algorithm".into())),
+    };
+    let data = read_imu_file(&req.imu, req.imu_format).map_err(|e| bad(e.to_string()))?;
+    let truth = match &req.truth {
+        Some(p) => Some(read_truth(p).map_err(|e| bad(e.to_string()))?),
+        None => None,
+    };
+    let init = initial_state(
+        req.init.as_deref(),
+        match (&req.truth, &truth) {
+            (Some(p), Some(t)) => Some((p.as_path(), t.as_slice())),
+            _ => None,
+        },
+        &req.imu,
+        &data,
+    )?;
+    let t0_s = data.t0_s - data.dt_s; // state epoch before the first sample
+    if let (Some(tr), Some(tp)) = (&truth, &req.truth) {
+        check_time_bases(
+            tr,
+            tp,
+            &req.imu,
+            t0_s,
+            data.dt_s,
+            spec.samples,
+            data.increments.len(),
+        )?;
+    }
+    let updates = data.increments.len() / spec.samples.max(1);
+    Ok(NavFilePlan {
+        request: req.clone(),
+        data,
+        truth,
+        init,
+        spec,
+        earth,
+        t0_s,
+        updates,
+    })
+}
+
+/// Navigate a prepared record: `observe(t_s, state)` gets every state (see [`navigate`]).
+pub fn run_plan(
+    plan: &NavFilePlan,
+    cancel: &CancelToken,
+    observe: impl FnMut(f64, &NavState),
+) -> Result<RecordedRun, Cancelled> {
+    navigate(
+        &plan.spec,
+        plan.earth,
+        plan.data.dt_s,
+        plan.t0_s,
+        &plan.init,
+        &plan.data.increments,
+        plan.truth.as_deref(),
+        cancel,
+        observe,
+    )
 }
 
 #[cfg(test)]

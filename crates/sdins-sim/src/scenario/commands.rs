@@ -26,6 +26,16 @@ pub(super) fn parse_body_motion(
     use crate::truth::body_motion::{
         BodyCommand, BodyMotion, BodyStart, CommandKind, MotionLimits,
     };
+    if let Some(c) = doc.command.get(crate::truth::body_motion::MAX_COMMANDS) {
+        return cx.err(
+            c.span(),
+            "command",
+            format!(
+                "more than {} [[command]] tables (the limit of one motion): split the motion",
+                crate::truth::body_motion::MAX_COMMANDS
+            ),
+        );
+    }
     if doc.command.is_empty() {
         if let Some(b) = &doc.body_motion {
             return cx.err(
@@ -213,8 +223,7 @@ pub(super) fn parse_body_motion(
         euler_ypr: [euler.yaw_rad, euler.pitch_rad, euler.roll_rad],
         vel_b,
     };
-    Ok(Some((
-        BodyMotion::compile(start, &commands, limits, dt),
-        spans,
-    )))
+    let body = BodyMotion::compile_with(start, &commands, limits, dt, cx.cancel)
+        .map_err(|_| ScenarioError::Cancelled)?;
+    Ok(Some((body, spans)))
 }

@@ -61,6 +61,10 @@ pub enum ScenarioError {
         /// the built-in names
         known: String,
     },
+    /// Stopped through the cancellation token (route compilation, the command list or
+    /// the envelope check of a large scenario).
+    #[error("cancelled")]
+    Cancelled,
 }
 
 // ---- end [body_motion] ----
@@ -210,6 +214,15 @@ impl Scenario {
 
     /// Read and validate a scenario file.
     pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
+        Scenario::from_file_with(path, &crate::cancel::CancelToken::new())
+    }
+
+    /// [`Scenario::from_file`], polling `cancel` in its long steps (route compilation,
+    /// command lists, the envelope check): [`ScenarioError::Cancelled`] once it is set.
+    pub fn from_file_with(
+        path: &Path,
+        cancel: &crate::cancel::CancelToken,
+    ) -> Result<Scenario, ScenarioError> {
         let file = path.display().to_string();
         let bytes = crate::input::read_capped(path).map_err(|e| ScenarioError::Read {
             file: file.clone(),
@@ -220,9 +233,9 @@ impl Scenario {
             reason: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         })?;
         if crate::io::gnss_ins_sim::looks_like_motion_def(&text) {
-            return Scenario::from_motion_def(&text, path, &Default::default());
+            return Scenario::from_motion_def_with(&text, path, &Default::default(), cancel);
         }
-        Scenario::from_toml(&text, &file)
+        Scenario::from_toml_with(&text, &file, cancel)
     }
 
     /// A gnss-ins-sim motion-definition file as a scenario
@@ -232,7 +245,17 @@ impl Scenario {
         path: &Path,
         opts: &crate::io::gnss_ins_sim::ImportOptions,
     ) -> Result<Scenario, ScenarioError> {
-        use crate::io::gnss_ins_sim::{parse_motion_def, to_scenario_toml, GisError};
+        Scenario::from_motion_def_with(text, path, opts, &crate::cancel::CancelToken::new())
+    }
+
+    /// [`Scenario::from_motion_def`] polling `cancel` ([`Scenario::from_file_with`]).
+    pub fn from_motion_def_with(
+        text: &str,
+        path: &Path,
+        opts: &crate::io::gnss_ins_sim::ImportOptions,
+        cancel: &crate::cancel::CancelToken,
+    ) -> Result<Scenario, ScenarioError> {
+        use crate::io::gnss_ins_sim::{parse_motion_def_with, to_scenario_toml_with, GisError};
         let file = path.display().to_string();
         let conv = |e: GisError| match e {
             GisError::Invalid {
@@ -246,27 +269,36 @@ impl Scenario {
                 key: format!("column {column}"),
                 message,
             },
+            GisError::Cancelled(_) => ScenarioError::Cancelled,
             other => ScenarioError::Read {
                 file: file.clone(),
                 reason: other.to_string(),
             },
         };
-        let mf = parse_motion_def(text, &file).map_err(conv)?;
+        let mf = parse_motion_def_with(text, &file, cancel).map_err(conv)?;
         let name = path
             .file_stem()
             .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned());
-        let toml = to_scenario_toml(&mf, &name, &file, opts).map_err(conv)?;
-        Scenario::from_toml(&toml, &file)
+        let toml = to_scenario_toml_with(&mf, &name, &file, opts, cancel).map_err(conv)?;
+        Scenario::from_toml_with(&toml, &file, cancel)
     }
 
     /// A built-in name or a file path.
     pub fn load(name_or_path: &str) -> Result<Scenario, ScenarioError> {
+        Scenario::load_with(name_or_path, &crate::cancel::CancelToken::new())
+    }
+
+    /// [`Scenario::load`] polling `cancel` ([`Scenario::from_file_with`]).
+    pub fn load_with(
+        name_or_path: &str,
+        cancel: &crate::cancel::CancelToken,
+    ) -> Result<Scenario, ScenarioError> {
         if let Some(b) = builtin(name_or_path) {
-            return Scenario::from_toml(b.toml, &format!("<built-in {}>", b.name));
+            return Scenario::from_toml_with(b.toml, &format!("<built-in {}>", b.name), cancel);
         }
         let p = Path::new(name_or_path);
         if p.exists() {
-            return Scenario::from_file(p);
+            return Scenario::from_file_with(p, cancel);
         }
         Err(ScenarioError::Unknown {
             name: name_or_path.to_string(),

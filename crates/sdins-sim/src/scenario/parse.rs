@@ -5,6 +5,7 @@ use super::*;
 pub(super) struct Ctx<'a> {
     pub(super) file: &'a str,
     pub(super) text: &'a str,
+    pub(super) cancel: &'a crate::cancel::CancelToken,
 }
 
 impl Ctx<'_> {
@@ -105,8 +106,18 @@ pub(super) fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> Scenari
 impl Scenario {
     /// Parse and validate scenario text; `file` names it in error messages.
     pub fn from_toml(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
+        Scenario::from_toml_with(text, file, &crate::cancel::CancelToken::new())
+    }
+
+    /// [`Scenario::from_toml`] polling `cancel` ([`Scenario::from_file_with`]).
+    pub fn from_toml_with(
+        text: &str,
+        file: &str,
+        cancel: &crate::cancel::CancelToken,
+    ) -> Result<Scenario, ScenarioError> {
         let doc: FileDoc = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;
-        let cx = Ctx { file, text };
+        cancel.check().map_err(|_| ScenarioError::Cancelled)?;
+        let cx = Ctx { file, text, cancel };
         let start_from_route;
         let start_doc: &S<StartDoc> = match (&doc.start, doc.waypoint.first()) {
             (Some(s), None) => s,
@@ -742,7 +753,7 @@ impl Scenario {
                 return cx.err(span, "segment", msg);
             }
         };
-        if let Err(e) = crate::truth::envelope::check_trajectory(
+        if let Err(e) = crate::truth::envelope::check_trajectory_with(
             &trajectory,
             crate::truth::envelope::StartPosition {
                 lat_rad: start.lat_rad,
@@ -750,7 +761,11 @@ impl Scenario {
             },
             dt,
             &crate::truth::envelope::Envelope::DEFAULT,
+            cancel,
         ) {
+            if let crate::truth::envelope::EnvelopeError::Cancelled(_) = e {
+                return Err(ScenarioError::Cancelled);
+            }
             // the trajectory's segment k comes from a [[segment]] (a coordinated turn
             // gives three)
             let span = match e.segment().and_then(|k| seg_of_motion.get(k)) {

@@ -24,6 +24,16 @@ pub(super) fn parse_route(
             ),
         );
     }
+    if let Some(w) = doc.waypoint.get(crate::truth::route::MAX_WAYPOINTS) {
+        return cx.err(
+            w.span(),
+            "waypoint",
+            format!(
+                "more than {} [[waypoint]] tables (the limit of one route): split the route",
+                crate::truth::route::MAX_WAYPOINTS
+            ),
+        );
+    }
     let mut wps = Vec::with_capacity(doc.waypoint.len());
     for w in &doc.waypoint {
         let wd = w.get_ref();
@@ -165,10 +175,14 @@ pub(super) fn parse_route(
         legs,
         limits,
     };
-    crate::truth::route::compile(&route, earth, dt).map_err(|e| {
+    crate::truth::route::compile_with(&route, earth, dt, cx.cancel).map_err(|e| {
+        if let RouteError::Cancelled(_) = e {
+            return ScenarioError::Cancelled;
+        }
         let wp = match &e {
             RouteError::Value { waypoint, .. }
             | RouteError::Coincident { waypoint, .. }
+            | RouteError::Ambiguous { waypoint, .. }
             | RouteError::Pole { waypoint, .. }
             | RouteError::TooShort { waypoint, .. }
             | RouteError::Turn { waypoint, .. }

@@ -26,6 +26,7 @@
 //! A command shorter than its slowest channel's `T_c` is extended to that time, rounded up
 //! to a whole number of IMU samples ([`BodyMotion::extended`] lists them).
 
+use crate::cancel::{CancelToken, Cancelled, POLL_EVERY_SAMPLES};
 use sdins_core::math::{c_b_n_from_sin_cos, Mat3, Vec3};
 use std::f64::consts::PI;
 
@@ -270,6 +271,10 @@ fn reach_time(delta: f64, rate_max: f64, accel_max: f64) -> f64 {
     }
 }
 
+/// Most commands in one motion (docs/scenarios.md §"Importing gnss-ins-sim motion files"):
+/// reading, compiling and checking them is linear in their number (bench/scale.sh).
+pub const MAX_COMMANDS: usize = 1_000_000;
+
 impl BodyMotion {
     /// Compile the commands from `start` under `limits`; extended durations are rounded up
     /// to whole multiples of `dt_s` (the IMU sample period).
@@ -279,6 +284,33 @@ impl BodyMotion {
         limits: MotionLimits,
         dt_s: f64,
     ) -> Self {
+        match Self::build(start, commands, limits, dt_s, || {
+            Ok::<(), std::convert::Infallible>(())
+        }) {
+            Ok(m) => m,
+            Err(never) => match never {},
+        }
+    }
+
+    /// [`BodyMotion::compile`], polling `cancel` every
+    /// [`POLL_EVERY_SAMPLES`] commands.
+    pub fn compile_with(
+        start: BodyStart,
+        commands: &[BodyCommand],
+        limits: MotionLimits,
+        dt_s: f64,
+        cancel: &CancelToken,
+    ) -> Result<Self, Cancelled> {
+        Self::build(start, commands, limits, dt_s, || cancel.check())
+    }
+
+    fn build<E>(
+        start: BodyStart,
+        commands: &[BodyCommand],
+        limits: MotionLimits,
+        dt_s: f64,
+        mut poll: impl FnMut() -> Result<(), E>,
+    ) -> Result<Self, E> {
         let mut x = [
             start.euler_ypr[0],
             start.euler_ypr[1],
@@ -293,6 +325,9 @@ impl BodyMotion {
         let mut pieces = Vec::with_capacity(commands.len());
         let mut extended = Vec::new();
         for (index, c) in commands.iter().enumerate() {
+            if (index as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
+                poll()?;
+            }
             let cmd = [
                 c.euler_ypr[0],
                 c.euler_ypr[1],
@@ -369,12 +404,12 @@ impl BodyMotion {
                 t = n_sum * dt_s;
             }
         }
-        Self {
+        Ok(Self {
             pieces,
             duration_s: t,
             limits,
             extended,
-        }
+        })
     }
 
     /// The compiled pieces (one per command).

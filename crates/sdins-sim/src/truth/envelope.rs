@@ -22,6 +22,7 @@
 //! check; on the grid its component phases advance by a rotation per step
 //! ([`Trajectory::phases_advance`]), which agrees with the direct evaluation to rounding.
 
+use crate::cancel::{CancelToken, Cancelled, POLL_EVERY_SAMPLES};
 use crate::truth::trajectory::{OverlayPhases, Trajectory};
 use sdins_core::earth::EarthModel;
 use std::f64::consts::PI;
@@ -116,6 +117,9 @@ pub enum EnvelopeError {
         /// indices of the overlays active at that time
         overlays: Vec<usize>,
     },
+    /// Stopped through the cancellation token.
+    #[error("cancelled")]
+    Cancelled(#[from] Cancelled),
     /// The trajectory has no samples at the IMU rate.
     #[error("the trajectory lasts {duration_s} s, less than one IMU sample of {dt_s} s")]
     NoSamples {
@@ -131,7 +135,7 @@ impl EnvelopeError {
     pub fn segment(&self) -> Option<usize> {
         match self {
             EnvelopeError::Outside { segment, .. } => *segment,
-            EnvelopeError::NoSamples { .. } => None,
+            EnvelopeError::NoSamples { .. } | EnvelopeError::Cancelled(_) => None,
         }
     }
 }
@@ -192,6 +196,18 @@ pub fn check_trajectory(
     start: StartPosition,
     dt_s: f64,
     env: &Envelope,
+) -> Result<EnvelopeReport, EnvelopeError> {
+    check_trajectory_with(traj, start, dt_s, env, &CancelToken::new())
+}
+
+/// [`check_trajectory`], polling `cancel` every [`POLL_EVERY_SAMPLES`] evaluations
+/// ([`EnvelopeError::Cancelled`]). Linear in the number of evaluations and segments.
+pub fn check_trajectory_with(
+    traj: &Trajectory,
+    start: StartPosition,
+    dt_s: f64,
+    env: &Envelope,
+    cancel: &CancelToken,
 ) -> Result<EnvelopeReport, EnvelopeError> {
     let dur = traj.duration_s;
     if !(dur.is_finite() && dt_s.is_finite() && dt_s > 0.0) || dur < dt_s * (1.0 - 1e-9) {
@@ -303,13 +319,19 @@ pub fn check_trajectory(
         }
         Ok(k.v_n_mps)
     };
-    for &(t, t_sel) in &extra {
+    for (i, &(t, t_sel)) in extra.iter().enumerate() {
+        if (i as u64).is_multiple_of(POLL_EVERY_SAMPLES) {
+            cancel.check()?;
+        }
         check_point(t, t_sel, None, &mut rep)?;
     }
     // grid with position integration
     let (mut lat, mut hgt) = (start.lat_rad, start.h_m);
     let mut v_prev = check_point(0.0, 0.0, None, &mut rep)?;
     for i in 1..=n_grid {
+        if i.is_multiple_of(POLL_EVERY_SAMPLES) {
+            cancel.check()?;
+        }
         let t = if i == n_grid { dur } else { i as f64 * h };
         // the last point belongs to the last segment's branch
         let t_sel = if i == n_grid { t - 0.5 * h } else { t };

@@ -543,6 +543,19 @@ impl<'a> TruthGenerator<'a> {
     /// The navigation initial state at t = 0 (exact), at the IMU when a mount is set
     /// ([`TruthGenerator::with_mount`], [`ImuMount::imu_point`]).
     pub fn initial_state(&self) -> InitialState {
+        let s = self.initial_truth();
+        InitialState {
+            lat_rad: s.lat_rad,
+            lon_rad: s.lon_rad,
+            h_m: s.h_m,
+            v_n_mps: s.v_n_mps,
+            c_b_n: s.c_b_n,
+        }
+    }
+
+    /// The truth at t = 0 (zero increments), at the IMU when a mount is set: what the
+    /// initial state of a navigation is compared with.
+    pub fn initial_truth(&self) -> TruthSample {
         let k = self.traj.kinematics(0.0, 0.0);
         let s = TruthSample::new(
             0.0,
@@ -553,14 +566,7 @@ impl<'a> TruthGenerator<'a> {
             k.v_n_mps,
             k.c_b_n,
         );
-        let s = self.at_imu(&s);
-        InitialState {
-            lat_rad: s.lat_rad,
-            lon_rad: s.lon_rad,
-            h_m: s.h_m,
-            v_n_mps: s.v_n_mps,
-            c_b_n: s.c_b_n,
-        }
+        self.at_imu(&s)
     }
 
     /// A sample of this generator moved to the IMU ([`ImuMount::imu_point`]; unchanged

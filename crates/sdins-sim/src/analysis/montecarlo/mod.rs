@@ -14,12 +14,12 @@
 //!   attitude error ε N, E, D \[rad\] (convention G, `C_alg C_trueᵀ = I + [ε×]`).
 //! * Statistics per epoch and channel: mean, sample σ = √(M2/(n − 1)), and the 5/50/95 %
 //!   percentiles ([`histogram`]).
-//! * Exactness: the canonical reduction of [`plan`] (blocks of K runs reduced in run
+//! * Exactness: the canonical reduction of [`plan`](mod@plan) (blocks of K runs reduced in run
 //!   order, blocks folded in block order with Chan's merge, shards of whole blocks that
 //!   keep their block results) makes the statistics bit-identical for any number of
 //!   threads and for one shard versus any number of merged shards.
 //!
-//! Files: [`moments`] (Welford/Chan), [`histogram`] (percentiles), [`plan`] (blocks and
+//! Files: [`moments`] (Welford/Chan), [`histogram`] (percentiles), [`plan`](mod@plan) (blocks and
 //! shards), [`state`] (the lossless, mergeable accumulator state), [`runner`] (rayon over
 //! blocks), [`stats`] (the final table and its CSV), [`truth_cache`] (the truth computed
 //! once for all runs).
@@ -33,7 +33,7 @@ pub mod state;
 pub mod stats;
 pub mod truth_cache;
 
-pub use options::{mc_options, McChoice, DEFAULT_MC_EVERY_S};
+pub use options::{mc_options, plan, McChoice, McPlan, McRequest, DEFAULT_MC_EVERY_S};
 pub use plan::{Shard, DEFAULT_BLOCK};
 pub use runner::{run_shard, McOptions};
 pub use state::{BlockResult, McJob, McState};

@@ -65,3 +65,84 @@ pub fn mc_options(scn: &Scenario, c: &McChoice) -> Result<McOptions, OptionError
         vertical_hold,
     })
 }
+
+/// A Monte Carlo job as a front end gives it: the choice, a grade replacing the scenario's
+/// error model, the shard and the worker threads.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct McRequest {
+    /// runs, seed, algorithm, epochs, …
+    pub choice: McChoice,
+    /// IMU grade preset replacing the scenario's error model (`--grade`)
+    pub grade: Option<String>,
+    /// the shard to compute (default: the whole job)
+    pub shard: Option<super::Shard>,
+    /// worker threads (default: rayon's global pool); the numbers do not depend on it
+    pub threads: Option<usize>,
+}
+
+/// A validated job: the scenario with its grade, the options, the shard and the pool.
+pub struct McPlan {
+    /// the scenario (grade applied)
+    pub scenario: Scenario,
+    /// the options
+    pub options: McOptions,
+    /// the shard
+    pub shard: super::Shard,
+    /// runs in the shard
+    pub runs: u64,
+    /// output epochs (rows of the statistics)
+    pub epochs: u64,
+    pool: Option<rayon::ThreadPool>,
+}
+
+/// Validate a request (messages name the option: `--grade`, `--threads`, …).
+pub fn plan(mut scenario: Scenario, req: &McRequest) -> Result<McPlan, OptionError> {
+    if let Some(g) = &req.grade {
+        crate::nav::options::apply_grade(&mut scenario, g)?;
+    }
+    let options = mc_options(&scenario, &req.choice)?;
+    let shard = req.shard.unwrap_or(super::Shard::ALL);
+    let pool = match req.threads {
+        None => None,
+        Some(t) if (1..=1024).contains(&t) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .map_err(|e| bad(format!("--threads {t}: {e}")))?,
+        ),
+        Some(t) => return Err(bad(format!("--threads {t}: expected 1 … 1024"))),
+    };
+    let end = options
+        .until_s
+        .map_or(scenario.duration_s(), |t| t.min(scenario.duration_s()));
+    Ok(McPlan {
+        runs: super::runner::shard_runs(&options, shard),
+        epochs: (end / options.every_s) as u64 + 2,
+        scenario,
+        options,
+        shard,
+        pool,
+    })
+}
+
+impl McPlan {
+    /// Whether every run is the same (ideal sensors): worth a warning.
+    pub fn ideal_sensors(&self) -> bool {
+        self.scenario.imu.model == crate::sensors::imu_error::ImuErrorModel::ideal()
+    }
+
+    /// Compute the shard; `on_run()` after every finished run (from worker threads),
+    /// `cancelled()` polled between runs.
+    pub fn run(
+        &self,
+        on_run: &(dyn Fn() + Sync),
+        cancelled: &(dyn Fn() -> bool + Sync),
+    ) -> Result<super::McState, super::McError> {
+        let compute =
+            || super::run_shard(&self.scenario, &self.options, self.shard, on_run, cancelled);
+        match &self.pool {
+            Some(p) => p.install(compute),
+            None => compute(),
+        }
+    }
+}

@@ -25,7 +25,8 @@ pub struct McOptions {
     pub seed: u64,
     /// the algorithm
     pub algo: AlgorithmSpec,
-    /// output epoch spacing \[s\] (rounded to whole navigation updates)
+    /// output epoch spacing \[s\]: the rows are the updates nearest to `k·every_s`
+    /// ([`crate::nav::epochs`])
     pub every_s: f64,
     /// stop time \[s\] (None: whole scenario)
     pub until_s: Option<f64>,
@@ -46,16 +47,11 @@ fn channels(e: &NavError) -> [f64; N_CHANNELS] {
 pub const MAX_RUNS: u64 = 100_000_000;
 
 /// One realisation: the errors at every output epoch.
-pub fn run_one(
-    scn: &Scenario,
-    opts: &McOptions,
-    every: u64,
-    run: u64,
-) -> Result<Vec<NavError>, McError> {
+pub fn run_one(scn: &Scenario, opts: &McOptions, run: u64) -> Result<Vec<NavError>, McError> {
     let ropts = RunOptions {
         algos: vec![opts.algo],
         vertical_hold: opts.vertical_hold,
-        every,
+        every_s: Some(opts.every_s),
         until_s: opts.until_s,
         sensor_run: Some(run),
     };
@@ -100,8 +96,6 @@ pub fn job(scn: &Scenario, opts: &McOptions) -> Result<(McJob, Scenario), McErro
         .map_err(|e| McError::Model(e.to_string()))?;
     let mut s = scn.clone();
     s.imu.seed = opts.seed;
-    let dt_u = s.imu.dt_s() * opts.algo.samples as f64;
-    let every = ((opts.every_s / dt_u).round() as u64).max(1);
     let fingerprint = fnv1a_hex(&format!("{s:?}|{:?}", opts.algo));
     Ok((
         McJob {
@@ -112,7 +106,7 @@ pub fn job(scn: &Scenario, opts: &McOptions) -> Result<(McJob, Scenario), McErro
             runs: opts.runs,
             seed: opts.seed,
             block: opts.block,
-            every,
+            every_s: opts.every_s,
             until_s: opts.until_s,
             vertical_hold: opts.vertical_hold,
         },
@@ -161,7 +155,7 @@ pub fn run_shard(
     let blocks: Vec<u64> = shard_blocks(shard, opts.runs, opts.block).collect();
     // the truth is the same for every run: generate it once where that is expensive
     let cache = worth_caching(&s, opts.algo.samples, opts.until_s)
-        .then(|| TruthCache::build(&s, opts.algo.samples, job.every, opts.until_s));
+        .then(|| TruthCache::build(&s, opts.algo.samples, job.every_s, opts.until_s));
     type Block = (BlockResult, Vec<LogHistogram>, Vec<f64>);
     let results: Vec<Result<Block, McError>> = blocks
         .par_iter()
@@ -175,7 +169,7 @@ pub fn run_shard(
                 }
                 let errs = match &cache {
                     Some(c) => c.run(&s.imu.model, s.imu.seed, r, &opts.algo, opts.vertical_hold),
-                    None => run_one(&s, opts, job.every, r)?,
+                    None => run_one(&s, opts, r)?,
                 };
                 if times.is_empty() {
                     times = errs.iter().map(|e| e.t_s).collect();
@@ -376,14 +370,14 @@ duration_s = 60.0
             ..opts(1)
         };
         let (job, s) = job(&scn, &o).unwrap();
-        let cache = TruthCache::build(&s, 2, job.every, o.until_s);
+        let cache = TruthCache::build(&s, 2, job.every_s, o.until_s);
         for hold in [true, false] {
             let o = McOptions {
                 vertical_hold: hold,
                 ..o.clone()
             };
             for r in [0, 5] {
-                let a = run_one(&s, &o, job.every, r).unwrap();
+                let a = run_one(&s, &o, r).unwrap();
                 let c = cache.run(&s.imu.model, s.imu.seed, r, &o.algo, hold);
                 assert_eq!(a.len(), 5);
                 assert_eq!(a, c);

@@ -17,7 +17,7 @@ use super::{McError, N_CHANNELS};
 use serde::{Deserialize, Serialize};
 
 /// Format tag of the state files.
-pub const FORMAT: &str = "sdins-montecarlo-state-1";
+pub const FORMAT: &str = "sdins-montecarlo-state-2";
 
 /// Identity of a Monte Carlo job.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -36,8 +36,10 @@ pub struct McJob {
     pub seed: u64,
     /// block size K
     pub block: u64,
-    /// navigation updates between output epochs
-    pub every: u64,
+    /// output epoch spacing \[s\]: rows at the updates nearest to `k·every_s`
+    /// ([`crate::nav::epochs`]; format 2, format 1 held a count of updates)
+    #[serde(with = "super::bits")]
+    pub every_s: f64,
     /// stop time \[s\] (None: whole scenario)
     #[serde(with = "super::bits::opt")]
     pub until_s: Option<f64>,

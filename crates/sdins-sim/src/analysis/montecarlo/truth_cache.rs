@@ -12,6 +12,7 @@
 //! (static, level cruise) use the generator's closed form, which is cheaper than reading
 //! a cache, and are streamed instead ([`worth_caching`]).
 
+use crate::nav::epochs::EpochGrid;
 use crate::nav::pipeline::{nav_error, NavError};
 use crate::scenario::Scenario;
 use crate::sensors::imu_error::{ImuErrorModel, ImuErrorState};
@@ -30,8 +31,7 @@ pub struct TruthCache {
     dt_s: f64,
     init: InitialState,
     n: usize,
-    every: u64,
-    total_updates: u64,
+    rows: Vec<u64>,
     incs: Vec<Increment>,
     vert: Vec<[f64; 2]>,
     epochs: Vec<TruthSample>,
@@ -71,18 +71,27 @@ pub fn worth_caching(scn: &Scenario, n: usize, until_s: Option<f64>) -> bool {
 }
 
 impl TruthCache {
-    /// Generate the truth once for `n` samples per update and epochs every `every`
-    /// updates (and at the end), up to `until_s`.
-    pub fn build(scn: &Scenario, n: usize, every: u64, until_s: Option<f64>) -> Self {
+    /// Generate the truth once for `n` samples per update and output rows every
+    /// `every_s` seconds by the rule of [`crate::nav::epochs`] (the initial state and the
+    /// last update included), up to `until_s`.
+    pub fn build(scn: &Scenario, n: usize, every_s: f64, until_s: Option<f64>) -> Self {
         let cfg = config(scn);
         let n = n.max(1);
-        let every = every.max(1);
         let mut gen = TruthGenerator::new(&scn.trajectory, cfg);
         let init = gen.initial_state();
         let total = total_updates(gen.len_samples(), n, cfg.dt_s, until_s);
+        // a bad spacing is refused by `job`; here the rows are the initial state and the end
+        let rows = match EpochGrid::new(every_s, cfg.dt_s * n as f64) {
+            Ok(g) => g.updates(total),
+            Err(_) => vec![0, total],
+        };
+        let mut next_row = rows.iter().peekable();
         let mut incs = Vec::with_capacity(total as usize * n);
         let mut vert = Vec::with_capacity(total as usize);
         let mut epochs = Vec::new();
+        if next_row.next_if_eq(&&0).is_some() {
+            epochs.push(gen.initial_truth());
+        }
         let mut done = 0_u64;
         while done < total {
             let mut end = None;
@@ -95,7 +104,7 @@ impl TruthCache {
             let Some(e) = end else { break };
             vert.push([e.h_m, e.v_n_mps.z]);
             done += 1;
-            if done.is_multiple_of(every) || done == total {
+            if next_row.next_if_eq(&&done).is_some() {
                 epochs.push(e);
             }
         }
@@ -104,8 +113,7 @@ impl TruthCache {
             dt_s: cfg.dt_s,
             init,
             n,
-            every,
-            total_updates: done,
+            rows,
             incs,
             vert,
             epochs,
@@ -132,6 +140,12 @@ impl TruthCache {
         let mut buf: Vec<Increment> = Vec::with_capacity(n);
         let mut out = Vec::with_capacity(self.epochs.len());
         let mut ep = self.epochs.iter();
+        let mut rows = self.rows.iter().peekable();
+        if rows.next_if_eq(&&0).is_some() {
+            if let Some(tr) = ep.next() {
+                out.push(nav_error(&self.earth, &mech.state(), tr));
+            }
+        }
         for (u, chunk) in self.incs.chunks(n).enumerate() {
             buf.clear();
             for inc in chunk {
@@ -146,7 +160,7 @@ impl TruthCache {
                 mech.hold_vertical(h, vd);
             }
             let finished = u as u64 + 1;
-            if finished.is_multiple_of(self.every) || finished == self.total_updates {
+            if rows.next_if_eq(&&finished).is_some() {
                 if let Some(tr) = ep.next() {
                     out.push(nav_error(&self.earth, &mech.state(), tr));
                 }

@@ -34,7 +34,7 @@ pub(super) fn wrap(a: f64) -> f64 {
     a
 }
 
-impl Ctx {
+impl Ctx<'_> {
     /// `[L̇, λ̇, ḣ, ψ̇]` for speed `s`, down velocity `v_d` (Groves eq. 2.111) and the
     /// geodesic heading rate `ψ̇ = v_E tan L/(R_N + h)` (zero on rhumb legs).
     pub(super) fn rates(&self, p: &P, s: f64, v_d: f64) -> [f64; 4] {
@@ -140,23 +140,49 @@ impl Ctx {
             h,
             psi: 0.0,
         };
-        let d0 = self.ned(&pa, &pb);
-        let mut psi = d0.y.atan2(d0.x);
-        let mut len = (d0.x * d0.x + d0.y * d0.y).sqrt();
-        if len < 1.0 {
+        // the start azimuth and length in closed form (Karney's inverse problem, or the
+        // rhumb line's formula): the start of the Newton iteration, and the checks
+        let way = match self.legs {
+            LegKind::GreatCircle => geodesic_way(&self.earth, a, b),
+            LegKind::Rhumb => rhumb_way(&self.earth, a, b),
+        };
+        if way.len_m < 1.0 {
             return Err(RouteError::Coincident {
                 waypoint: wp,
-                distance_m: len,
+                distance_m: way.len_m,
             });
         }
+        if way.margin_m < AMBIGUOUS_M {
+            let [lat_deg, lon_deg] = intermediate(&self.earth, a, way.len_m);
+            return Err(RouteError::Ambiguous {
+                from: wp - 1,
+                waypoint: wp,
+                kind: self.legs,
+                length_m: way.len_m,
+                margin_m: way.margin_m,
+                suggest_deg: [lat_deg, lon_deg],
+            });
+        }
+        let mut psi = way.azi1;
+        let mut len = way.len_m * (1.0 + h / self.earth.a_m);
         let miss = |psi: f64, len: f64| -> Vec3 {
             let (q, _) = self.arc(P { psi, ..pa }, len);
             self.ned(&pb, &q)
         };
         for _ in 0..30 {
+            self.cancel.check()?;
             let m = miss(psi, len);
             if m.x.hypot(m.y) < 1e-7 {
                 let (q, max_lat) = self.arc(P { psi, ..pa }, len);
+                // the horizontal NED components vanish at the antipode too: the end must
+                // be the waypoint itself
+                let d = (self.ecef(&q) - self.ecef(&pb)).norm();
+                if d > 1e-3 {
+                    return Err(RouteError::Solve {
+                        waypoint: wp,
+                        why: format!("the ideal leg ends {d:.3} m from the waypoint"),
+                    });
+                }
                 return Ok((psi, q.psi, len, max_lat));
             }
             let (dp, dl) = (1e-7, 1e-3);
@@ -200,7 +226,7 @@ pub(super) struct Piece {
 /// The leg pieces before the cruise (speed change, climb) and after it (stop), and their
 /// along-track length.
 pub(super) fn leg_pieces(
-    ctx: &Ctx,
+    ctx: &Ctx<'_>,
     lim: &RouteLimits,
     v0: f64,
     v1: f64,
@@ -299,7 +325,7 @@ pub(super) fn piece_step(dur: f64) -> f64 {
     (dur / 100.0).clamp(1e-3, 1.0)
 }
 
-impl Ctx {
+impl Ctx<'_> {
     /// Fly a leg from `p` with start heading `p.psi`: the end state.
     pub(super) fn fly_leg(&self, leg: &Leg, p: P) -> P {
         let mut q = p;
@@ -359,6 +385,7 @@ impl Ctx {
         };
         let mut ok = false;
         for _ in 0..30 {
+            self.cancel.check()?;
             let m = miss(psi, t_c);
             if m.x.hypot(m.y) < 1e-6 {
                 ok = true;
@@ -386,6 +413,11 @@ impl Ctx {
         if !ok {
             return Err(fail("the shooting did not converge"));
         }
+        let end = self.fly_leg(&build(t_c), P { psi, ..p });
+        let d = (self.ecef(&end) - self.ecef(target)).norm();
+        if d > 1.0 {
+            return Err(fail(&format!("the shot leg ends {d:.3} m from its target")));
+        }
         // whole samples, then zero cross-track miss (normal to the arrival heading)
         let t_r = if t_c < 0.5 * self.dt {
             0.0
@@ -399,6 +431,7 @@ impl Ctx {
             -m.x * s + m.y * c
         };
         for _ in 0..20 {
+            self.cancel.check()?;
             let c0 = cross(psi);
             if c0.abs() < 1e-7 {
                 break;

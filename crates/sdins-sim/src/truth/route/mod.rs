@@ -23,12 +23,16 @@
 //! durations are whole IMU samples, so a leg ends within `V·dt/2` along-track of its
 //! target ([`WaypointReport::miss_m`] at the last waypoint).
 
+use crate::cancel::{CancelToken, Cancelled};
 use crate::truth::trajectory::{Motion, Segment, GEO_CHEB_N};
 use sdins_core::earth::EarthModel;
 use sdins_core::math::Vec3;
 use std::f64::consts::PI;
 
+mod geodesic;
 mod legs;
+pub use geodesic::AMBIGUOUS_M;
+use geodesic::*;
 use legs::*;
 
 const G: f64 = 9.806_65;
@@ -164,6 +168,24 @@ pub enum RouteError {
         /// leg length \[m\]
         distance_m: f64,
     },
+    /// The waypoint lies on or next to the cut locus of the previous one (nearly
+    /// antipodal): two geodesics (or, for rhumb legs, the rhumb lines east and west)
+    /// join them with lengths within [`AMBIGUOUS_M`], so the leg is not determined.
+    #[error("the leg from waypoint {from} to waypoint {waypoint} is ambiguous: waypoint {waypoint} is (nearly) antipodal to waypoint {from}, and two {} of {:.3} km join them whose lengths differ by {margin_m:.3e} m (less than 1 mm); add an intermediate waypoint to choose the way, e.g. lat_deg = {:.4}, lon_deg = {:.4}", kind_ways(.kind), .length_m / 1e3, .suggest_deg[0], .suggest_deg[1])]
+    Ambiguous {
+        /// 1-based start waypoint of the leg
+        from: usize,
+        /// 1-based end waypoint of the leg
+        waypoint: usize,
+        /// leg kind
+        kind: LegKind,
+        /// length of the shortest way \[m\]
+        length_m: f64,
+        /// how much longer the other way is \[m\]
+        margin_m: f64,
+        /// a waypoint between them `[lat, lon]` \[deg\] that resolves it
+        suggest_deg: [f64; 2],
+    },
     /// The leg to the waypoint passes too close to a pole.
     #[error("the leg to waypoint {waypoint} reaches latitude {lat_deg:.3} deg: legs must stay within ±89.5 deg (the NED mechanization is singular at the poles)")]
     Pole {
@@ -205,20 +227,57 @@ pub enum RouteError {
     /// The earth model has no ellipsoid (flat earth).
     #[error("routes need an ellipsoidal earth model (nav.earth = \"wgs84\" or \"psins\")")]
     FlatEarth,
+    /// More waypoints than [`MAX_WAYPOINTS`].
+    #[error("the route has {count} waypoints, more than the limit of {MAX_WAYPOINTS}: split it into several scenarios")]
+    TooMany {
+        /// waypoints given
+        count: usize,
+    },
+    /// Stopped through the cancellation token.
+    #[error("cancelled")]
+    Cancelled(#[from] Cancelled),
 }
 
-struct Ctx {
+/// Most waypoints in one route (docs/scenarios.md §"Routes"): compilation is linear in
+/// their number (bench/scale.sh), about 10 ms each.
+pub const MAX_WAYPOINTS: usize = 100_000;
+
+fn kind_ways(k: &LegKind) -> &'static str {
+    match k {
+        LegKind::GreatCircle => "geodesics",
+        LegKind::Rhumb => "rhumb lines (east and west)",
+    }
+}
+
+struct Ctx<'a> {
     earth: EarthModel,
     dt: f64,
     legs: LegKind,
+    cancel: &'a CancelToken,
 }
 
-/// Compile a route for IMU interval `dt_s` on `earth`.
+/// Compile a route for IMU interval `dt_s` on `earth` ([`compile_with`] without a
+/// cancellation token).
 pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRoute, RouteError> {
+    compile_with(route, earth, dt_s, &CancelToken::new())
+}
+
+/// Compile a route for IMU interval `dt_s` on `earth`, polling `cancel` at every leg and
+/// every shooting iteration ([`RouteError::Cancelled`] once it is set). Linear in the
+/// number of waypoints (at most [`MAX_WAYPOINTS`]).
+pub fn compile_with(
+    route: &Route,
+    earth: EarthModel,
+    dt_s: f64,
+    cancel: &CancelToken,
+) -> Result<CompiledRoute, RouteError> {
     let wps = &route.waypoints;
     let n = wps.len();
     if n < 2 {
         return Err(RouteError::TooFew { count: n });
+    }
+    if n > MAX_WAYPOINTS {
+        return Err(RouteError::TooMany { count: n });
     }
     if !earth.transport || earth.a_m <= 0.0 {
         return Err(RouteError::FlatEarth);
@@ -272,10 +331,12 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
         earth,
         dt: dt_s,
         legs: route.legs,
+        cancel,
     };
     // ideal legs
     let mut ideal = Vec::with_capacity(n - 1);
     for k in 0..n - 1 {
+        cancel.check()?;
         let l = ctx.ideal_leg(&wps[k], &wps[k + 1], k + 2)?;
         if l.3 > MAX_LAT_RAD {
             return Err(RouteError::Pole {
@@ -291,6 +352,7 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
     let mut lead_in = vec![0.0; n];
     let mut lead_out = vec![0.0; n];
     for j in 1..n - 1 {
+        cancel.check()?;
         let d = wrap(ideal[j].0 - ideal[j - 1].1);
         dpsi0[j] = d;
         if d.abs() < 1e-9 {
@@ -392,6 +454,7 @@ pub fn compile(route: &Route, earth: EarthModel, dt_s: f64) -> Result<CompiledRo
     let mut start_heading = p.psi;
     let mut rate_in = 0.0; // heading rate at the end of the previous leg
     for k in 0..n - 1 {
+        cancel.check()?;
         let (pre, post, _) = &pieces[k];
         let v0 = if k == 0 {
             start_speed

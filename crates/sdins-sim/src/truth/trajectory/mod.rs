@@ -481,15 +481,12 @@ impl Trajectory {
 
     /// Index of the segment whose branch `t_sel` selects.
     pub fn segment_at(&self, t_sel: f64) -> Option<usize> {
-        // Segments are few; linear search from the end finds the last one starting ≤ t_sel.
-        self.segments
-            .iter()
-            .rposition(|s| s.t0_s <= t_sel)
-            .or(if self.segments.is_empty() {
-                None
-            } else {
-                Some(0)
-            })
+        // the last one starting ≤ t_sel (the starts ascend): a binary search, since routes
+        // and command lists have up to 10⁵–10⁶ segments and this runs at every evaluation
+        match self.segments.partition_point(|s| s.t0_s <= t_sel) {
+            _ if self.segments.is_empty() => None,
+            i => Some(i.saturating_sub(1)),
+        }
     }
 
     /// `(sin, cos)` of `Ω_k (t_base − start_k)` for every overlay `k` into `out`: the
