@@ -694,8 +694,8 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::math::{c_b_n_from_euler, Euler, Mat3};
-    use std::{vec, vec::Vec};
     use crate::nav::{transport_matrix, AlgorithmKind, AlgorithmSpec, AnyMechanization};
+    use std::{vec, vec::Vec};
 
     #[test]
     fn transport_factors_into_elementary_rotations() {
