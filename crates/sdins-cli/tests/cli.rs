@@ -903,3 +903,41 @@ fn fuse_health_verdict_exit_3_on_a_diverged_filter() {
     assert_eq!(code, 0, "{stderr}");
     assert!(!stderr.contains("health"), "{stderr}");
 }
+
+/// Reliability class 10: a logger killed mid-write cuts its last line; `nav` and `allan`
+/// drop it with a warning on stderr (not stdout) that names the line, recorded in
+/// run.toml.
+#[test]
+fn cut_last_line_is_dropped_with_a_warning() {
+    let d = tmp("cutline");
+    truth_and_imu(&d);
+    let full = std::fs::read_to_string(d.join("imu.csv")).unwrap();
+    let rows = full.lines().count();
+    let cut = format!("{full}0.5,1e-4,2e-4");
+    let f = input(&d, "cut.csv");
+    std::fs::write(&f, &cut).unwrap();
+    let truth = d.join("truth.csv");
+    for cmd in ["nav", "allan"] {
+        let out = d.with_extension(format!("out-{cmd}"));
+        let mut args = vec![
+            cmd,
+            "--imu",
+            f.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if cmd == "nav" {
+            args.extend(["--truth", truth.to_str().unwrap()]);
+        }
+        let (code, stdout, stderr) = sdins(&args);
+        assert_eq!(code, 0, "{cmd}: {stderr}");
+        let line = format!("line {}", rows + 1);
+        assert!(
+            stderr.contains("warning:") && stderr.contains(&line) && stderr.contains("dropped"),
+            "{cmd}: {stderr}"
+        );
+        assert!(!stdout.contains("dropped"), "{cmd}: {stdout}");
+        let run = std::fs::read_to_string(out.join("run.toml")).unwrap();
+        assert!(run.contains("dropped"), "{cmd}: {run}");
+    }
+}
