@@ -139,7 +139,8 @@ pub fn fuse<'py>(
             self.vel_mps.extend(e.nav.vel_err_ned_mps);
             self.att_rad.extend(e.nav.att_err_rad);
             self.sigma.extend((0..NX).map(|i| e.sigma(i)));
-            self.nees.extend([e.nees_block(0), e.nees_block(3), e.nees_block(6)]);
+            self.nees
+                .extend([e.nees_block(0), e.nees_block(3), e.nees_block(6)]);
             if let Some(sf) = e.scale_factors() {
                 self.sf_err.extend(sf.err.iter());
                 self.sf_sigma
@@ -179,7 +180,10 @@ pub fn fuse<'py>(
         r.map(|o| (a, o))
     })?
     .map_err(run_err)?;
-    let FuseDetails::Scenario { summary: s, run, .. } = &o.details else {
+    let FuseDetails::Scenario {
+        summary: s, run, ..
+    } = &o.details
+    else {
         return Err(err("fuse on a scenario returned no scenario result"));
     };
     let out = acc.forward.dict(py)?;

@@ -8,7 +8,7 @@
 //! reduced in run order ([`super::montecarlo::moments::Moments`], Welford), the blocks of a
 //! shard computed on the rayon pool and kept unfolded, the statistics folded in block
 //! order (Chan) — the same seed gives the same bits for any thread count and any shard
-//! split ([`super::montecarlo::plan`]). The seed replaces both the scenario's `[imu] seed`
+//! split ([`super::montecarlo::plan`](mod@super::montecarlo::plan)). The seed replaces both the scenario's `[imu] seed`
 //! and its `[gnss] seed` (their random streams are disjoint by construction).
 //!
 //! With [`FuseMcOptions::draw_scale_factors`] each run's true scale factors are drawn

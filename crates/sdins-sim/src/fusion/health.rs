@@ -177,7 +177,7 @@ impl HealthMonitor {
                     }
                 };
                 let h = sigma_ne[0].hypot(sigma_ne[1]);
-                if !(h <= self.sigma_h.0) {
+                if h.is_nan() || h > self.sigma_h.0 {
                     self.sigma_h = (h, t);
                 }
                 self.prior.get_or_insert((bias, sigma_bias));
@@ -263,7 +263,7 @@ impl HealthMonitor {
             for i in 0..6 {
                 if prior[i] > 0.0 {
                     let r = (self.last_bias[i] - b0[i]).abs() / prior[i];
-                    if !(r <= worst.0) {
+                    if r.is_nan() || r > worst.0 {
                         worst = (r, i);
                     }
                 }

@@ -656,37 +656,6 @@ impl Parser<'_> {
         ))
     }
 
-    /// Fixed-decimal text (KF-GINS prints every column with the same decimals): a last line
-    /// without final newline with fewer decimals in a field than the line before was cut.
-    fn check_cut_number(&self) -> Result<(), ImuFileError> {
-        let n = self.lines.len();
-        if self.ends_with_newline || n < 2 {
-            return Ok(());
-        }
-        let dec = |s: &str| {
-            if s.contains(['e', 'E']) {
-                None
-            } else {
-                Some(s.find('.').map_or(0, |k| s.len() - k - 1))
-            }
-        };
-        let (line, last) = self.lines[n - 1];
-        let prev = split_fields(self.lines[n - 2].1);
-        for (c, (a, b)) in prev.iter().zip(split_fields(last)).enumerate() {
-            if let (Some(da), Some(db)) = (dec(a), dec(b)) {
-                if db < da {
-                    return Err(ImuFileError::CutNumber {
-                        file: self.f(),
-                        line,
-                        column: c + 1,
-                        text: b.to_string(),
-                    });
-                }
-            }
-        }
-        Ok(())
-    }
-
     /// Line number of data row `k` when the data starts at `lines[from]`.
     fn line_of(&self, from: usize, k: usize) -> usize {
         self.lines.get(from + k).map_or(0, |l| l.0)
@@ -861,7 +830,6 @@ impl Parser<'_> {
     }
 
     fn kfgins(&self) -> Result<ImuData, ImuFileError> {
-        self.check_cut_number()?;
         let (v, t0, dt) = self.timed(0, &KFGINS_NAMES)?;
         let mut incs = Vec::with_capacity(v.len());
         for (k, [g, f]) in v.into_iter().enumerate() {

@@ -12,7 +12,7 @@
 //!
 //! Both are numerically stable (no cancellation of `Σx²` against `n·mean²`). Floating-point
 //! addition is not associative, so the result depends on the **order** of the updates and
-//! merges; the Monte Carlo fixes that order (see [`super::plan`]) to make results
+//! merges; the Monte Carlo fixes that order (see [`super::plan`](mod@super::plan)) to make results
 //! bit-identical for any thread count and any sharding.
 
 use serde::{Deserialize, Serialize};

@@ -3,7 +3,7 @@
 //! A run is one pass of [`crate::nav::pipeline::run`] with `sensor_run = Some(r)` and the
 //! Monte Carlo seed in place of the scenario's `[imu] seed`. The blocks of a shard are
 //! computed in parallel on the current rayon pool (`par_iter().map().collect()` keeps
-//! block order); see [`super::plan`] for why the result does not depend on the pool.
+//! block order); see [`super::plan`](mod@super::plan) for why the result does not depend on the pool.
 
 use super::histogram::LogHistogram;
 use super::moments::Moments;

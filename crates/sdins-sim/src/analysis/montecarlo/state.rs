@@ -6,7 +6,7 @@
 //!   block size, epoch spacing, vertical mode — merging requires them to be equal;
 //! * the output epochs' times;
 //! * one [`BlockResult`] per computed block (moments per epoch and channel, **not**
-//!   folded, see [`super::plan`]);
+//!   folded, see [`super::plan`](mod@super::plan));
 //! * one [`LogHistogram`] per epoch and channel (integer counts: merging is exact in any
 //!   order).
 

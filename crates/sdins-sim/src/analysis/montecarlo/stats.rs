@@ -38,7 +38,7 @@ pub struct McStats {
 }
 
 impl McState {
-    /// Statistics of the blocks present (the canonical fold, see [`super::plan`]).
+    /// Statistics of the blocks present (the canonical fold, see [`super::plan`](mod@super::plan)).
     pub fn statistics(&self) -> McStats {
         let m = self.folded_moments();
         let cells = self
