@@ -104,6 +104,9 @@ pub enum ImuFormat {
     KfGins,
     /// NaveGo CSV (rates, FRD)
     NaveGo,
+    /// any delimited text read through a column map (`crate::io::imu_columns`); not a
+    /// `--imu-format` value: `--columns` or `--profile` selects it
+    Columns,
 }
 
 impl ImuFormat {
@@ -119,6 +122,7 @@ impl ImuFormat {
             ImuFormat::PsinsCsv => "psins-csv",
             ImuFormat::KfGins => "kfgins",
             ImuFormat::NaveGo => "navego",
+            ImuFormat::Columns => "columns",
         }
     }
 }
@@ -443,6 +447,13 @@ pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuDa
     let mut data = match format {
         ImuFormat::Psins => p.psins()?,
         ImuFormat::KfGins => p.kfgins()?,
+        ImuFormat::Columns => {
+            return Err(ImuFileError::UnknownFormat {
+                file: file.to_path_buf(),
+                line: first_no,
+                why: "a column map is read by `io::imu_columns::read_imu_columns` (give --columns or --profile)".into(),
+            })
+        }
         ImuFormat::Sdins | ImuFormat::PsinsCsv | ImuFormat::NaveGo | ImuFormat::Auto => {
             p.csv(format)?
         }
