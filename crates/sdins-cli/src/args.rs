@@ -63,3 +63,105 @@ pub fn warn_deprecated(args: &[std::ffi::OsString]) {
         }
     }
 }
+
+/// The column maps of one's own files (docs/own-data.md): `--imu-columns`,
+/// `--gnss-columns`, an input profile and the settings a file cannot carry.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct ColumnsArgs {
+    /// read the IMU file through a column map `quantity_unit=COLUMN,…` with settings
+    /// (`axes=`, `mount_deg=`, `time=`, `delim=`, `header=`, `rates=`; docs/own-data.md);
+    /// replaces --imu-format
+    #[arg(long, value_name = "MAP")]
+    pub imu_columns: Option<String>,
+    /// read the GNSS file through a column map (`t_s=…,lat_deg=…,lon_deg=…,h_m=…` or
+    /// `alt_msl_m=…`, optional σ and velocity columns; docs/own-data.md)
+    #[arg(long, value_name = "MAP")]
+    pub gnss_columns: Option<String>,
+    /// input profile: a TOML file with `[imu]` and `[gnss]` maps (docs/own-data.md)
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
+    /// GPS week of `time=gps-sow` files without a week column
+    #[arg(long, value_name = "WEEK")]
+    pub gps_week: Option<u32>,
+    /// σ of fixes whose file has no σ columns: N,E,D[,vN,vE,vD] [m, m/s]
+    #[arg(long, value_name = "N,E,D[,vN,vE,vD]")]
+    pub gnss_sigma: Option<String>,
+    /// geoid undulation N [m] for a GNSS map with `alt_msl_m` (h = H + N)
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub undulation_m: Option<f64>,
+}
+
+impl ColumnsArgs {
+    /// The IMU and GNSS maps from the options and the profile (a map given both ways is
+    /// refused); every error names its option or `profile:line`.
+    pub fn resolve(
+        &self,
+    ) -> Result<
+        (
+            Option<sdins_sim::io::imu_columns::ImuColumns>,
+            Option<sdins_sim::io::gnss_columns::GnssColumns>,
+        ),
+        crate::error::CliError,
+    > {
+        use crate::error::CliError;
+        use sdins_sim::io::columns::MapOrigin;
+        use sdins_sim::io::gnss_columns::{GnssColumns, GnssSigma};
+        use sdins_sim::io::imu_columns::ImuColumns;
+        let bad = |e: sdins_sim::io::columns::ColumnsError| CliError::bad(e.to_string());
+        let (mut imu, mut gnss) = match &self.profile {
+            Some(p) => {
+                let pr = sdins_sim::io::profile::Profile::read(p).map_err(bad)?;
+                (pr.imu, pr.gnss)
+            }
+            None => (None, None),
+        };
+        if let Some(text) = &self.imu_columns {
+            if imu.is_some() {
+                return Err(CliError::bad(
+                    "--imu-columns: the profile has an [imu] map too: give one",
+                ));
+            }
+            imu = Some(
+                ImuColumns::parse(text, MapOrigin::Option("--imu-columns".into())).map_err(bad)?,
+            );
+        }
+        if let Some(text) = &self.gnss_columns {
+            if gnss.is_some() {
+                return Err(CliError::bad(
+                    "--gnss-columns: the profile has a [gnss] map too: give one",
+                ));
+            }
+            gnss = Some(
+                GnssColumns::parse(text, MapOrigin::Option("--gnss-columns".into()))
+                    .map_err(bad)?,
+            );
+        }
+        if let Some(w) = self.gps_week {
+            if imu.is_none() && gnss.is_none() {
+                return Err(CliError::bad(
+                    "--gps-week applies to files read through a column map (--imu-columns, --gnss-columns or --profile)",
+                ));
+            }
+            if let Some(c) = imu.as_mut() {
+                c.gps_week = Some(w);
+            }
+            if let Some(c) = gnss.as_mut() {
+                c.gps_week = Some(w);
+            }
+        }
+        let need_gnss = |opt: &str| {
+            CliError::bad(format!(
+                "{opt} applies to a GNSS file read through a column map (--gnss-columns or a profile's [gnss])"
+            ))
+        };
+        if let Some(s) = &self.gnss_sigma {
+            let c = gnss.as_mut().ok_or_else(|| need_gnss("--gnss-sigma"))?;
+            c.sigma = Some(GnssSigma::parse(s).map_err(|e| CliError::bad(format!("--gnss-sigma: {e}")))?);
+        }
+        if let Some(n) = self.undulation_m {
+            let c = gnss.as_mut().ok_or_else(|| need_gnss("--undulation-m"))?;
+            c.undulation_m = Some(n);
+        }
+        Ok((imu, gnss))
+    }
+}

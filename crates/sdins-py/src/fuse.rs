@@ -331,6 +331,7 @@ pub fn fuse_files<'py>(
         init,
         truth,
         check_after_s: 30.0,
+        columns: Default::default(),
     };
     let opts = RecordOptions {
         algo,

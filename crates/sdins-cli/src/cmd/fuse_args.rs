@@ -93,6 +93,9 @@ pub struct Args {
     /// print the summary as JSON
     #[arg(long)]
     pub json: bool,
+    /// column maps of one's own files
+    #[command(flatten)]
+    pub columns: crate::args::ColumnsArgs,
 }
 
 /// `--scale-factors-ppm ACCEL,GYRO`: prior σ of the scale-factor states, in (0, 1e5] ppm.

@@ -9,7 +9,9 @@ use crate::error::CliError;
 use crate::output::AtomicFile;
 use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
 use sdins_core::nav::AlgorithmSpec;
-use sdins_sim::fusion::files::{fuse_files, FilesError, FilesInput, InitSource, SensorModelSource};
+use sdins_sim::fusion::files::{
+    fuse_files, FilesError, FilesInput, InitSource, InputColumns, SensorModelSource,
+};
 use sdins_sim::fusion::records::{RecordEvent, RecordOptions, RecordPoint, COMPARISON_AXES};
 use sdins_sim::fusion::simulated::FuseError;
 use sdins_sim::io::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
@@ -99,6 +101,17 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         ));
     }
     let imu_format: ImuFormat = args.imu_format.parse().map_err(CliError::bad)?;
+    let (imu_columns, gnss_columns) = args.columns.resolve()?;
+    if imu_columns.is_some() && args.imu_format != "auto" {
+        return Err(CliError::bad(
+            "--imu-format: the IMU file is read through a column map (--imu-columns or the profile): give one",
+        ));
+    }
+    if gnss_columns.is_some() && args.gnss_format != "auto" {
+        return Err(CliError::bad(
+            "--gnss-format: the GNSS file is read through a column map (--gnss-columns or the profile): give one",
+        ));
+    }
     let gnss_format: GnssFormat = args.gnss_format.parse().map_err(CliError::bad)?;
     let samples = args.samples.unwrap_or(2);
     if !(1..=4).contains(&samples) {
@@ -149,6 +162,10 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         init,
         truth: args.truth.clone(),
         check_after_s: 30.0,
+        columns: InputColumns {
+            imu: imu_columns,
+            gnss: gnss_columns,
+        },
     };
     let opts = RecordOptions {
         algo,
@@ -311,6 +328,13 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
     fields.insert("cov_rate_hz".into(), args.cov_rate_hz.into());
     fields.insert("gate".into(), (!args.no_gate).into());
     fields.insert("smooth".into(), args.smooth.into());
+    if !r.inputs.is_empty() {
+        let mut t = toml::Table::new();
+        for rep in &r.inputs {
+            t.insert(rep.kind.to_string(), rep.to_toml().into());
+        }
+        fields.insert("inputs".into(), t.into());
+    }
     let rm = |c: &Option<sdins_sim::fusion::records::TruthComparison>, name: &str| {
         c.as_ref().map(|c| {
             let v = c.rmse();
@@ -368,6 +392,9 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
         )?;
     }
     crate::report::write_run_toml(&out, fields)?;
+    for rep in &r.inputs {
+        eprintln!("{}", rep.summary());
+    }
     for w in &r.imu_warnings {
         eprintln!("warning: {}: {w}", imu.display());
     }

@@ -14,7 +14,12 @@ use crate::io::gnss_file::{
     clip_to_imu_span, imu_span_s, read_gnss_file, to_imu_time, GnssFileError, GnssFormat,
     GnssReadOptions, GnssReadReport, ImuClock,
 };
+use crate::io::columns::ColumnsError;
+use crate::io::gnss_columns::{read_gnss_columns, GnssColumns};
+use crate::io::gnss_file::TimeBase;
+use crate::io::imu_columns::{read_imu_columns, ImuColumns, InputReport};
 use crate::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
+use crate::io::time::{ClockScale, RunClock};
 use crate::io::navego_params::{read_navego_imu_params, NavegoImuParams, ParamsError};
 use crate::io::truth_file::{read_truth, TruthFileError};
 use crate::sensors::imu_error::ImuErrorModel;
@@ -125,6 +130,17 @@ pub struct FilesInput {
     /// compare with the reference after this many seconds from the navigation start
     /// (the ±3σ fractions) \[s\]
     pub check_after_s: f64,
+    /// column maps of the IMU and GNSS files (each `None`: the file's fixed format)
+    pub columns: InputColumns,
+}
+
+/// Column maps of a fused run's files (`crate::io::columns`; docs/own-data.md).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InputColumns {
+    /// the IMU file's map (its format is then ignored)
+    pub imu: Option<ImuColumns>,
+    /// the GNSS file's map (its format is then ignored)
+    pub gnss: Option<GnssColumns>,
 }
 
 /// Why a fused run on files failed.
@@ -143,6 +159,9 @@ pub enum FilesError {
     /// the reference trajectory
     #[error(transparent)]
     Truth(#[from] TruthFileError),
+    /// a column map or a file read through one
+    #[error(transparent)]
+    Columns(#[from] ColumnsError),
     /// the filter or an option
     #[error(transparent)]
     Fuse(#[from] FuseError),
@@ -174,6 +193,8 @@ pub struct FilesResult {
     pub forward: Option<TruthComparison>,
     /// comparison of the smoothed solution with the reference
     pub smoothed: Option<TruthComparison>,
+    /// what the column maps did (time base, clock origin, offsets), IMU first
+    pub inputs: Vec<InputReport>,
 }
 
 /// Run it; `observe` sees every forward and smoothed point and every update, with the
@@ -185,8 +206,53 @@ pub fn fuse_files(
     cancel: &CancelToken,
     mut observe: impl FnMut(RecordEvent<'_>, Option<&[f64; 9]>),
 ) -> Result<FilesResult, FilesError> {
-    let imu = read_imu_file(&input.imu.0, input.imu.1)?;
-    let gnss = read_gnss_file(&input.gnss.0, input.gnss.1, &input.gnss_options)?;
+    let mut inputs = Vec::new();
+    let imu = match &input.columns.imu {
+        Some(c) => {
+            let d = read_imu_columns(&input.imu.0, c, None)?;
+            if d.segments.len() > 1 {
+                return Err(ColumnsError::Data {
+                    file: input.imu.0.clone(),
+                    line: 1,
+                    field: "(time)".into(),
+                    message: format!(
+                        "the record has {} segments split at gaps: fuse runs on one continuous record (cut the file at the gap)",
+                        d.segments.len()
+                    ),
+                }
+                .into());
+            }
+            inputs.push(d.report);
+            d.data
+        }
+        None => read_imu_file(&input.imu.0, input.imu.1)?,
+    };
+    let gnss = match &input.columns.gnss {
+        Some(c) => {
+            // on the IMU map's clock; alone, on its own scale from origin 0 (GPS seconds
+            // since the epoch or of week), which the fixed IMU formats' clocks understand
+            let alone = |scale| RunClock { scale, origin_s: 0 };
+            let (clock, base) = match inputs.first() {
+                Some(r) => (r.clock, TimeBase::FileSeconds),
+                None => match c.map.time.unwrap_or_default() {
+                    crate::io::columns::TimeKind::Relative => {
+                        (alone(ClockScale::File), TimeBase::FileSeconds)
+                    }
+                    crate::io::columns::TimeKind::GpsSow
+                        if c.gps_week.is_none() && c.map.get("week").is_none() =>
+                    {
+                        (alone(ClockScale::GpsWeekUnknown), TimeBase::GpsSecondsOfWeek)
+                    }
+                    _ => (alone(ClockScale::Gpst), TimeBase::GpsSecondsSinceEpoch),
+                },
+            };
+            let (mut d, rep) = read_gnss_columns(&input.gnss.0, c, Some(&clock))?;
+            d.time_base = base;
+            inputs.push(rep);
+            d
+        }
+        None => read_gnss_file(&input.gnss.0, input.gnss.1, &input.gnss_options)?,
+    };
     let on_imu = to_imu_time(&input.gnss.0, &gnss, input.clock)?;
     let (first, last) = imu_span_s(&imu);
     let clip = clip_to_imu_span(&input.gnss.0, &on_imu, first, last)?;
@@ -261,5 +327,6 @@ pub fn fuse_files(
         fixes_outside: (clip.before, clip.after),
         forward: fwd,
         smoothed: smo,
+        inputs,
     })
 }

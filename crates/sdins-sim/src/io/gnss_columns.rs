@@ -327,6 +327,7 @@ pub fn parse_gnss_columns(
         &TimeSpec {
             kind: m.time.unwrap_or_default(),
             gps_week: cols.gps_week,
+            week_column: m.get("week").is_some(),
             offset_s: cols.offset_s,
         },
         clock,

@@ -63,6 +63,7 @@ impl ImuColumns {
         TimeSpec {
             kind: self.map.time.unwrap_or_default(),
             gps_week: self.gps_week,
+            week_column: self.map.get("week").is_some(),
             offset_s: self.offset_s,
         }
     }

@@ -167,6 +167,7 @@ pub fn parse_generic_on(
     let spec = TimeSpec {
         kind: m.time.unwrap_or_default(),
         gps_week: cm.gps_week,
+        week_column: wi.is_some(),
         offset_s: cm.offset_s,
     };
     let mut conv = TimeConverter::new(&spec, clock).map_err(|e| ColumnsError::map(&m.origin, e))?;

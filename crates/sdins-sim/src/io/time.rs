@@ -61,6 +61,8 @@ pub struct TimeSpec {
     pub kind: TimeKind,
     /// GPS week of a seconds-of-week file without week column
     pub gps_week: Option<u32>,
+    /// the file has a GPS week column (the week is then known row by row)
+    pub week_column: bool,
     /// constant added to every time \[s\] (the file's clock error: t_gpst = t_file + offset)
     pub offset_s: f64,
 }
@@ -162,7 +164,9 @@ impl TimeConverter {
         }
         let scale = match spec.kind {
             TimeKind::Relative => ClockScale::File,
-            TimeKind::GpsSow if spec.gps_week.is_none() => ClockScale::GpsWeekUnknown,
+            TimeKind::GpsSow if spec.gps_week.is_none() && !spec.week_column => {
+                ClockScale::GpsWeekUnknown
+            }
             TimeKind::GpsSow | TimeKind::Unix => ClockScale::Gpst,
         };
         if let Some(c) = clock {
@@ -336,7 +340,7 @@ mod tests {
     fn seconds_of_week_roll_over_and_weeks_count() {
         let spec = TimeSpec {
             kind: TimeKind::GpsSow,
-            gps_week: Some(2000),
+            gps_week: Some(2000), week_column: false,
             offset_s: 0.0,
         };
         let mut c = TimeConverter::new(&spec, None).unwrap();

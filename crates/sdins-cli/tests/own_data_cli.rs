@@ -1,0 +1,223 @@
+//! `sdins fuse` on one's own files through column maps (docs/own-data.md): the worked
+//! example of the docs, run on a logger layout written from an `sdins truth` record,
+//! equals the run on sdins's own files to round-off; bad maps exit 2 naming the option.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const SCN: &str = "name = \"own-data\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nspeed_mps = 10.0\n[imu]\nrate_hz = 100.0\ngrade = \"tactical\"\n[nav]\nsamples = 2\n[[segment]]\ntype = \"turn\"\nrate_dps = 3.0\nduration_s = 30.0\n";
+
+const INIT: &str = "37.5,127,0,10,0,0,0,0,0";
+
+/// The first ```toml block of docs/own-data.md: the worked example's profile.
+fn doc_profile() -> String {
+    let doc = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/own-data.md"),
+    )
+    .unwrap();
+    let start = doc.find("```toml\n").unwrap() + "```toml\n".len();
+    let end = start + doc[start..].find("```").unwrap();
+    doc[start..end].to_string()
+}
+
+struct Files {
+    dir: PathBuf,
+    imu: PathBuf,
+    gnss: PathBuf,
+    truth: PathBuf,
+    imu_txt: PathBuf,
+    gnss_own: PathBuf,
+}
+
+/// An `sdins truth` record, its fixes as an sdins GNSS CSV (σ 1, 1, 2 m) and the same
+/// data in the logger's layout: increments in degrees and m/s on RFU axes, milliseconds,
+/// whitespace, reordered columns; GNSS heights above mean sea level (N = 30 m), no σ.
+fn files(tag: &str) -> Files {
+    let dir = std::env::temp_dir().join(format!("sdins-own-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scn = dir.join("s.toml");
+    std::fs::write(&scn, SCN).unwrap();
+    let rec = dir.join("rec");
+    let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args(["truth", scn.to_str().unwrap(), "--out", rec.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let truth = std::fs::read_to_string(rec.join("truth.csv")).unwrap();
+    let mut g = String::from("t_s,lat_deg,lon_deg,h_m,sigma_n_m,sigma_e_m,sigma_d_m\n");
+    let mut own = String::from("time,latitude,longitude,alt\n");
+    for l in truth.lines().skip(1) {
+        let f: Vec<&str> = l.split(',').collect();
+        let t: f64 = f[0].parse().unwrap();
+        if t > 0.0 && (t * 2.0 - (t * 2.0).round()).abs() < 1e-9 {
+            g.push_str(&format!("{},{},{},{},1,1,2\n", f[0], f[1], f[2], f[3]));
+            let h: f64 = f[3].parse().unwrap();
+            own.push_str(&format!("{},{},{},{}\n", f[0], f[1], f[2], h - 30.0));
+        }
+    }
+    let gnss = dir.join("g.csv");
+    std::fs::write(&gnss, &g).unwrap();
+    let gnss_own = dir.join("gnss.csv");
+    std::fs::write(&gnss_own, &own).unwrap();
+    let imu = rec.join("imu.csv");
+    let text = std::fs::read_to_string(&imu).unwrap();
+    let mut out = String::from("# logger v1\nfx fy fz stamp wz wy wx\n");
+    for l in text.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        // FRD body → RFU sensor: s = (b_y, b_x, −b_z)
+        let (dth, dv) = ([v[1], v[2], v[3]], [v[4], v[5], v[6]]);
+        let ws = [dth[1], dth[0], -dth[2]].map(f64::to_degrees);
+        let fs = [dv[1], dv[0], -dv[2]];
+        let ms = (v[0] * 1000.0).round() as i64;
+        out.push_str(&format!(
+            "{} {} {}   {ms} {} {} {}\n",
+            fs[0], fs[1], fs[2], ws[2], ws[1], ws[0]
+        ));
+    }
+    let imu_txt = dir.join("imu.txt");
+    std::fs::write(&imu_txt, out).unwrap();
+    Files {
+        truth: rec.join("truth.csv"),
+        dir,
+        imu,
+        gnss,
+        imu_txt,
+        gnss_own,
+    }
+}
+
+fn fuse(f: &Files, imu: &Path, gnss: &Path, out: &str, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args(["fuse", "--imu"])
+        .arg(imu)
+        .arg("--gnss")
+        .arg(gnss)
+        .args(["--grade", "tactical", "--init", INIT, "--json", "--out"])
+        .arg(f.dir.join(out))
+        .arg("--truth")
+        .arg(&f.truth)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn rmse(o: &Output) -> Vec<f64> {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    ["roll", "pitch", "yaw", "vN", "vE", "vD", "N", "E", "D"]
+        .iter()
+        .map(|k| {
+            j["forward_vs_truth"]
+                .as_object()
+                .unwrap()
+                .iter()
+                .find(|(name, _)| name.as_str() == *k)
+                .map_or_else(
+                    || panic!("{k} in {}", j["forward_vs_truth"]),
+                    |(_, v)| v["rmse"].as_f64().unwrap(),
+                )
+        })
+        .collect()
+}
+
+#[test]
+fn worked_example_matches_sdins_files() {
+    let f = files("ex");
+    let want = rmse(&fuse(&f, &f.imu, &f.gnss, "canonical", &[]));
+    let profile = f.dir.join("logger.toml");
+    std::fs::write(&profile, doc_profile()).unwrap();
+    let o = fuse(
+        &f,
+        &f.imu_txt,
+        &f.gnss_own,
+        "profile",
+        &["--profile", profile.to_str().unwrap()],
+    );
+    let got = rmse(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("imu: 3000 rows, time relative"), "{err}");
+    let run = std::fs::read_to_string(f.dir.join("profile/run.toml")).unwrap();
+    assert!(run.contains("[inputs.imu]") && run.contains("[inputs.gnss]"), "{run}");
+    // the same maps on the command line
+    let imu_map = "t_ms=stamp,gyro_x_deg_inc=wx,gyro_y_deg_inc=wy,gyro_z_deg_inc=wz,accel_x_mps_inc=fx,accel_y_mps_inc=fy,accel_z_mps_inc=fz,axes=x:+y,y:+x,z:-z";
+    let gnss_map = "t_s=time,lat_deg=latitude,lon_deg=longitude,alt_msl_m=alt";
+    let args = [
+        "--imu-columns",
+        imu_map,
+        "--gnss-columns",
+        gnss_map,
+        "--undulation-m",
+        "30",
+        "--gnss-sigma",
+        "1,1,2",
+    ];
+    let cli = rmse(&fuse(&f, &f.imu_txt, &f.gnss_own, "cli", &args));
+    for i in 0..9 {
+        let rel = |a: f64| (a - want[i]).abs() / want[i].abs().max(1e-12);
+        println!("{i}: {} {} {}", want[i], got[i], cli[i]);
+        assert!(rel(got[i]) < 1e-9, "{i}: {} vs {}", got[i], want[i]);
+        assert!(rel(cli[i]) < 1e-9, "{i}: {} vs {}", cli[i], want[i]);
+    }
+    std::fs::remove_dir_all(&f.dir).ok();
+}
+
+#[test]
+fn bad_maps_exit_2_naming_the_option() {
+    let f = files("bad");
+    let imu_map = "t_ms=stamp,gyro_x_deg_inc=wx,gyro_y_deg_inc=wy,gyro_z_deg_inc=wz,accel_x_mps_inc=fx,accel_y_mps_inc=fy,accel_z_mps_inc=fz";
+    let gnss_ok = "t_s=time,lat_deg=latitude,lon_deg=longitude,alt_msl_m=alt";
+    let reflect = format!("{imu_map},axes=x:+y,y:+x,z:+z");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["--imu-columns", &reflect, "--gnss-columns", gnss_ok, "--undulation-m", "30", "--gnss-sigma", "1,1,2"],
+            "--imu-columns",
+        ),
+        (
+            vec!["--imu-columns", imu_map, "--gnss-columns", gnss_ok, "--gnss-sigma", "1,1,2"],
+            "--gnss-columns",
+        ),
+        (
+            vec!["--imu-columns", imu_map, "--gnss-columns", gnss_ok, "--undulation-m", "30"],
+            "--gnss-sigma",
+        ),
+        (
+            vec!["--imu-columns", "t_ms=stamp,gyro_x_dps=nope", "--gnss-columns", gnss_ok],
+            "--imu-columns",
+        ),
+        (
+            vec!["--imu-columns", imu_map, "--gnss-columns", gnss_ok, "--undulation-m", "30", "--gnss-sigma", "1,1"],
+            "--gnss-sigma",
+        ),
+        (vec!["--gnss-sigma", "1,1,2"], "--gnss-sigma"),
+    ];
+    let want_words = ["reflection", "undulation", "--gnss-sigma", "missing", "3 or 6", "column map"];
+    for ((args, option), word) in cases.iter().zip(want_words) {
+        let o = fuse(&f, &f.imu_txt, &f.gnss_own, "bad", args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(option) && err.contains(word), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // a bad row is located: file, line, column
+    let text = std::fs::read_to_string(&f.imu_txt).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines[9] = {
+        let mut v: Vec<&str> = lines[9].split_whitespace().collect();
+        v[0] = "oops";
+        v.join(" ")
+    };
+    let bad = f.dir.join("bad.txt");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    let o = fuse(
+        &f,
+        &bad,
+        &f.gnss_own,
+        "bad",
+        &["--imu-columns", imu_map, "--gnss-columns", gnss_ok, "--undulation-m", "30", "--gnss-sigma", "1,1,2"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("bad.txt:10: accel_x_mps_inc: `oops` is not a number"), "{err}");
+    std::fs::remove_dir_all(&f.dir).ok();
+}
