@@ -15,7 +15,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import _sdins
+from . import _sdins as _raw
 from ._results import (
     AlgorithmRun,
     AlignResult,
@@ -29,9 +29,50 @@ from ._results import (
     RunResult,
     Truth,
 )
-from ._sdins import McState, Scenario, SdinsError
+from ._sdins import FuseMcState, McState, Scenario, SdinsError
 
-__version__: str = _sdins.__version__
+__version__: str = _raw.__version__
+
+_U64_MAX = 2**64 - 1
+
+
+def _overflow_message(f: Any, name: str, args: tuple, kwargs: dict) -> str:
+    """Name the integer argument PyO3 could not convert (negative, or above u64)."""
+    import inspect
+
+    try:
+        bound = inspect.signature(f).bind(*args, **kwargs).arguments
+    except (TypeError, ValueError):
+        bound = {}
+    for arg, v in bound.items():
+        for x in v if isinstance(v, tuple) else (v,):
+            if isinstance(x, int) and not isinstance(x, bool) and not 0 <= x <= _U64_MAX:
+                return f"{arg} = {x}: expected a whole number in 0..={_U64_MAX}"
+    return f"{name}: an integer argument is negative or too large"
+
+
+class _Checked:
+    """``_sdins`` with PyO3's OverflowError (a negative ``seed``, ``runs``, …) raised as
+    :class:`SdinsError` naming the argument, like every other bad value."""
+
+    def __init__(self, mod: Any) -> None:
+        self._mod = mod
+
+    def __getattr__(self, name: str) -> Any:
+        f = getattr(self._mod, name)
+        if isinstance(f, type) or not callable(f):
+            return f
+
+        def call(*args: Any, **kwargs: Any) -> Any:
+            try:
+                return f(*args, **kwargs)
+            except OverflowError:
+                raise SdinsError(_overflow_message(f, name, args, kwargs)) from None
+
+        return call
+
+
+_sdins = _Checked(_raw)
 
 
 def __dir__() -> List[str]:
@@ -40,6 +81,9 @@ def __dir__() -> List[str]:
 
 __all__ = [
     "fuse_files",
+    "fuse_montecarlo",
+    "fuse_merge",
+    "FuseMcState",
     "SdinsError",
     "Scenario",
     "McState",
@@ -64,6 +108,7 @@ __all__ = [
     "ErrorAnalysis",
     "FuseResult",
     "align",
+    "calibrate",
     "errors",
     "fuse",
     "schuler_share",
@@ -324,6 +369,36 @@ def errors(
     return ErrorAnalysis(_sdins.errors(grade, g, a, hours, lat_deg, nonlinear))
 
 
+def calibrate(
+    scenario: Union[Scenario, str],
+    imu: Optional[Any] = None,
+    imu_format: Optional[str] = None,
+    run: Optional[int] = None,
+    runs: Optional[int] = None,
+    draw_scale_ppm: Optional[Tuple[float, float]] = None,
+    draw_misalignment_mrad: Optional[Tuple[float, float]] = None,
+    draw: Optional[bool] = None,
+) -> Dict[str, Any]:
+    """Turntable calibration (``sdins calibrate``) of the scenario's schedule: on its
+    simulated IMU (run ``run``, default 0; ``runs`` > 1: a Monte Carlo over runs 0..runs)
+    or on a recorded IMU file ``imu`` (``imu_format``: auto (default), sdins, psins, …).
+
+    ``draw_scale_ppm`` / ``draw_misalignment_mrad``: the (lo, hi) magnitudes of the drawn
+    scale factors and misalignments (default (100, 1000) ppm, (0.1, 1) mrad); ``draw=False``
+    keeps the scenario's own. Returns the ``sdins calibrate --json`` summary as a dict
+    (parameters with estimate, 1σ and truth; NEES; the Monte Carlo summary).
+    """
+    import json
+
+    t = _sdins.calibrate(
+        _scenario(scenario), None if imu is None else str(imu), imu_format, run, runs,
+        None if draw_scale_ppm is None else (float(draw_scale_ppm[0]), float(draw_scale_ppm[1])),
+        None if draw_misalignment_mrad is None else (float(draw_misalignment_mrad[0]), float(draw_misalignment_mrad[1])),
+        draw,
+    )
+    return json.loads(t)
+
+
 def schuler_share() -> List[Dict[str, Any]]:
     """The Schuler-share table (``sdins errors --schuler-share``, reconstruction of
     [P2] Table 1) as a list of dicts (grade, accel_bias_ug, gyro_bias_dph, share_pct)."""
@@ -346,30 +421,85 @@ def fuse(
     smooth: Optional[bool] = None,
     in_motion: Optional[bool] = None,
     scale_factors_ppm: Optional[Tuple[float, float]] = None,
+    grade: Optional[str] = None,
+    every_s: Optional[float] = None,
+    max_latency_s: Optional[float] = None,
 ) -> FuseResult:
-    """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``); the scenario's
-    ``[gnss]`` table sets the receiver.
+    """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``, the same library
+    call); the scenario's ``[gnss]`` table sets the receiver.
 
-    Every parameter defaults to the library's ``FuseOptions::default()``: ``algo``
-    songlee-complete, ``samples`` the scenario's N (as the CLI), ``run`` 0 (IMU/GNSS/
-    initial-error streams), ``cov_rate_hz`` 10, ``gate`` True (χ² 99.9 % NIS gate),
-    ``exact_start`` False (initial errors drawn from P0), ``zupt_sigma_mps`` /
-    ``nhc_sigma_mps`` None (off), ``until_s`` None (whole scenario), ``smooth`` False
-    (True: the Rauch–Tung–Striebel smoother; ``result.smoothed`` then holds the smoothed
-    epochs with the same fields as the forward ones), ``in_motion`` False (True: in-motion
-    alignment from an unknown heading, started at the first fix at ≥ 5 m/s),
-    ``scale_factors_ppm`` None (15 states; ``(accel_ppm, gyro_ppm)``: the 21-state filter
-    that also estimates the accelerometer and gyro scale factors with that prior σ per
-    axis; the result then has ``scale_factor_error`` / ``scale_factor_sigma`` (n × 6,
-    dimensionless, accel x y z then gyro x y z) and the ``accel_scale_est`` /
-    ``accel_scale_true`` / ``gyro_scale_est`` / ``gyro_scale_true`` summaries).
+    Every parameter defaults to the library's: ``algo`` songlee-complete, ``samples`` the
+    scenario's N (as the CLI), ``run`` 0 (IMU/GNSS/initial-error streams), ``cov_rate_hz``
+    10, ``gate`` True (χ² 99.9 % NIS gate), ``exact_start`` False (initial errors drawn
+    from P0), ``zupt_sigma_mps`` / ``nhc_sigma_mps`` None (off), ``until_s`` None (whole
+    scenario), ``smooth`` False (True: the Rauch–Tung–Striebel smoother; ``result.smoothed``
+    then holds the smoothed rows with the same fields as the forward ones), ``in_motion``
+    False (True: in-motion alignment from an unknown heading, started at the first fix at
+    ≥ 5 m/s), ``scale_factors_ppm`` None (15 states; ``(accel_ppm, gyro_ppm)``: the
+    layout with the accelerometer and gyro scale factors, prior σ per axis; the result
+    then has ``scale_factor_error`` / ``scale_factor_sigma`` (n × 6, dimensionless, accel
+    x y z then gyro x y z) and the ``accel_scale_est`` / ``accel_scale_true`` /
+    ``gyro_scale_est`` / ``gyro_scale_true`` summaries), ``grade`` None (an IMU grade
+    preset replacing the scenario's error model: the simulated IMU errors and the
+    filter's model), ``every_s`` None (output rows at the updates nearest to k·every_s;
+    default the covariance interval), ``max_latency_s`` None (1 s: older measurements are
+    refused and counted in ``late``).
     """
     return FuseResult(
         _sdins.fuse(
             _scenario(scenario), algo, samples, run, cov_rate_hz, gate, exact_start,
             zupt_sigma_mps, nhc_sigma_mps, until_s, smooth, in_motion, scale_factors_ppm,
+            grade, every_s, max_latency_s,
         )
     )
+
+
+def fuse_montecarlo(
+    scenario: Union[Scenario, str],
+    runs: int,
+    seed: Optional[int] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    block: Optional[int] = None,
+    threads: Optional[int] = None,
+    draw_scale_factors: Optional[bool] = None,
+    algo: Optional[str] = None,
+    samples: Optional[int] = None,
+    cov_rate_hz: Optional[float] = None,
+    gate: Optional[bool] = None,
+    exact_start: Optional[bool] = None,
+    zupt_sigma_mps: Optional[float] = None,
+    nhc_sigma_mps: Optional[float] = None,
+    until_s: Optional[float] = None,
+    scale_factors_ppm: Optional[Tuple[float, float]] = None,
+    grade: Optional[str] = None,
+    every_s: Optional[float] = None,
+    max_latency_s: Optional[float] = None,
+) -> FuseMcState:
+    """Shard ``shard = (i, n)`` (default: the whole job) of the Monte Carlo of the filter on
+    a scenario (``sdins fuse SCENARIO --runs N --seed S --shard i/n``): per output epoch the
+    mergeable moments of the NEES of every state block with a known truth and of the NIS
+    of every measurement kind. ``seed`` (default the scenario's ``[imu] seed``) replaces
+    the IMU and GNSS seeds; ``block`` runs per block (default 16, equal in every shard);
+    ``threads`` (default: rayon's pool); ``draw_scale_factors`` draws each run's true
+    scale factors from the prior of ``scale_factors_ppm``; the filter options as in
+    :func:`fuse` (use ``gate=False`` for consistency). Returns a picklable
+    :class:`FuseMcState` (``.statistics()``, ``.consistency(column, after_s=30)``); merge
+    shards with :func:`fuse_merge` in any order: the statistics equal a single run's bit
+    for bit, for any thread count.
+    """
+    return _sdins.fuse_montecarlo(
+        _scenario(scenario), runs, seed,
+        None if shard is None else (int(shard[0]), int(shard[1])),
+        block, threads, draw_scale_factors, algo, samples, cov_rate_hz, gate, exact_start,
+        zupt_sigma_mps, nhc_sigma_mps, until_s, scale_factors_ppm, grade, every_s,
+        max_latency_s,
+    )
+
+
+def fuse_merge(states: Iterable[FuseMcState], allow_partial: Optional[bool] = None) -> FuseMcState:
+    """Merge fusion Monte Carlo shard states exactly, in any order (``sdins fuse --merge``).
+    Missing blocks are an error unless ``allow_partial=True``."""
+    return _sdins.fuse_merge(list(states), allow_partial)
 
 
 def fuse_files(
@@ -393,6 +523,8 @@ def fuse_files(
     nhc_sigma_mps: Optional[float] = None,
     gnss_offset_s: Optional[float] = None,
     scale_factors_ppm: Optional[Tuple[float, float]] = None,
+    every_s: Optional[float] = None,
+    max_latency_s: Optional[float] = None,
 ) -> Dict[str, Any]:
     """INS/GNSS filter (and smoother) on recorded files (``sdins fuse --imu --gnss``).
 
@@ -409,8 +541,8 @@ def fuse_files(
     (n, 6: accelerometer [m/s²], gyro [rad/s]), ``scale_factor`` and
     ``sigma_scale_factor`` (n, 6: accelerometer then gyro, dimensionless; zero unless
     ``scale_factors_ppm = (accel_ppm, gyro_ppm)`` selects the 21-state filter with that
-    prior σ); ``innovations`` (t_s, nis, dof,
-    accepted); ``fixes_used``, ``rejected``, ``fixes_outside`` (before, after),
+    prior σ); ``innovations`` (t_s, t_valid_s, kind, dof, nis, accepted, forced, late,
+    innovation (m, 12)); ``fixes_used``, ``rejected``, ``late``, ``fixes_outside`` (before, after),
     ``imu_samples``; with ``truth``: ``forward_rmse`` / ``smoothed_rmse`` (roll, pitch,
     yaw [rad], v N, E, D [m/s], N, E, D [m]) and their ``*_inside_3sigma`` fractions.
     """
@@ -421,5 +553,5 @@ def fuse_files(
         static_s,
         None if lever_arm_m is None else [float(x) for x in lever_arm_m],
         truth, smooth, algo, samples, cov_rate_hz, gate, nhc_sigma_mps, gnss_offset_s,
-        scale_factors_ppm,
+        scale_factors_ppm, every_s, max_latency_s,
     )

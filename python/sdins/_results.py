@@ -349,7 +349,8 @@ class ErrorAnalysis:
 
 
 class FuseResult:
-    """INS/GNSS filter run (``sdins.fuse``). Per covariance epoch: ``t_s`` (n,);
+    """INS/GNSS filter run (``sdins.fuse``). Per output row (by default every covariance
+    epoch, the initial state first): ``t_s`` (n,);
     ``error`` (n, 15) true error in state coordinates (δL, δλ [rad], δh [m], δv NED
     [m/s], φ NED [rad], accelerometer bias [m/s²], gyro bias [rad/s]); ``pos_error_ned_m``
     (n, 3) position error in metres NED, ``vel_error_ned_mps`` (n, 3) [m/s] and
@@ -357,9 +358,9 @@ class FuseResult:
     (the CLI's nav.csv); ``sigma`` (n, 15) filter 1σ in user units
     (position in metres NED, the rest as ``error``); ``nees`` (n, 3) NEES of the
     position, velocity and attitude blocks (3 dof each). ``innovations``: dict of arrays
-    per measurement update: ``t_s``, ``kind`` (gnss, zupt, nhc), ``dof``, ``nis``,
-    ``accepted``, ``forced``, ``innovation`` (m, 6; first ``dof`` used). Summary:
-    ``fixes``, ``rejected``, ``nav_updates``, ``accel_bias_est_mps2``,
+    per measurement update: ``t_s``, ``t_valid_s``, ``kind`` (gnss, zupt, nhc), ``dof``,
+    ``nis``, ``accepted``, ``forced``, ``late``, ``innovation`` (m, 12; first ``dof`` used).
+    Summary: ``fixes``, ``rejected``, ``late``, ``nav_updates``, ``accel_bias_est_mps2``,
     ``accel_bias_true_mps2``, ``gyro_bias_est_rps``, ``gyro_bias_true_rps``, ``samples``,
     ``run``. With ``scale_factors_ppm`` (the 21-state filter) also
     ``scale_factor_error`` / ``scale_factor_sigma`` (n, 6; true error ``s − ŝ`` and 1σ,
@@ -378,11 +379,13 @@ class FuseResult:
         inn = d["innovations"]
         self.innovations: Dict[str, Any] = {
             "t_s": inn["t_s"],
+            "t_valid_s": inn["t_valid_s"],
             "kind": np.array(inn["kind"]),
             "dof": np.asarray(inn["dof"], dtype=np.int64),
             "nis": inn["nis"],
             "accepted": np.asarray(inn["accepted"], dtype=bool),
             "forced": np.asarray(inn["forced"], dtype=bool),
+            "late": np.asarray(inn["late"], dtype=bool),
             "innovation": inn["innovation"],
         }
         self.smoothed: Optional[Dict[str, Any]] = d.get("smoothed")
@@ -391,7 +394,7 @@ class FuseResult:
         for k in ("accel_scale_est", "accel_scale_true", "gyro_scale_est", "gyro_scale_true"):
             setattr(self, k, d.get(k))
         for k in (
-            "fixes", "rejected", "nav_updates", "accel_bias_est_mps2", "accel_bias_true_mps2",
+            "fixes", "rejected", "late", "nav_updates", "accel_bias_est_mps2", "accel_bias_true_mps2",
             "gyro_bias_est_rps", "gyro_bias_true_rps", "samples", "run",
         ):
             setattr(self, k, d[k])

@@ -195,3 +195,52 @@ def test_fuse_scale_factors_equal_cli(cli, tmp_path):
     assert [x * 1e6 for x in r.accel_scale_true] == js["accel_scale_true_ppm"]
     # without the option: no scale-factor states
     assert sdins.fuse("dq-paper", until_s=5.0).scale_factor_error is None
+
+
+def test_fuse_grade_equals_cli(cli, tmp_path):
+    # --grade on a scenario: the simulated IMU errors and the filter's model
+    code, out, err = cli(
+        "fuse", "dq-paper", "--grade", "consumer", "--json", "--until-s", "20",
+        "--out", str(tmp_path / "g"),
+    )
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.fuse("dq-paper", grade="consumer", until_s=20.0)
+    assert js["grade"] == "consumer"
+    for k in ("accel_bias_est_mps2", "accel_bias_true_mps2", "gyro_bias_true_rps"):
+        assert r.__dict__[k] == js[k], k
+    assert r.rms()["rms_pos_ned_m"] == js["rms_pos_ned_m"]
+    # and it changes the run: the consumer grade's biases are 10x the default's
+    plain = sdins.fuse("dq-paper", until_s=20.0)
+    assert plain.accel_bias_true_mps2 != r.accel_bias_true_mps2
+    with pytest.raises(sdins.SdinsError, match="grade"):
+        sdins.fuse("dq-paper", grade="nope")
+
+
+def test_fuse_montecarlo_equals_cli(cli, tmp_path):
+    # two CLI shards merged by the CLI against Python shards merged in Python
+    kw = ["--grade", "tactical", "--no-gate", "--until-s", "15", "--runs", "6", "--seed", "3",
+          "--block", "2", "--quiet"]
+    for i in range(2):
+        code, _, err = cli("fuse", "dq-paper", *kw, "--shard", f"{i}/2",
+                           "--out", str(tmp_path / f"s{i}"))
+        assert code == 0, err
+    code, out, err = cli("fuse", "--merge", str(tmp_path / "s1"), str(tmp_path / "s0"),
+                         "--out", str(tmp_path / "m"), "--json")
+    assert code == 0, err
+    js = json.loads(out)
+    py = [
+        sdins.fuse_montecarlo("dq-paper", 6, seed=3, shard=(i, 2), block=2, grade="tactical",
+                              gate=False, until_s=15.0)
+        for i in (1, 0)
+    ]
+    merged = sdins.fuse_merge(py)
+    cli_state = sdins.FuseMcState.from_file(tmp_path / "m")
+    assert merged == cli_state
+    st = merged.statistics()
+    assert st["runs"] == 6 and st["complete"] and js["runs"] == 6
+    assert st["columns"][0] == "nees_position" and st["mean"].shape[1] == len(st["columns"])
+    c = merged.consistency("nees_position", after_s=5.0)
+    assert c["epochs"] > 0 and c["dof"] == 3
+    with pytest.raises(sdins.SdinsError, match="missing"):
+        sdins.fuse_merge(py[:1])

@@ -68,10 +68,14 @@ def test_navigate_equals_run_state_for_state():
     nav = sdins.navigate(t.dtheta_rad, t.dv_mps, t.dt_s, init, algo="songlee-complete", samples=3)
     run = sdins.run(scn, algos=["songlee-complete"], every_s=3 * t.dt_s, vertical="free", ideal=True)
     rn = run["songlee-complete"].nav
-    assert len(nav) == len(rn) == 5000
+    # run keeps the initial state as its first row (the epoch rule), navigate returns
+    # the state after every update
+    assert len(nav) == 5000 and len(rn) == 5001
+    assert rn.t_s[0] == 0.0
+    assert np.array_equal(nav.t_s, rn.t_s[1:])
     # init through degrees costs ≤ 1 ulp of the angles; the algorithm is the same
-    assert np.max(np.abs(nav.lat_rad - rn.lat_rad)) < 1e-15
-    assert np.max(np.abs(nav.v_ned_mps - rn.v_ned_mps)) < 1e-9
+    assert np.max(np.abs(nav.lat_rad - rn.lat_rad[1:])) < 1e-15
+    assert np.max(np.abs(nav.v_ned_mps - rn.v_ned_mps[1:])) < 1e-9
     # and the complete algorithm is exact to ~1e-10 rad on this case (README table)
     e = run["songlee-complete"].errors
     assert np.max(np.abs(e.att_err_rad)) < 1e-9
@@ -81,7 +85,7 @@ def test_run_defaults_are_the_scenarios():
     r = sdins.run("turn-90dps")
     assert list(r) == sdins.Scenario.builtin("turn-90dps").algos
     a = next(iter(r.values()))
-    assert a.nav_updates == 5000 and len(a.errors) == 30  # 1 s epochs over 30 s
+    assert a.nav_updates == 5000 and len(a.errors) == 31  # 0, 1, …, 30 s
     assert a.errors.t_s[-1] == pytest.approx(30.0)
 
 
@@ -201,3 +205,18 @@ def test_statistics_and_merge_return_one_type():
     b = sdins.merge([st])
     assert type(a) is type(b) is sdins.McStatistics
     assert a.sigma.tobytes() == b.sigma.tobytes()
+
+
+@pytest.mark.parametrize(
+    "call,arg",
+    [
+        (lambda: sdins.montecarlo("turn-90dps", -1), "runs = -1"),
+        (lambda: sdins.montecarlo("turn-90dps", 2, seed=-5, until_s=1.0), "seed = -5"),
+        (lambda: sdins.run("turn-90dps", run=2**64, until_s=1.0), "run = 18446744073709551616"),
+        (lambda: sdins.truth("turn-90dps", every=-2), "every = -2"),
+    ],
+)
+def test_out_of_range_integers_raise_sdins_error_naming_the_argument(call, arg):
+    # PyO3 raises OverflowError for a negative u64; the front end says which argument
+    with pytest.raises(sdins.SdinsError, match=arg.replace("+", r"\+")):
+        call()

@@ -119,3 +119,65 @@ def test_montecarlo_state_equals_cli(cli, tmp_path):
         f = js["final"][c]
         assert stats.mean[-1, k] == f["mean"] and stats.sigma[-1, k] == f["sigma"]
         assert stats.p95[-1, k] == f["p95"]
+
+
+# the unit constants of sdins_sim::sensors::imu_error, formed as there
+DEG = math.pi / 180.0
+DPH = DEG / 3600.0
+DPSH = DEG / 60.0
+UG = 1e-6 * 9.80665
+
+
+def test_allan_equals_cli_json_and_csv(cli, tmp_path):
+    """`sdins allan --json` and allan.csv against `sdins.read_imu` + `sdins.allan`."""
+    code, _, err = cli("truth", "turn-90dps", "--out", tmp_path / "t", "--quiet")
+    assert code == 0, err
+    code, out, err = cli("allan", "--imu", tmp_path / "t" / "imu.csv", "--json", "--out", tmp_path / "a")
+    assert code == 0, err
+    rec = sdins.read_imu(tmp_path / "t" / "imu.csv")
+    res = sdins.allan(rec.dtheta_rad, rec.dv_mps, rec.dt_s)
+    header, rows = read_csv(tmp_path / "a" / "allan.csv")
+    got = np.array(rows, dtype=float)
+    assert np.array_equal(got[:, 0], res.tau_s)
+    units = [DPH] * 3 + [UG] * 3
+    for k in range(6):
+        assert np.array_equal(got[:, 1 + k], res.adev[:, k] / units[k]), header[1 + k]
+    js = json.loads(out)
+    for k, ch in enumerate(js["channels"]):
+        white = res.fits[k]["white"]
+        if k < 3:
+            want = None if white is None else white / DPSH
+            assert ch["arw_dpsh"] == want, ch["name"]
+        else:
+            want = None if white is None else white / UG
+            assert ch["vrw_ugpsqrthz"] == want, ch["name"]
+
+
+def test_calibrate_equals_cli_json(cli):
+    code, out, err = cli("calibrate", "calibration", "--runs", "3", "--json")
+    assert code == 0, err
+    assert sdins.calibrate("calibration", runs=3) == json.loads(out)
+    code, out, err = cli("calibrate", "calibration", "--no-draw", "--run", "2", "--json")
+    assert code == 0, err
+    assert sdins.calibrate("calibration", draw=False, run=2) == json.loads(out)
+    with pytest.raises(sdins.SdinsError, match="draw_scale_ppm"):
+        sdins.calibrate("calibration", draw_scale_ppm=(10.0, 2e5))
+
+
+def test_merge_equals_cli_json(cli, tmp_path):
+    kw = dict(grade="tactical", block=2, every_s=0.5)
+    for i in range(2):
+        code, _, err = cli(
+            "montecarlo", "turn-90dps", "--runs", "6", "--seed", "5", "--grade", "tactical",
+            "--block", "2", "--every-s", "0.5", "--shard", f"{i}/2", "--quiet",
+            "--out", tmp_path / f"s{i}",
+        )
+        assert code == 0, err
+    code, out, err = cli("merge", tmp_path / "s0", tmp_path / "s1", "--json", "--quiet", "--out", tmp_path / "m")
+    assert code == 0, err
+    states = [sdins.montecarlo("turn-90dps", 6, 5, shard=(i, 2), **kw) for i in range(2)]
+    stats = sdins.merge(states)
+    js = json.loads(out)
+    for k, c in enumerate(stats.channels):
+        f = js["final"][c]
+        assert stats.mean[-1, k] == f["mean"] and stats.sigma[-1, k] == f["sigma"], c

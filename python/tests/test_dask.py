@@ -41,9 +41,31 @@ def test_shards_on_a_local_cluster_merge_bit_for_bit():
     assert np.all(merged.sigma[-1, horizontal] > 0)
 
 
+def test_fuse_montecarlo_shards_on_a_local_cluster_merge_bit_for_bit():
+    scn = sdins.Scenario.builtin("dq-paper")
+    kw = dict(grade="tactical", gate=False, until_s=10.0, block=2, threads=1)
+    runs, seed, n = 8, 2, 4
+    whole = sdins.fuse_montecarlo(scn, runs, seed, **kw)
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        futures = [
+            client.submit(sdins.fuse_montecarlo, scn, runs, seed, shard=(i, n), pure=False, **kw)
+            for i in range(n)
+        ]
+        states = client.gather(futures)
+    order = list(range(n))
+    random.Random(2).shuffle(order)
+    merged = sdins.fuse_merge([states[i] for i in order])
+    assert merged == whole
+    a, b = merged.statistics(), whole.statistics()
+    assert a["mean"].tobytes() == b["mean"].tobytes()
+    assert np.all(a["mean"][1:, 0] > 0)
+
+
 def test_the_documented_dask_example_runs_as_a_script(tmp_path):
     """docs/montecarlo.md's Dask block, saved as a file and run as `python file.py`
-    (smaller: 16 runs of 60 s), finishes: the `__main__` guard is there."""
+    (smaller: 16 runs of 60 s in blocks of 2), finishes: the `__main__` guard is there."""
     import pathlib
     import re
     import subprocess
@@ -53,7 +75,12 @@ def test_the_documented_dask_example_runs_as_a_script(tmp_path):
     section = doc[doc.index("## The same job from Python, on Dask"):]
     block = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     assert 'if __name__ == "__main__":' in block
-    script = block.replace("1000, 1, shard", "16, 1, shard").replace("until_s=600.0", "until_s=60.0")
+    # 16 runs in blocks of 2: every one of the 8 shards gets a block
+    small = {"1000, 1, shard": "16, 1, shard", "until_s=600.0": "until_s=60.0", "threads=1)": "threads=1, block=2)"}
+    script = block
+    for a, b in small.items():
+        assert a in script, a
+        script = script.replace(a, b)
     f = tmp_path / "mc_dask.py"
     f.write_text(script)
     r = subprocess.run([sys.executable, str(f)], capture_output=True, text=True, timeout=600)

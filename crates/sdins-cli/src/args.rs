@@ -156,7 +156,8 @@ impl ColumnsArgs {
         };
         if let Some(s) = &self.gnss_sigma {
             let c = gnss.as_mut().ok_or_else(|| need_gnss("--gnss-sigma"))?;
-            c.sigma = Some(GnssSigma::parse(s).map_err(|e| CliError::bad(format!("--gnss-sigma: {e}")))?);
+            c.sigma =
+                Some(GnssSigma::parse(s).map_err(|e| CliError::bad(format!("--gnss-sigma: {e}")))?);
         }
         if let Some(n) = self.undulation_m {
             let c = gnss.as_mut().ok_or_else(|| need_gnss("--undulation-m"))?;

@@ -108,43 +108,61 @@ pub fn nav_row(t_s: f64, st: &sdins_core::nav::NavState) -> [f64; 10] {
     ]
 }
 
-/// Header of `innovations.csv` of `sdins fuse`.
-pub const INNOVATION_HEADER: [&str; 12] = [
-    "t_s", "kind", "dof", "nis", "accepted", "forced", "nu_1", "nu_2", "nu_3", "nu_4", "nu_5",
+/// Header of `innovations.csv` of `sdins fuse`: time of the update and of validity
+/// \[s\], kind, rows, NIS, outcome, and the innovation ν = predicted − measured (first
+/// `dof` values; back-propagated to the update for a delayed measurement).
+pub const INNOVATION_HEADER: [&str; 20] = [
+    "t_s",
+    "t_valid_s",
+    "kind",
+    "dof",
+    "nis",
+    "accepted",
+    "forced",
+    "late",
+    "nu_1",
+    "nu_2",
+    "nu_3",
+    "nu_4",
+    "nu_5",
     "nu_6",
+    "nu_7",
+    "nu_8",
+    "nu_9",
+    "nu_10",
+    "nu_11",
+    "nu_12",
 ];
 
-/// A record of [`INNOVATION_HEADER`]: a measurement update at time `t_s` (the report's
-/// time plus the caller's offset).
-#[allow(clippy::type_complexity)]
-pub fn innovation_row(
-    t_s: f64,
-    u: &sdins_core::aiding::ekf::UpdateReport,
-) -> (
-    f64,
-    &'static str,
-    usize,
-    f64,
-    bool,
-    bool,
-    f64,
-    f64,
-    f64,
-    f64,
-    f64,
-    f64,
-) {
-    use sdins_core::aiding::ekf::MeasKind;
-    let kind = match u.kind {
-        MeasKind::Gnss => "gnss",
-        MeasKind::Zupt => "zupt",
-        MeasKind::Nhc => "nhc",
-        _ => "other",
-    };
-    let n = u.innovation;
-    (
-        t_s, kind, u.dof, u.nis, u.accepted, u.forced, n[0], n[1], n[2], n[3], n[4], n[5],
-    )
+/// One field of a heterogeneous record.
+#[derive(Clone, Copy, Debug, Serialize)]
+#[serde(untagged)]
+pub enum Field {
+    /// a number
+    Num(f64),
+    /// an integer
+    Int(usize),
+    /// a name
+    Text(&'static str),
+    /// a flag
+    Flag(bool),
+}
+
+/// A record of [`INNOVATION_HEADER`] (times as the report gives them: the data's clock).
+pub fn innovation_row(u: &sdins_core::aiding::ekf::UpdateReport) -> [Field; 20] {
+    let mut r = [Field::Num(0.0); 20];
+    r[0] = Field::Num(u.t_s);
+    r[1] = Field::Num(u.t_valid_s);
+    r[2] = Field::Text(u.kind.name());
+    r[3] = Field::Int(u.dof);
+    r[4] = Field::Num(u.nis);
+    r[5] = Field::Flag(u.accepted);
+    r[6] = Field::Flag(u.forced);
+    r[7] = Field::Flag(u.late);
+    for (f, x) in r[8..].iter_mut().zip(u.innovation) {
+        *f = Field::Num(x);
+    }
+    r
 }
 
 /// A CSV table as a string (for small tables built in memory): header, then records. A

@@ -8,8 +8,9 @@ pub enum CliError {
     /// The user's input is wrong (file content, option value). Exit code 2.
     #[error("{0}")]
     BadInput(String),
-    /// Reading or writing a file failed.
-    #[error("{path}: {source}")]
+    /// Reading or writing a file failed. Exit code 2 when the path the user gave is the
+    /// cause (missing, a name too long, a folder under a file, …; [`user_io_cause`]), else 1.
+    #[error("{}: {}", path.display(), describe_io(source))]
     Io {
         /// the file
         path: PathBuf,
@@ -29,6 +30,7 @@ impl CliError {
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::BadInput(_) => 2,
+            CliError::Io { source, .. } if user_io_cause(source).is_some() => 2,
             CliError::Io { .. } | CliError::Other(_) => 1,
             CliError::Interrupted => crate::progress::cancel_exit_code(),
         }
@@ -36,6 +38,30 @@ impl CliError {
     /// Shorthand for a bad-input error.
     pub fn bad(msg: impl Into<String>) -> Self {
         CliError::BadInput(msg.into())
+    }
+}
+
+/// The user-facing cause of an I/O error the user's path provoked, in sdins's words, or
+/// None for a system failure (full disk, I/O error: exit 1).
+pub fn user_io_cause(e: &std::io::Error) -> Option<&'static str> {
+    Some(match e.raw_os_error()? {
+        libc::ENOENT => "no such file or folder",
+        libc::ENOTDIR => "a part of this path is a file, not a folder",
+        libc::EISDIR => "is a folder, not a file",
+        libc::ENAMETOOLONG => "name too long for the file system",
+        libc::EACCES | libc::EPERM => "permission denied",
+        libc::EROFS => "on a read-only file system",
+        libc::ELOOP => "too many levels of symbolic links",
+        libc::EEXIST => "already exists",
+        _ => return None,
+    })
+}
+
+/// An I/O error in sdins's words where the cause is the user's path, else the OS message.
+fn describe_io(e: &std::io::Error) -> String {
+    match user_io_cause(e) {
+        Some(s) => s.to_string(),
+        None => e.to_string(),
     }
 }
 

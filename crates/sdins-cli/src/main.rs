@@ -6,6 +6,9 @@
 // doc comments of the clap arguments are the --help text: units in [brackets] stay plain
 #![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 
+// first: its macros (outln!, out!) are in scope for the modules below
+#[macro_use]
+mod stdout;
 mod args;
 mod cmd;
 mod csv_out;
@@ -63,23 +66,35 @@ enum Command {
     Spp(cmd::spp::Args),
 }
 
-/// Die quietly on a closed stdout (`sdins run --json | head -c1`), like other Unix tools:
-/// Rust ignores SIGPIPE, which turns every later `println!` into a panic.
-fn restore_sigpipe() {
-    // SAFETY: setting a signal disposition to its default has no preconditions; this runs
-    // first in `main`, before any thread exists.
-    #[allow(unsafe_code)]
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-    }
-}
-
 fn main() -> ExitCode {
-    restore_sigpipe();
     args::warn_deprecated(&std::env::args_os().collect::<Vec<_>>());
     let cli = Cli::parse();
     progress::install_signal_handlers();
-    let result = match cli.command {
+    // SIGPIPE stays ignored (Rust's default): a closed stdout is an EPIPE error of the
+    // checked writer (stdout.rs), which unwinds here; so does a panic. Either way the
+    // staging folders go and the output folder keeps its previous contents.
+    let result =
+        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| dispatch(cli.command))) {
+            Ok(r) => r,
+            Err(payload) => {
+                output::abort_all();
+                return ExitCode::from(stdout::exit_code_of(payload.as_ref()).unwrap_or(101));
+            }
+        };
+    // a run's outputs all or none: swap the staged files in only if the command succeeded
+    let result = output::finish(result);
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("sdins: error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
+
+/// Run one command.
+fn dispatch(command: Command) -> Result<(), error::CliError> {
+    match command {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Scenarios(a) => cmd::scenarios::run(a),
         Command::Truth(a) => cmd::truth::run(a),
@@ -93,14 +108,5 @@ fn main() -> ExitCode {
         Command::Merge(a) => cmd::merge::run(a),
         Command::Fuse(a) => cmd::fuse::run(*a),
         Command::Spp(a) => cmd::spp::run(a),
-    };
-    // a run's outputs all or none: swap the staged files in only if the command succeeded
-    let result = output::finish(result);
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("sdins: error: {e}");
-            ExitCode::from(e.exit_code())
-        }
     }
 }

@@ -153,6 +153,9 @@ struct Stage {
     dir: PathBuf,
     created_root: bool,
     old: Vec<String>,
+    /// `dir/.lock`, flock'ed (exclusive) for the life of the run: a stage folder whose lock
+    /// another process can take is a dead run's leftover ([`remove_stale_stages`])
+    _lock: File,
 }
 
 thread_local! {
@@ -214,6 +217,86 @@ fn list_files(dir: &Path) -> Result<Vec<(String, u64)>, CliError> {
     Ok(v)
 }
 
+/// Why a `[manifest]` name may not be deleted by a later run: it must be a relative path of
+/// plain components (no `..`, no absolute path, no `.`) whose folders inside `root` are real
+/// folders, not symbolic links leading elsewhere. None if it is safe.
+fn unsafe_manifest_name(root: &Path, name: &str) -> Option<&'static str> {
+    use std::path::Component;
+    let p = Path::new(name);
+    if name.is_empty() || p.is_absolute() || name.starts_with('/') {
+        return Some("an absolute or empty path");
+    }
+    if !p.components().all(|c| matches!(c, Component::Normal(_))) {
+        return Some("a path with `..` or `.`");
+    }
+    // every folder on the way must be a real folder inside root (a symbolic link would lead
+    // the removal out of the output folder); the file itself may be a link: removing a link
+    // removes the link, not its target
+    let mut dir = root.to_path_buf();
+    let comps: Vec<_> = p.components().collect();
+    for c in &comps[..comps.len().saturating_sub(1)] {
+        dir.push(c);
+        match std::fs::symlink_metadata(&dir) {
+            Ok(m) if m.file_type().is_symlink() => return Some("a path through a symbolic link"),
+            _ => {}
+        }
+    }
+    None
+}
+
+/// Refuse (exit 2) a folder whose `run.toml` manifest names a file outside it: a later run
+/// removes the files of the previous manifest, so such a name (hand-edited or planted) would
+/// make sdins delete a file outside the output folder.
+fn check_manifest(root: &Path, names: &[String]) -> Result<(), CliError> {
+    for n in names {
+        if let Some(why) = unsafe_manifest_name(root, n) {
+            return Err(CliError::bad(format!(
+                "{}: its [manifest] lists {:?}, {why}: sdins only ever replaces files inside the output folder, so it refuses this folder (fix or remove run.toml)",
+                root.join("run.toml").display(),
+                n
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Remove the staging folders of dead runs in `root` (a notice on stderr for each): a stage
+/// folder whose `.lock` can be locked belongs to no running process (a killed or crashed
+/// run); a locked one belongs to a running sdins and is never touched.
+fn remove_stale_stages(root: &Path) {
+    let Ok(entries) = std::fs::read_dir(root) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if !name.starts_with(STAGE_PREFIX) || !e.file_type().is_ok_and(|t| t.is_dir()) {
+            continue;
+        }
+        let lock_path = e.path().join(".lock");
+        let stale = match File::open(&lock_path) {
+            Ok(f) => try_lock(&f),
+            // no lock file: a stage of an older sdins or one killed before locking
+            Err(_) => true,
+        };
+        if stale && std::fs::remove_dir_all(e.path()).is_ok() {
+            eprintln!(
+                "sdins: note: removed {}, the staging folder of a run that did not finish",
+                e.path().display()
+            );
+        }
+    }
+}
+
+/// Take an exclusive `flock` on `f` without waiting; true if taken. Released when `f` is
+/// closed, i.e. at the latest when the process ends, however it ends.
+fn try_lock(f: &File) -> bool {
+    use std::os::fd::AsRawFd;
+    // SAFETY: flock on a file descriptor owned by `f`, valid for the call.
+    #[allow(unsafe_code)]
+    let r = unsafe { libc::flock(f.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+    r == 0
+}
+
 /// The file names of the `[manifest]` of `root/run.toml`, or None if there is none.
 fn read_manifest(root: &Path) -> Option<Vec<String>> {
     let text = std::fs::read_to_string(root.join("run.toml")).ok()?;
@@ -267,6 +350,8 @@ fn claim_new(root: &Path) -> Result<Stage, CliError> {
                 if foreign.len() > shown.len() { ", ..." } else { "" }
             )));
         }
+        check_manifest(root, &known)?;
+        remove_stale_stages(root);
         old = known;
         if listed.is_some() {
             old.push("run.toml".into());
@@ -275,14 +360,24 @@ fn claim_new(root: &Path) -> Result<Stage, CliError> {
     std::fs::create_dir_all(root).map_err(io(root))?;
     let dir = root.join(format!("{STAGE_PREFIX}{}", std::process::id()));
     if dir.exists() {
+        // this PID's folder from a dead process (PIDs are reused): not locked by anyone
         let _ = std::fs::remove_dir_all(&dir);
     }
     std::fs::create_dir(&dir).map_err(io(&dir))?;
+    let lock_path = dir.join(".lock");
+    let lock = File::create(&lock_path).map_err(io(&lock_path))?;
+    if !try_lock(&lock) {
+        return Err(CliError::Other(format!(
+            "{}: cannot lock the staging folder",
+            dir.display()
+        )));
+    }
     Ok(Stage {
         root: root.to_path_buf(),
         dir,
         created_root,
         old,
+        _lock: lock,
     })
 }
 
@@ -326,7 +421,7 @@ fn manifest_text(files: &[(String, u64)]) -> String {
 fn commit_one(s: &Stage) -> Result<(), CliError> {
     let files: Vec<(String, u64)> = list_files(&s.dir)?
         .into_iter()
-        .filter(|(n, _)| n != "run.toml")
+        .filter(|(n, _)| n != "run.toml" && n != ".lock")
         .collect();
     // run.toml: the command's own, or a minimal one, followed by the manifest
     let staged_toml = s.dir.join("run.toml");

@@ -6,9 +6,13 @@ pub fn git_commit() -> &'static str {
     option_env!("SDINS_GIT_COMMIT").unwrap_or("unknown")
 }
 
-/// The command line of this process, space-separated.
+/// The command line of this process, space-separated (arguments that are not UTF-8 are
+/// shown lossily, U+FFFD for each bad byte sequence: `env::args` would panic on them).
 pub fn command_line() -> String {
-    std::env::args().collect::<Vec<_>>().join(" ")
+    std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// The text of a scenario as given on the command line: a built-in scenario's TOML, or

@@ -90,7 +90,9 @@ fn shards_merge_to_the_single_run_byte_for_byte() {
         .nth(1)
         .unwrap()
         .starts_with("t_s,pos_n_m_mean,pos_n_m_sigma,pos_n_m_p05,pos_n_m_p50,pos_n_m_p95"));
-    assert_eq!(text.lines().count(), 2 + 6);
+    // rows 0, 5, …, 30 s: the epoch rule keeps the initial state (docs/conventions.md)
+    assert_eq!(text.lines().count(), 2 + 7);
+    assert!(text.lines().nth(2).unwrap().starts_with("0.0,"));
 
     // incomplete or overlapping sets are refused with exit code 2
     let (code, _, err) = sdins(&[

@@ -40,7 +40,12 @@ fn files(tag: &str) -> Files {
     std::fs::write(&scn, SCN).unwrap();
     let rec = dir.join("rec");
     let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
-        .args(["truth", scn.to_str().unwrap(), "--out", rec.to_str().unwrap()])
+        .args([
+            "truth",
+            scn.to_str().unwrap(),
+            "--out",
+            rec.to_str().unwrap(),
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -138,7 +143,10 @@ fn worked_example_matches_sdins_files() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("imu: 3000 rows, time relative"), "{err}");
     let run = std::fs::read_to_string(f.dir.join("profile/run.toml")).unwrap();
-    assert!(run.contains("[inputs.imu]") && run.contains("[inputs.gnss]"), "{run}");
+    assert!(
+        run.contains("[inputs.imu]") && run.contains("[inputs.gnss]"),
+        "{run}"
+    );
     // the same maps on the command line
     let imu_map = "t_ms=stamp,gyro_x_deg_inc=wx,gyro_y_deg_inc=wy,gyro_z_deg_inc=wz,accel_x_mps_inc=fx,accel_y_mps_inc=fy,accel_z_mps_inc=fz,axes=x:+y,y:+x,z:-z";
     let gnss_map = "t_s=time,lat_deg=latitude,lon_deg=longitude,alt_msl_m=alt";
@@ -170,33 +178,80 @@ fn bad_maps_exit_2_naming_the_option() {
     let reflect = format!("{imu_map},axes=x:+y,y:+x,z:+z");
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
-            vec!["--imu-columns", &reflect, "--gnss-columns", gnss_ok, "--undulation-m", "30", "--gnss-sigma", "1,1,2"],
+            vec![
+                "--imu-columns",
+                &reflect,
+                "--gnss-columns",
+                gnss_ok,
+                "--undulation-m",
+                "30",
+                "--gnss-sigma",
+                "1,1,2",
+            ],
             "--imu-columns",
         ),
         (
-            vec!["--imu-columns", imu_map, "--gnss-columns", gnss_ok, "--gnss-sigma", "1,1,2"],
+            vec![
+                "--imu-columns",
+                imu_map,
+                "--gnss-columns",
+                gnss_ok,
+                "--gnss-sigma",
+                "1,1,2",
+            ],
             "--gnss-columns",
         ),
         (
-            vec!["--imu-columns", imu_map, "--gnss-columns", gnss_ok, "--undulation-m", "30"],
+            vec![
+                "--imu-columns",
+                imu_map,
+                "--gnss-columns",
+                gnss_ok,
+                "--undulation-m",
+                "30",
+            ],
             "--gnss-sigma",
         ),
         (
-            vec!["--imu-columns", "t_ms=stamp,gyro_x_dps=nope", "--gnss-columns", gnss_ok],
+            vec![
+                "--imu-columns",
+                "t_ms=stamp,gyro_x_dps=nope",
+                "--gnss-columns",
+                gnss_ok,
+            ],
             "--imu-columns",
         ),
         (
-            vec!["--imu-columns", imu_map, "--gnss-columns", gnss_ok, "--undulation-m", "30", "--gnss-sigma", "1,1"],
+            vec![
+                "--imu-columns",
+                imu_map,
+                "--gnss-columns",
+                gnss_ok,
+                "--undulation-m",
+                "30",
+                "--gnss-sigma",
+                "1,1",
+            ],
             "--gnss-sigma",
         ),
         (vec!["--gnss-sigma", "1,1,2"], "--gnss-sigma"),
     ];
-    let want_words = ["reflection", "undulation", "--gnss-sigma", "missing", "3 or 6", "column map"];
+    let want_words = [
+        "reflection",
+        "undulation",
+        "--gnss-sigma",
+        "missing",
+        "3 or 6",
+        "column map",
+    ];
     for ((args, option), word) in cases.iter().zip(want_words) {
         let o = fuse(&f, &f.imu_txt, &f.gnss_own, "bad", args);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(option) && err.contains(word), "{args:?}: {err}");
+        assert!(
+            err.contains(option) && err.contains(word),
+            "{args:?}: {err}"
+        );
         assert!(!err.contains("panicked"), "{err}");
     }
     // a bad row is located: file, line, column
@@ -214,10 +269,22 @@ fn bad_maps_exit_2_naming_the_option() {
         &bad,
         &f.gnss_own,
         "bad",
-        &["--imu-columns", imu_map, "--gnss-columns", gnss_ok, "--undulation-m", "30", "--gnss-sigma", "1,1,2"],
+        &[
+            "--imu-columns",
+            imu_map,
+            "--gnss-columns",
+            gnss_ok,
+            "--undulation-m",
+            "30",
+            "--gnss-sigma",
+            "1,1,2",
+        ],
     );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("bad.txt:10: accel_x_mps_inc: `oops` is not a number"), "{err}");
+    assert!(
+        err.contains("bad.txt:10: accel_x_mps_inc: `oops` is not a number"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&f.dir).ok();
 }

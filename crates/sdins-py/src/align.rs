@@ -258,3 +258,47 @@ pub fn schuler_share_json() -> PyResult<String> {
     )
     .map_err(err)
 }
+
+/// Turntable calibration (`sdins calibrate`, `sdins_sim::align::calibration::request`):
+/// the `--json` summary as JSON text (the wrapper parses it).
+#[pyfunction]
+#[pyo3(signature = (scenario, imu=None, imu_format=None, run=None, runs=None, draw_scale_ppm=None, draw_misalignment_mrad=None, draw=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate(
+    py: Python<'_>,
+    scenario: &Scenario,
+    imu: Option<PathBuf>,
+    imu_format: Option<&str>,
+    run: Option<u64>,
+    runs: Option<usize>,
+    draw_scale_ppm: Option<(f64, f64)>,
+    draw_misalignment_mrad: Option<(f64, f64)>,
+    draw: Option<bool>,
+) -> PyResult<String> {
+    use sdins_sim::align::calibration::request::{calibrate as cal, CalibrateRequest};
+    use sdins_sim::align::calibration::run::CalibrationError;
+    use sdins_sim::align::calibration::DrawSpec;
+    let d = DrawSpec::DEFAULT;
+    let req = CalibrateRequest {
+        imu,
+        imu_format: imu_format
+            .unwrap_or("auto")
+            .parse::<ImuFormat>()
+            .map_err(err)?,
+        run: run.unwrap_or(0),
+        runs: runs.unwrap_or(1),
+        draw: draw.unwrap_or(true).then_some(DrawSpec {
+            scale_ppm: draw_scale_ppm.unwrap_or(d.scale_ppm),
+            misalignment_mrad: draw_misalignment_mrad.unwrap_or(d.misalignment_mrad),
+        }),
+    };
+    let scn = &scenario.scn;
+    let res = interrupt::run(py, |tok| cal(scn, &req, tok))?.map_err(|e| match e {
+        CalibrationError::Cancelled(_) => {
+            pyo3::exceptions::PyKeyboardInterrupt::new_err("cancelled")
+        }
+        CalibrationError::Draw { key, what } => err(format!("draw_{key}: {what}")),
+        other => err(other),
+    })?;
+    serde_json::to_string(&res.summary_json(scn)).map_err(err)
+}

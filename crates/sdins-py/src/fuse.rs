@@ -1,5 +1,8 @@
-//! `sdins.fuse`: the loosely coupled INS/GNSS filter on a scenario
-//! (`sdins_sim::fusion::simulated::fuse_scenario`, the library call of `sdins fuse`).
+//! `sdins.fuse`, `sdins.fuse_files`: the INS/GNSS filter on a scenario or on recorded
+//! files through the library call of `sdins fuse` (`sdins_sim::fusion::request::fuse`);
+//! `sdins.fuse_montecarlo` and `sdins.fuse_merge`: its Monte Carlo
+//! (`sdins_sim::analysis::fuse_mc`, the work of `sdins fuse SCENARIO --runs N --shard i/n`
+//! and `sdins fuse --merge`).
 
 use crate::arrays::{matrix, vector};
 use crate::error::err;
@@ -7,19 +10,77 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use sdins_core::aiding::ekf::MeasKind;
-use sdins_core::aiding::error_model::{I_ATT, I_POS, I_VEL};
-use sdins_core::nav::AlgorithmSpec;
-use sdins_sim::fusion::simulated::{fuse_scenario, FuseError, FuseEvent, FuseOptions};
+use sdins_core::aiding::linalg::MAX_ROWS;
+use sdins_sim::analysis::fuse_mc::{self, FuseMcOptions, FuseMcState as State};
+use sdins_sim::analysis::montecarlo::Shard;
+use sdins_sim::fusion::request::{
+    fuse as fuse_request, FilesData, FuseData, FuseDetails, FuseOutput, FuseRequest, FuseRow,
+    FuseRunError, ScenarioData,
+};
+use sdins_sim::fusion::simulated::ScaleFactorPrior;
 
-/// Number of filter states.
+/// Number of filter states in the `error` and `sigma` arrays (the navigation and bias
+/// states; scale factors separately).
 const NX: usize = 15;
+
+fn run_err(e: FuseRunError) -> PyErr {
+    if e.is_cancelled() {
+        pyo3::exceptions::PyKeyboardInterrupt::new_err("cancelled")
+    } else {
+        err(e)
+    }
+}
+
+/// The options shared by `fuse` and `fuse_montecarlo`.
+#[allow(clippy::too_many_arguments)]
+fn scenario_request(
+    scenario: &Scenario,
+    algo: Option<&str>,
+    samples: Option<usize>,
+    run: Option<u64>,
+    cov_rate_hz: Option<f64>,
+    gate: Option<bool>,
+    exact_start: Option<bool>,
+    zupt_sigma_mps: Option<f64>,
+    nhc_sigma_mps: Option<f64>,
+    until_s: Option<f64>,
+    smooth: Option<bool>,
+    in_motion: Option<bool>,
+    scale_factors_ppm: Option<(f64, f64)>,
+    grade: Option<&str>,
+    every_s: Option<f64>,
+    max_latency_s: Option<f64>,
+) -> PyResult<FuseRequest> {
+    let mut r = FuseRequest::new(FuseData::Scenario(ScenarioData {
+        scenario: scenario.scn.clone(),
+        run: run.unwrap_or(0),
+        exact_start: exact_start.unwrap_or(false),
+        in_motion: in_motion.unwrap_or(false),
+        zupt_sigma_mps,
+    }));
+    if let Some(a) = algo {
+        r.algo = a.to_string();
+    }
+    r.samples = samples;
+    r.cov_rate_hz = cov_rate_hz.unwrap_or(r.cov_rate_hz);
+    r.gate = gate.unwrap_or(r.gate);
+    r.nhc_sigma_mps = nhc_sigma_mps;
+    r.until_s = until_s;
+    r.smooth = smooth.unwrap_or(false);
+    r.scale_factors = scale_factors_ppm.map(|(a, g)| ScaleFactorPrior::uniform(a, g));
+    r.grade = grade.map(str::to_string);
+    r.every_s = every_s;
+    r.max_latency_s = max_latency_s;
+    r.check().map_err(run_err)?;
+    Ok(r)
+}
 
 /// Run the filter; see the Python wrapper for parameters and the returned dict.
 #[pyfunction]
 #[pyo3(signature = (scenario, algo=None, samples=None, run=None, cov_rate_hz=None,
     gate=None, exact_start=None, zupt_sigma_mps=None, nhc_sigma_mps=None, until_s=None,
-    smooth=None, in_motion=None, scale_factors_ppm=None))]
+    smooth=None, in_motion=None, scale_factors_ppm=None, grade=None, every_s=None,
+    max_latency_s=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse<'py>(
     py: Python<'py>,
@@ -36,54 +97,28 @@ pub fn fuse<'py>(
     smooth: Option<bool>,
     in_motion: Option<bool>,
     scale_factors_ppm: Option<(f64, f64)>,
+    grade: Option<&str>,
+    every_s: Option<f64>,
+    max_latency_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let scn = scenario.scn.clone();
-    let d = FuseOptions::default();
-    let samples = samples.unwrap_or(scn.nav.samples);
-    if !(1..=4).contains(&samples) {
-        return Err(err(format!("samples: must be 1..4, got {samples}")));
-    }
-    let algo = match algo {
-        None => AlgorithmSpec::new(d.algo.kind, samples),
-        Some(a) => AlgorithmSpec::from_name(a, samples)
-            .ok_or_else(|| err(format!("algo: unknown algorithm `{a}`")))?,
-    };
-    for (name, v) in [
-        ("cov_rate_hz", cov_rate_hz),
-        ("zupt_sigma_mps", zupt_sigma_mps),
-        ("nhc_sigma_mps", nhc_sigma_mps),
-        ("until_s", until_s),
-    ] {
-        if let Some(x) = v {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(err(format!("{name}: must be finite and > 0, got {x}")));
-            }
-        }
-    }
-    let opts = FuseOptions {
+    let req = scenario_request(
+        scenario,
         algo,
-        cov_rate_hz: cov_rate_hz.unwrap_or(d.cov_rate_hz),
-        draw_initial_errors: exact_start.map_or(d.draw_initial_errors, |e| !e),
-        gate_chi2: match gate {
-            None => d.gate_chi2,
-            Some(false) => None,
-            Some(true) => Some(sdins_core::aiding::ekf::CHI2_999),
-        },
-        zupt: zupt_sigma_mps.map(|s| (s, 1e-3)),
+        samples,
+        run,
+        cov_rate_hz,
+        gate,
+        exact_start,
+        zupt_sigma_mps,
         nhc_sigma_mps,
         until_s,
-        smooth: smooth.unwrap_or(d.smooth),
-        in_motion: match in_motion {
-            Some(true) => Some(sdins_sim::fusion::simulated::InMotionInit::default()),
-            Some(false) => None,
-            None => d.in_motion,
-        },
-        scale_factors: scale_factors_ppm
-            .map(|(a, g)| sdins_sim::fusion::simulated::ScaleFactorPrior::uniform(a, g)),
-        ..d
-    };
-    let gnss = scn.gnss.clone().unwrap_or_default();
-    let run = run.unwrap_or(0);
+        smooth,
+        in_motion,
+        scale_factors_ppm,
+        grade,
+        every_s,
+        max_latency_s,
+    )?;
     #[derive(Default)]
     struct Ep {
         t: Vec<f64>,
@@ -99,17 +134,13 @@ pub fn fuse<'py>(
     impl Ep {
         fn push(&mut self, e: &sdins_sim::fusion::simulated::FuseEpoch) {
             self.t.push(e.t_s);
-            self.err.extend(e.err.iter());
+            self.err.extend(e.err.iter().take(NX));
             self.pos_m.extend(e.nav.pos_err_ned_m);
             self.vel_mps.extend(e.nav.vel_err_ned_mps);
             self.att_rad.extend(e.nav.att_err_rad);
             self.sigma.extend((0..NX).map(|i| e.sigma(i)));
-            self.nees.extend([
-                e.nees_block(I_POS),
-                e.nees_block(I_VEL),
-                e.nees_block(I_ATT),
-            ]);
-            if let Some(sf) = &e.scale_factors {
+            self.nees.extend([e.nees_block(0), e.nees_block(3), e.nees_block(6)]);
+            if let Some(sf) = e.scale_factors() {
                 self.sf_err.extend(sf.err.iter());
                 self.sf_sigma
                     .extend((0..6).map(|i| sf.p[(i, i)].max(0.0).sqrt()));
@@ -135,57 +166,31 @@ pub fn fuse<'py>(
     struct Acc {
         forward: Ep,
         smoothed: Ep,
-        it: Vec<f64>,
-        kind: Vec<&'static str>,
-        dof: Vec<usize>,
-        nis: Vec<f64>,
-        accepted: Vec<bool>,
-        forced: Vec<bool>,
-        nu: Vec<f64>,
+        inn: Inn,
     }
-    let (acc, s) = interrupt::run(py, |tok| {
+    let (acc, o) = interrupt::run(py, |tok| {
         let mut a = Acc::default();
-        let r = fuse_scenario(&scn, &gnss, &opts, run, tok, |ev| match ev {
-            FuseEvent::Epoch(e) => a.forward.push(e),
-            FuseEvent::Update(u) => {
-                a.it.push(u.t_s);
-                a.kind.push(match u.kind {
-                    MeasKind::Gnss => "gnss",
-                    MeasKind::Zupt => "zupt",
-                    MeasKind::Nhc => "nhc",
-                    _ => "other",
-                });
-                a.dof.push(u.dof);
-                a.nis.push(u.nis);
-                a.accepted.push(u.accepted);
-                a.forced.push(u.forced);
-                a.nu.extend(u.innovation);
-            }
-            FuseEvent::Smoothed(e) => a.smoothed.push(e),
+        let r = fuse_request(&req, tok, &mut |ev| match ev {
+            FuseOutput::Forward(FuseRow::Scenario(e)) => a.forward.push(e),
+            FuseOutput::Smoothed(FuseRow::Scenario(e)) => a.smoothed.push(e),
+            FuseOutput::Update(u) => a.inn.push(u),
             _ => {}
         });
-        r.map(|s| (a, s))
+        r.map(|o| (a, o))
     })?
-    .map_err(|e| match e {
-        FuseError::Cancelled(_) => pyo3::exceptions::PyKeyboardInterrupt::new_err("cancelled"),
-        other => err(other),
-    })?;
+    .map_err(run_err)?;
+    let FuseDetails::Scenario { summary: s, run, .. } = &o.details else {
+        return Err(err("fuse on a scenario returned no scenario result"));
+    };
     let out = acc.forward.dict(py)?;
-    let inn = PyDict::new(py);
-    inn.set_item("t_s", vector(py, acc.it))?;
-    inn.set_item("kind", acc.kind)?;
-    inn.set_item("dof", acc.dof)?;
-    inn.set_item("nis", vector(py, acc.nis))?;
-    inn.set_item("accepted", acc.accepted)?;
-    inn.set_item("forced", acc.forced)?;
-    inn.set_item("innovation", matrix(py, acc.nu, 6)?)?;
-    out.set_item("innovations", inn)?;
-    if opts.smooth {
+    out.set_item("innovations", acc.inn.dict(py)?)?;
+    if req.smooth {
         out.set_item("smoothed", acc.smoothed.dict(py)?)?;
     }
     let v3 = |v: &sdins_core::math::Vec3| vec![v.x, v.y, v.z];
     out.set_item("fixes", s.fixes)?;
     out.set_item("rejected", s.rejected)?;
+    out.set_item("late", s.late)?;
     out.set_item("nav_updates", s.nav_updates)?;
     out.set_item("accel_bias_est_mps2", v3(&s.est_bias.0))?;
     out.set_item("accel_bias_true_mps2", v3(&s.true_bias.0))?;
@@ -197,9 +202,50 @@ pub fn fuse<'py>(
         out.set_item("gyro_scale_est", v3(&s.est_scale.1))?;
         out.set_item("gyro_scale_true", v3(&tg))?;
     }
-    out.set_item("samples", samples)?;
-    out.set_item("run", run)?;
+    out.set_item("samples", o.algo.samples)?;
+    out.set_item("run", *run)?;
     Ok(out)
+}
+
+/// Measurement reports as flat columns.
+#[derive(Default)]
+struct Inn {
+    t: Vec<f64>,
+    t_valid: Vec<f64>,
+    kind: Vec<&'static str>,
+    dof: Vec<usize>,
+    nis: Vec<f64>,
+    accepted: Vec<bool>,
+    forced: Vec<bool>,
+    late: Vec<bool>,
+    nu: Vec<f64>,
+}
+
+impl Inn {
+    fn push(&mut self, u: &sdins_core::aiding::ekf::UpdateReport) {
+        self.t.push(u.t_s);
+        self.t_valid.push(u.t_valid_s);
+        self.kind.push(u.kind.name());
+        self.dof.push(u.dof);
+        self.nis.push(u.nis);
+        self.accepted.push(u.accepted);
+        self.forced.push(u.forced);
+        self.late.push(u.late);
+        self.nu.extend(u.innovation);
+    }
+    fn dict<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let inn = PyDict::new(py);
+        inn.set_item("t_s", vector(py, self.t))?;
+        inn.set_item("t_valid_s", vector(py, self.t_valid))?;
+        inn.set_item("kind", self.kind)?;
+        inn.set_item("dof", self.dof)?;
+        inn.set_item("nis", vector(py, self.nis))?;
+        inn.set_item("accepted", self.accepted)?;
+        inn.set_item("forced", self.forced)?;
+        inn.set_item("late", self.late)?;
+        inn.set_item("innovation", matrix(py, self.nu, MAX_ROWS)?)?;
+        Ok(inn)
+    }
 }
 
 /// Points of a recorded-data run as flat columns.
@@ -253,13 +299,14 @@ impl Track {
     }
 }
 
-/// `sdins fuse --imu FILE --gnss FILE` (`sdins_sim::fusion::files::fuse_files`); see the
-/// Python wrapper for parameters and the returned dict.
+/// `sdins fuse --imu FILE --gnss FILE` (the same library call); see the Python wrapper
+/// for parameters and the returned dict.
 #[pyfunction]
 #[pyo3(signature = (imu, gnss, imu_format=None, gnss_format=None, grade=None,
     navego_params=None, init=None, attitude_deg=None, attitude_sigma_deg=None, static_s=None,
     lever_arm_m=None, truth=None, smooth=None, algo=None, samples=None, cov_rate_hz=None,
-    gate=None, nhc_sigma_mps=None, gnss_offset_s=None, scale_factors_ppm=None))]
+    gate=None, nhc_sigma_mps=None, gnss_offset_s=None, scale_factors_ppm=None, every_s=None,
+    max_latency_s=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse_files<'py>(
     py: Python<'py>,
@@ -283,118 +330,64 @@ pub fn fuse_files<'py>(
     nhc_sigma_mps: Option<f64>,
     gnss_offset_s: Option<f64>,
     scale_factors_ppm: Option<(f64, f64)>,
+    every_s: Option<f64>,
+    max_latency_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use sdins_sim::fusion::files::{FilesError, FilesInput, InitSource, SensorModelSource};
-    use sdins_sim::fusion::records::{RecordEvent, RecordOptions};
-    use sdins_sim::io::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
-    use sdins_sim::io::imu_file::ImuFormat;
-    let d = RecordOptions::default();
-    let samples = samples.unwrap_or(d.algo.samples);
-    if !(1..=4).contains(&samples) {
-        return Err(err(format!("samples: must be 1..4, got {samples}")));
-    }
-    let algo = match algo {
-        None => AlgorithmSpec::new(d.algo.kind, samples),
-        Some(a) => AlgorithmSpec::from_name(a, samples)
-            .ok_or_else(|| err(format!("algo: unknown algorithm `{a}`")))?,
-    };
-    let imu_format: ImuFormat = imu_format.unwrap_or("auto").parse().map_err(err)?;
-    let gnss_format: GnssFormat = gnss_format.unwrap_or("auto").parse().map_err(err)?;
-    let sensor = SensorModelSource::from_options(grade, navego_params.as_deref()).map_err(err)?;
-    let init = InitSource::from_options(
-        init,
+    let mut req = FuseRequest::new(FuseData::Files(FilesData {
+        imu: (imu, imu_format.unwrap_or("auto").parse().map_err(err)?),
+        gnss: (gnss, gnss_format.unwrap_or("auto").parse().map_err(err)?),
+        gnss_offset_s: gnss_offset_s.unwrap_or(0.0),
+        navego_params,
+        init: init.map(str::to_string),
         attitude_deg,
         attitude_sigma_deg,
         static_s,
-        navego_params.is_some(),
-    )
-    .map_err(err)?;
-    if lever_arm_m.is_some_and(|l| l.iter().any(|x| !x.is_finite())) {
-        return Err(err("lever_arm_m: must be finite"));
-    }
-    let off = gnss_offset_s.unwrap_or(0.0);
-    if !off.is_finite() {
-        return Err(err("gnss_offset_s: must be finite"));
-    }
-    let input = FilesInput {
-        imu: (imu, imu_format),
-        gnss: (gnss, gnss_format),
-        gnss_options: GnssReadOptions::default(),
-        clock: if off == 0.0 {
-            ImuClock::SameAsGnss
-        } else {
-            ImuClock::Offset {
-                t_imu_minus_t_gnss_s: off,
-            }
-        },
-        sensor,
-        init,
+        lever_arm_m,
         truth,
-        check_after_s: 30.0,
         columns: Default::default(),
-    };
-    let opts = RecordOptions {
-        algo,
-        cov_rate_hz: cov_rate_hz.unwrap_or(d.cov_rate_hz),
-        gate_chi2: match gate {
-            None => d.gate_chi2,
-            Some(false) => None,
-            Some(true) => Some(sdins_core::aiding::ekf::CHI2_999),
-        },
-        lever_arm_b_m: lever_arm_m.unwrap_or(d.lever_arm_b_m),
-        nhc_sigma_mps,
-        smooth: smooth.unwrap_or(d.smooth),
-        scale_factors: scale_factors_ppm
-            .map(|(a, g)| sdins_sim::fusion::simulated::ScaleFactorPrior::uniform(a, g)),
-        ..d
-    };
+    }));
+    if let Some(a) = algo {
+        req.algo = a.to_string();
+    }
+    req.samples = samples;
+    req.cov_rate_hz = cov_rate_hz.unwrap_or(req.cov_rate_hz);
+    req.gate = gate.unwrap_or(req.gate);
+    req.nhc_sigma_mps = nhc_sigma_mps;
+    req.smooth = smooth.unwrap_or(false);
+    req.scale_factors = scale_factors_ppm.map(|(a, g)| ScaleFactorPrior::uniform(a, g));
+    req.grade = grade.map(str::to_string);
+    req.every_s = every_s;
+    req.max_latency_s = max_latency_s;
+    req.check().map_err(run_err)?;
     #[derive(Default)]
     struct Acc {
         fwd: Track,
         smo: Track,
-        it: Vec<f64>,
-        nis: Vec<f64>,
-        dof: Vec<usize>,
-        accepted: Vec<bool>,
+        inn: Inn,
     }
-    let (acc, r) = interrupt::run(py, |tok| {
+    let (acc, o) = interrupt::run(py, |tok| {
         let mut a = Acc::default();
-        let mut t0 = None;
-        let r = sdins_sim::fusion::files::fuse_files(&input, &opts, tok, |ev, _| match ev {
-            RecordEvent::Forward(p) => {
-                t0.get_or_insert(p.t_s - p.state.t_s);
-                a.fwd.push(p)
-            }
-            RecordEvent::Smoothed(p) => a.smo.push(p),
-            RecordEvent::Update(u) => {
-                a.it.push(t0.unwrap_or(0.0) + u.t_s);
-                a.nis.push(u.nis);
-                a.dof.push(u.dof);
-                a.accepted.push(u.accepted);
-            }
+        let r = fuse_request(&req, tok, &mut |ev| match ev {
+            FuseOutput::Forward(FuseRow::Files(p, _)) => a.fwd.push(p),
+            FuseOutput::Smoothed(FuseRow::Files(p, _)) => a.smo.push(p),
+            FuseOutput::Update(u) => a.inn.push(u),
             _ => {}
         });
-        r.map(|r| (a, r))
+        r.map(|o| (a, o))
     })?
-    .map_err(|e| match e {
-        FilesError::Fuse(FuseError::Cancelled(_)) => {
-            pyo3::exceptions::PyKeyboardInterrupt::new_err("cancelled")
-        }
-        other => err(other),
-    })?;
+    .map_err(run_err)?;
+    let FuseDetails::Files(r) = &o.details else {
+        return Err(err("fuse on files returned no file result"));
+    };
     let out = PyDict::new(py);
     out.set_item("forward", acc.fwd.dict(py)?)?;
-    if opts.smooth {
+    if req.smooth {
         out.set_item("smoothed", acc.smo.dict(py)?)?;
     }
-    let inn = PyDict::new(py);
-    inn.set_item("t_s", vector(py, acc.it))?;
-    inn.set_item("nis", vector(py, acc.nis))?;
-    inn.set_item("dof", acc.dof)?;
-    inn.set_item("accepted", acc.accepted)?;
-    out.set_item("innovations", inn)?;
-    out.set_item("fixes_used", r.summary.fixes_used)?;
-    out.set_item("rejected", r.summary.rejected)?;
+    out.set_item("innovations", acc.inn.dict(py)?)?;
+    out.set_item("fixes_used", o.fixes)?;
+    out.set_item("rejected", o.rejected)?;
+    out.set_item("late", o.late)?;
     out.set_item("fixes_outside", (r.fixes_outside.0, r.fixes_outside.1))?;
     out.set_item("imu_samples", r.imu_samples)?;
     for (name, c) in [("forward_rmse", &r.forward), ("smoothed_rmse", &r.smoothed)] {
@@ -404,4 +397,228 @@ pub fn fuse_files<'py>(
         }
     }
     Ok(out)
+}
+
+/// Accumulator state of a fusion Monte Carlo job or shard (picklable as the CLI's
+/// `fuse_mc_state.json` text).
+#[pyclass(module = "sdins", frozen)]
+pub struct FuseMcState {
+    pub(crate) state: State,
+}
+
+#[pymethods]
+impl FuseMcState {
+    /// Restore a state from its JSON text (`fuse_mc_state.json`).
+    #[new]
+    fn new(json: &str) -> PyResult<Self> {
+        let state: State = serde_json::from_str(json)
+            .map_err(|e| err(format!("not a fuse Monte Carlo state: {e}")))?;
+        state.validate().map_err(err)?;
+        Ok(FuseMcState { state })
+    }
+
+    /// Read `fuse_mc_state.json` (or a folder holding it) written by the CLI.
+    #[staticmethod]
+    fn from_file(path: std::path::PathBuf) -> PyResult<Self> {
+        let file = if path.is_dir() {
+            path.join("fuse_mc_state.json")
+        } else {
+            path
+        };
+        let text = std::fs::read_to_string(&file)
+            .map_err(|e| err(format!("{}: cannot read: {e}", file.display())))?;
+        FuseMcState::new(&text).map_err(|e| err(format!("{}: {e}", file.display())))
+    }
+
+    /// The state as JSON text.
+    fn to_json(&self) -> PyResult<String> {
+        serde_json::to_string(&self.state).map_err(err)
+    }
+
+    /// Statistics (dict): `runs`, `complete`, `times_s` (m,), `columns`, `dof`, and `n`,
+    /// `mean`, `sd` (m, columns).
+    fn statistics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.state.statistics();
+        let c = s.columns.len();
+        let m = s.times_s.len();
+        let (mut n, mut mean, mut sd) = (
+            Vec::with_capacity(m * c),
+            Vec::with_capacity(m * c),
+            Vec::with_capacity(m * c),
+        );
+        for e in 0..m {
+            for col in &s.columns {
+                n.push(col.n[e] as f64);
+                mean.push(col.mean[e]);
+                sd.push(col.sd[e]);
+            }
+        }
+        let d = PyDict::new(py);
+        d.set_item("runs", s.runs)?;
+        d.set_item("complete", s.complete)?;
+        d.set_item("times_s", vector(py, s.times_s.clone()))?;
+        d.set_item(
+            "columns",
+            s.columns.iter().map(|c| c.name.clone()).collect::<Vec<_>>(),
+        )?;
+        d.set_item("dof", s.columns.iter().map(|c| c.dof).collect::<Vec<_>>())?;
+        d.set_item("n", matrix(py, n, c.max(1))?)?;
+        d.set_item("mean", matrix(py, mean, c.max(1))?)?;
+        d.set_item("sd", matrix(py, sd, c.max(1))?)?;
+        Ok(d)
+    }
+
+    /// The consistency criterion (docs/validation.md) on a column after `after_s` (dict:
+    /// grand_mean, band95, band99, in95, in99, max, epochs, pass, …).
+    #[pyo3(signature = (column, after_s=30.0, tests=1))]
+    fn consistency<'py>(
+        &self,
+        py: Python<'py>,
+        column: &str,
+        after_s: f64,
+        tests: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let c = self
+            .state
+            .statistics()
+            .consistency(column, after_s, tests)
+            .ok_or_else(|| err(format!("no column `{column}`")))?;
+        let d = PyDict::new(py);
+        d.set_item("name", &c.name)?;
+        d.set_item("dof", c.dof)?;
+        d.set_item("runs", c.runs)?;
+        d.set_item("epochs", c.epochs)?;
+        d.set_item("grand_mean", c.grand_mean)?;
+        d.set_item("band95", c.band95)?;
+        d.set_item("band99", c.band99)?;
+        d.set_item("band_grand", c.band_grand)?;
+        d.set_item("in95", c.in95)?;
+        d.set_item("in99", c.in99)?;
+        d.set_item("max", c.max)?;
+        d.set_item("pass", c.pass)?;
+        Ok(d)
+    }
+
+    /// Block indices not yet computed.
+    fn missing_blocks(&self) -> Vec<u64> {
+        self.state.missing_blocks()
+    }
+
+    fn __getnewargs__(&self) -> PyResult<(String,)> {
+        Ok((self.to_json()?,))
+    }
+
+    fn __eq__(&self, other: &FuseMcState) -> bool {
+        self.state == other.state
+    }
+
+    fn __repr__(&self) -> String {
+        let j = &self.state.job;
+        format!(
+            "FuseMcState({:?}, {} runs, {} blocks present)",
+            j.scenario,
+            j.runs,
+            self.state.blocks.len()
+        )
+    }
+}
+
+/// Compute shard `shard = (i, n)` of a fusion Monte Carlo (see the wrapper's docstring).
+#[pyfunction]
+#[pyo3(signature = (scenario, runs, seed=None, shard=None, block=None, threads=None,
+    draw_scale_factors=None, algo=None, samples=None, cov_rate_hz=None, gate=None,
+    exact_start=None, zupt_sigma_mps=None, nhc_sigma_mps=None, until_s=None,
+    scale_factors_ppm=None, grade=None, every_s=None, max_latency_s=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn fuse_montecarlo(
+    py: Python<'_>,
+    scenario: &Scenario,
+    runs: u64,
+    seed: Option<u64>,
+    shard: Option<(u64, u64)>,
+    block: Option<u64>,
+    threads: Option<usize>,
+    draw_scale_factors: Option<bool>,
+    algo: Option<&str>,
+    samples: Option<usize>,
+    cov_rate_hz: Option<f64>,
+    gate: Option<bool>,
+    exact_start: Option<bool>,
+    zupt_sigma_mps: Option<f64>,
+    nhc_sigma_mps: Option<f64>,
+    until_s: Option<f64>,
+    scale_factors_ppm: Option<(f64, f64)>,
+    grade: Option<&str>,
+    every_s: Option<f64>,
+    max_latency_s: Option<f64>,
+) -> PyResult<FuseMcState> {
+    let req = scenario_request(
+        scenario,
+        algo,
+        samples,
+        None,
+        cov_rate_hz,
+        gate,
+        exact_start,
+        zupt_sigma_mps,
+        nhc_sigma_mps,
+        until_s,
+        None,
+        None,
+        scale_factors_ppm,
+        grade,
+        every_s,
+        max_latency_s,
+    )?;
+    let mc = FuseMcOptions {
+        runs,
+        seed: seed.unwrap_or(scenario.scn.imu.seed),
+        block: block.unwrap_or(16),
+        draw_scale_factors: draw_scale_factors.unwrap_or(false),
+    };
+    let shard = match shard {
+        None => Shard::ALL,
+        Some((index, count)) => Shard { index, count },
+    };
+    let pool = match threads {
+        Some(0) => return Err(err("threads 0: expected at least 1")),
+        Some(t) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .map_err(err)?,
+        ),
+        None => None,
+    };
+    let result = interrupt::run(py, |tok| {
+        let cancelled = || tok.is_cancelled();
+        let compute = || fuse_mc::run_shard(&req, &mc, shard, &|| {}, &cancelled);
+        match &pool {
+            Some(p) => p.install(compute),
+            None => compute(),
+        }
+    })?;
+    Ok(FuseMcState {
+        state: result.map_err(err)?,
+    })
+}
+
+/// Merge shard states exactly (any order).
+#[pyfunction]
+#[pyo3(signature = (states, allow_partial=None))]
+pub fn fuse_merge(
+    states: Vec<PyRef<'_, FuseMcState>>,
+    allow_partial: Option<bool>,
+) -> PyResult<FuseMcState> {
+    let v: Vec<State> = states.iter().map(|s| s.state.clone()).collect();
+    let merged = State::merge(&v).map_err(err)?;
+    let missing = merged.missing_blocks();
+    if !missing.is_empty() && !allow_partial.unwrap_or(false) {
+        return Err(err(format!(
+            "{} blocks missing (first missing block {}): give every shard, or allow_partial=True",
+            missing.len(),
+            missing[0]
+        )));
+    }
+    Ok(FuseMcState { state: merged })
 }

@@ -153,6 +153,7 @@ pub fn allan<'py>(
     }
     d.set_item("tau_s", vector(py, tau))?;
     d.set_item("adev", matrix(py, adev, 6)?)?;
+    d.set_item("warnings", rep.warnings())?;
     let fits = PyList::empty(py);
     for f in &rep.fits {
         let fd = PyDict::new(py);

@@ -26,6 +26,7 @@ fn _sdins(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<scenario::Scenario>()?;
     m.add_class::<mc::McState>()?;
+    m.add_class::<fuse::FuseMcState>()?;
     m.add_function(wrap_pyfunction!(scenario::scenarios, m)?)?;
     m.add_function(wrap_pyfunction!(truth::truth, m)?)?;
     m.add_function(wrap_pyfunction!(imu::corrupt, m)?)?;
@@ -37,8 +38,11 @@ fn _sdins(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mc::merge, m)?)?;
     m.add_function(wrap_pyfunction!(align::align, m)?)?;
     m.add_function(wrap_pyfunction!(align::errors, m)?)?;
+    m.add_function(wrap_pyfunction!(align::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(fuse::fuse, m)?)?;
     m.add_function(wrap_pyfunction!(fuse::fuse_files, m)?)?;
+    m.add_function(wrap_pyfunction!(fuse::fuse_montecarlo, m)?)?;
+    m.add_function(wrap_pyfunction!(fuse::fuse_merge, m)?)?;
     m.add_function(wrap_pyfunction!(align::schuler_share_json, m)?)?;
     Ok(())
 }

@@ -261,7 +261,7 @@ fn history(res: &AlignOutcome) -> Result<(String, Vec<HistRow>), CliError> {
 pub fn run(args: Args) -> Result<(), CliError> {
     if args.observability {
         let lat = args.lat.unwrap_or(37.5);
-        print!("{}", observability_tables(lat)?);
+        out!("{}", observability_tables(lat)?);
         return Ok(());
     }
     let opts = args.options();
@@ -273,7 +273,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
     if let (Some(sz), false) = (res.sigma_z_used_mps, args.json) {
-        println!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
+        outln!("fine filter from i0: zero-velocity σ_z {sz:.5} m/s (from the disturbance)");
     }
     let (hist, rows) = history(&res)?;
     let (e, phi) = (res.euler, res.phi_true);
@@ -281,7 +281,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         write_outputs(dir, &args, &inp, &res, &hist, &rows)?;
     }
     if args.json {
-        println!("{}", result_json(&res, &e, phi, inp.true_bias));
+        outln!("{}", result_json(&res, &e, phi, inp.true_bias));
     } else {
         print_text(&args, &inp, &res, rows.len());
     }
@@ -326,7 +326,7 @@ fn print_text(args: &Args, inp: &AlignInput, res: &AlignOutcome, history_rows: u
     let (dt, e, phi) = (inp.dt_s, res.euler, res.phi_true);
     let t_end = res.samples as f64 * dt;
     let rows_len = history_rows;
-    println!(
+    outln!(
         "{}: {} samples, dt {} s, {:.1} s, latitude {:.6}°, g {:.6} m/s²",
         inp.name,
         res.samples,
@@ -335,7 +335,7 @@ fn print_text(args: &Args, inp: &AlignInput, res: &AlignOutcome, history_rows: u
         inp.site.lat_rad.to_degrees(),
         inp.site.g_mps2
     );
-    println!(
+    outln!(
         "method {}: roll {:.6}°, pitch {:.6}°, yaw {:.6}° (NED, clockwise from north)",
         res.method,
         e.roll_rad.to_degrees(),
@@ -343,7 +343,7 @@ fn print_text(args: &Args, inp: &AlignInput, res: &AlignOutcome, history_rows: u
         e.yaw_rad.to_degrees()
     );
     if let Some(s) = res.attitude_sigma {
-        println!(
+        outln!(
             "  1σ φ N/E/D: {:.1} / {:.1} / {:.1} μrad (includes the unobservable part)",
             s.x / 1e-6,
             s.y / 1e-6,
@@ -352,20 +352,30 @@ fn print_text(args: &Args, inp: &AlignInput, res: &AlignOutcome, history_rows: u
     }
     if let Some((b, s)) = res.accel_bias {
         let (b, s) = (b / UG, s / UG);
-        println!(
+        outln!(
             "  accel bias [μg]: {:.2} ± {:.2}, {:.2} ± {:.2}, {:.2} ± {:.2}",
-            b.x, s.x, b.y, s.y, b.z, s.z
+            b.x,
+            s.x,
+            b.y,
+            s.y,
+            b.z,
+            s.z
         );
     }
     if let Some((b, s)) = res.gyro_bias {
         let (b, s) = (b / DPH, s / DPH);
-        println!(
+        outln!(
             "  gyro bias [°/h]: {:.5} ± {:.5}, {:.5} ± {:.5}, {:.5} ± {:.5}",
-            b.x, s.x, b.y, s.y, b.z, s.z
+            b.x,
+            s.x,
+            b.y,
+            s.y,
+            b.z,
+            s.z
         );
     }
     if let Some(p) = phi {
-        println!(
+        outln!(
             "  attitude error φ (G, NED) vs truth: {:.2}, {:.2}, {:.2} μrad",
             p.x / 1e-6,
             p.y / 1e-6,
@@ -373,7 +383,7 @@ fn print_text(args: &Args, inp: &AlignInput, res: &AlignOutcome, history_rows: u
         );
     }
     if let Some((ba, bg)) = inp.true_bias {
-        println!(
+        outln!(
             "  true biases: accel {:.2?} μg, gyro {:.5?} °/h",
             (ba / UG).as_slice(),
             (bg / DPH).as_slice()
@@ -381,12 +391,12 @@ fn print_text(args: &Args, inp: &AlignInput, res: &AlignOutcome, history_rows: u
     }
     if let Some(d) = &args.out.out {
         if rows_len >= 2 {
-            println!(
+            outln!(
                 "wrote {0}/align_result.csv, {0}/align_history.csv, plots {0}/align_attitude.svg/.png, {0}/align_bias.svg/.png, {0}/report.html, {0}/run.toml",
                 d.display()
             );
         } else {
-            println!(
+            outln!(
                 "wrote {0}/align_result.csv, {0}/report.html, {0}/run.toml",
                 d.display()
             );

@@ -68,18 +68,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let svg = plot_svg(&report)?;
     write_string(&args.out.join("allan.svg"), &svg)?;
     plot_png(&report, &args.out.join("allan.png"))?;
+    for w in report.warnings() {
+        eprintln!("warning: {}: {w}", args.imu.display());
+    }
     if args.json {
-        println!("{}", json(&report));
+        outln!("{}", json(&report));
     } else {
-        println!(
+        outln!(
             "{}: format {}, {n} samples, dt {} s, {:.1} s",
             args.imu.display(),
             data.format,
             data.dt_s,
             n as f64 * data.dt_s
         );
-        print!("{}", table(&report));
-        println!(
+        out!("{}", table(&report));
+        outln!(
             "wrote {}/allan.csv, allan.svg, allan.png",
             args.out.display()
         );
@@ -201,7 +204,7 @@ pub fn json(r: &AllanReport) -> String {
             }
         })
         .collect();
-    serde_json::json!({ "channels": ch }).to_string()
+    serde_json::json!({ "channels": ch, "warnings": r.warnings() }).to_string()
 }
 
 /// `allan.csv`: τ and the six deviations (gyro °/h, accelerometer μg).
@@ -435,7 +438,7 @@ mod tests {
             "/../../../shared/data/psins/lasergyro.imu"
         ));
         if !p.exists() {
-            println!("skipped: {} not found", p.display());
+            outln!("skipped: {} not found", p.display());
             return;
         }
         let data = read_imu_file(p, ImuFormat::Auto).unwrap();
@@ -443,8 +446,8 @@ mod tests {
         assert_eq!(data.increments.len(), 184_718);
         assert!((data.dt_s - 0.01).abs() < 1e-15);
         let r = analyse(&data.increments, data.dt_s);
-        println!("{}", table(&r));
-        println!("{}", json(&r));
+        outln!("{}", table(&r));
+        outln!("{}", json(&r));
         // parked: the mean specific force is gravity (header g = 9.780327) along −z FRD
         let n = data.increments.len() as f64;
         let fz: f64 = data.increments.iter().map(|i| i.dv_b_mps[2]).sum::<f64>() / (n * data.dt_s);

@@ -13,14 +13,10 @@
 use crate::args::ImuFormatArg;
 use crate::error::CliError;
 use crate::output::write_string;
-use sdins_sim::align::calibration::run::calibrate_recorded;
-use sdins_sim::align::calibration::run::{
-    calibrate_scenario, group_errors, monte_carlo, CalibrationError, CalibrationRun, GroupMax,
-    MonteCarloSummary,
-};
-use sdins_sim::align::calibration::table::{rows, triad_rows, ParamRow};
+use sdins_sim::align::calibration::request::{calibrate, CalibrateRequest, CalibrateResult};
+use sdins_sim::align::calibration::run::{group_errors, CalibrationError, MonteCarloSummary};
+use sdins_sim::align::calibration::table::ParamRow;
 use sdins_sim::align::calibration::DrawSpec;
-use sdins_sim::io::imu_file::{read_imu_file, ImuFileError};
 use sdins_sim::scenario::Scenario;
 use sdins_sim::sensors::imu_error::{DPH, UG};
 use std::fmt::Write as _;
@@ -66,16 +62,6 @@ pub struct Args {
     pub json: bool,
 }
 
-fn file_error(e: ImuFileError) -> CliError {
-    match e {
-        ImuFileError::Io { file, source } => CliError::Io { path: file, source },
-        other => CliError::BadInput(other.to_string()),
-    }
-}
-
-/// Largest accepted `--runs`.
-const MAX_RUNS: usize = 100_000;
-
 fn pair(option: &str, s: &str) -> Result<(f64, f64), CliError> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let bad = || {
@@ -98,18 +84,6 @@ impl Args {
     fn draw(&self) -> Result<Option<DrawSpec>, CliError> {
         let scale = pair("draw-scale-ppm", &self.draw_scale_ppm)?;
         let mis = pair("draw-misalignment-mrad", &self.draw_misalignment_mrad)?;
-        if scale.1 > 1e5 {
-            return Err(CliError::bad(format!(
-                "--draw-scale-ppm: {} ppm is beyond the small-error model (at most 1e5 ppm)",
-                scale.1
-            )));
-        }
-        if mis.1 > 100.0 {
-            return Err(CliError::bad(format!(
-                "--draw-misalignment-mrad: {} mrad is beyond the small-angle model (at most 100 mrad)",
-                mis.1
-            )));
-        }
         Ok((!self.no_draw).then_some(DrawSpec {
             scale_ppm: scale,
             misalignment_mrad: mis,
@@ -120,6 +94,10 @@ impl Args {
 fn cal_error(e: CalibrationError) -> CliError {
     match e {
         CalibrationError::Cancelled(_) => CliError::Interrupted,
+        CalibrationError::ImuIo(m) => CliError::Other(m),
+        CalibrationError::Draw { key, what } => {
+            CliError::BadInput(format!("--draw-{}: {what}", key.replace('_', "-")))
+        }
         other => CliError::BadInput(other.to_string()),
     }
 }
@@ -141,56 +119,6 @@ fn params_csv(rows: &[ParamRow]) -> String {
         );
     }
     s
-}
-
-fn group_json(g: &GroupMax, bias_unit: &str) -> serde_json::Value {
-    serde_json::json!({
-        format!("bias_{bias_unit}"): g.bias,
-        "scale_ppm": g.scale_ppm,
-        "misalignment_mrad": g.misalignment_mrad,
-    })
-}
-
-/// What one invocation estimated: the parameter rows and, for simulations, the run.
-struct Outcome<'a> {
-    rows: Vec<ParamRow>,
-    samples: u64,
-    first: Option<&'a CalibrationRun>,
-    mc: Option<&'a MonteCarloSummary>,
-    all: &'a [CalibrationRun],
-}
-
-fn summary_json(scn: &Scenario, o: &Outcome<'_>) -> serde_json::Value {
-    let params: Vec<serde_json::Value> = o
-        .rows
-        .iter()
-        .map(|r| {
-            serde_json::json!({
-                "name": r.name, "unit": r.unit, "estimate": r.estimate,
-                "sigma": r.sigma, "truth": r.truth,
-            })
-        })
-        .collect();
-    let mut v = serde_json::json!({
-        "scenario": scn.name,
-        "samples": o.samples,
-        "dt_s": scn.imu.dt_s(),
-        "run": o.first.map(|f| f.run),
-        "nees": o.first.map(|f| f.nees),
-        "nees_dof": sdins_sim::align::calibration::N_PARAMS,
-        "unmodelled_terms": o.first.map_or(Vec::new(), |f| f.unmodelled.clone()),
-        "parameters": params,
-    });
-    if let Some(m) = o.mc {
-        v["monte_carlo"] = serde_json::json!({
-            "runs": m.runs,
-            "mean_nees": m.mean_nees,
-            "nees_band_95": [m.nees_band.0, m.nees_band.1],
-            "gyro_max_abs_error": group_json(&m.gyro_max, "dph"),
-            "accel_max_abs_error": group_json(&m.accel_max, "ug"),
-        });
-    }
-    v
 }
 
 fn param_table(rows: &[ParamRow]) -> Vec<Vec<String>> {
@@ -233,85 +161,24 @@ fn mc_rows(m: &MonteCarloSummary) -> Vec<Vec<String>> {
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    if args.runs == 0 || args.runs > MAX_RUNS {
-        return Err(CliError::bad(format!(
-            "--runs: {} must be in 1..={MAX_RUNS}",
-            args.runs
-        )));
-    }
-    let draw = args.draw()?;
     let scn = Scenario::load(&args.scenario)?;
-    let token = crate::progress::token();
-    if let Some(path) = &args.imu {
-        if args.runs != 1 {
-            return Err(CliError::bad(
-                "--runs: a recorded IMU file is one calibration (Monte Carlo needs a simulated IMU)",
-            ));
-        }
-        let data = read_imu_file(path, args.imu_format.imu_format).map_err(file_error)?;
-        for w in &data.warnings {
-            eprintln!("warning: {w}");
-        }
-        let (g, a) =
-            calibrate_recorded(&scn, &data.increments, data.dt_s, &token).map_err(cal_error)?;
-        let mut rows = triad_rows(&g, None, 'g', (DPH, "deg/h"));
-        rows.extend(triad_rows(&a, None, 'a', (UG, "ug")));
-        let o = Outcome {
-            rows,
-            samples: g.samples,
-            first: None,
-            mc: None,
-            all: &[],
-        };
-        let resid = |v: sdins_core::math::Vec3, unit: f64| {
-            format!("{:.4}, {:.4}, {:.4}", v.x / unit, v.y / unit, v.z / unit)
-        };
-        let note = format!(
-            "residual noise densities: gyro {} °/√h, accelerometer {} μg/√Hz (the 1σ uses {})",
-            resid(g.density_residual, sdins_sim::sensors::imu_error::DPSH),
-            resid(
-                a.density_residual,
-                sdins_sim::sensors::imu_error::UG_PER_SQRT_HZ
-            ),
-            if g.density == g.density_residual {
-                "these"
-            } else {
-                "the scenario's grade"
-            }
-        );
-        return finish(&args, &scn, &o, &format!("{}: {}", path.display(), note));
-    }
-    let (first, all, mc) = if args.runs == 1 {
-        let r = calibrate_scenario(&scn, draw.as_ref(), args.run, &token).map_err(cal_error)?;
-        (r, Vec::new(), None)
-    } else {
-        let (all, s) = monte_carlo(&scn, draw.as_ref(), args.runs, &token).map_err(cal_error)?;
-        let first = all[0].clone();
-        (first, all, Some(s))
+    let req = CalibrateRequest {
+        imu: args.imu.clone(),
+        imu_format: args.imu_format.imu_format,
+        run: args.run,
+        runs: args.runs,
+        draw: args.draw()?,
     };
-    if !first.unmodelled.is_empty() {
-        eprintln!(
-            "warning: the IMU model has terms the estimator does not model ({}): its 1σ is optimistic",
-            first.unmodelled.join(", ")
-        );
+    let res = calibrate(&scn, &req, &crate::progress::token()).map_err(cal_error)?;
+    for w in &res.warnings {
+        eprintln!("warning: {w}");
     }
-    let o = Outcome {
-        rows: rows(&first),
-        samples: first.gyro.samples,
-        first: Some(&first),
-        mc: mc.as_ref(),
-        all: &all,
-    };
-    let note = format!(
-        "run {}: NEES {:.2} (χ²(24): mean 24, 95 % below 36.4)",
-        first.run, first.nees
-    );
-    finish(&args, &scn, &o, &note)
+    finish(&args, &scn, &res)
 }
 
 /// Write the outputs and print the table.
-fn finish(args: &Args, scn: &Scenario, o: &Outcome<'_>, note: &str) -> Result<(), CliError> {
-    let json = summary_json(scn, o);
+fn finish(args: &Args, scn: &Scenario, o: &CalibrateResult) -> Result<(), CliError> {
+    let (json, note) = (o.summary_json(scn), &o.note);
     if let Some(dir) = &args.out {
         crate::output::claim(dir)?;
         write_string(&dir.join("calibration.csv"), &params_csv(&o.rows))?;
@@ -319,7 +186,7 @@ fn finish(args: &Args, scn: &Scenario, o: &Outcome<'_>, note: &str) -> Result<()
             let mut s = String::from(
                 "run,nees,gyro_bias_dph,gyro_scale_ppm,gyro_misalignment_mrad,accel_bias_ug,accel_scale_ppm,accel_misalignment_mrad\n",
             );
-            for r in o.all {
+            for r in &o.all {
                 let g = group_errors(&r.gyro, &r.gyro_truth, DPH);
                 let a = group_errors(&r.accel, &r.accel_truth, UG);
                 let _ = writeln!(
@@ -369,38 +236,51 @@ fn finish(args: &Args, scn: &Scenario, o: &Outcome<'_>, note: &str) -> Result<()
         crate::report::write_run_toml(dir, t)?;
     }
     if args.json {
-        println!("{json}");
+        outln!("{json}");
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: {} samples at {} Hz ({:.0} s); {note}",
         scn.name,
         o.samples,
         scn.imu.rate_hz,
         scn.duration_s(),
     );
-    println!(
+    outln!(
         "{:<8} {:>6} {:>14} {:>12} {:>14} {:>8}",
-        "param", "unit", "estimate", "1σ", "truth", "err/σ"
+        "param",
+        "unit",
+        "estimate",
+        "1σ",
+        "truth",
+        "err/σ"
     );
     for r in param_table(&o.rows) {
-        println!(
+        outln!(
             "{:<8} {:>6} {:>14} {:>12} {:>14} {:>8}",
-            r[0], r[1], r[2], r[3], r[4], r[5]
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            r[4],
+            r[5]
         );
     }
-    if let Some(m) = o.mc {
-        println!(
+    if let Some(m) = &o.mc {
+        outln!(
             "Monte Carlo, {} runs: mean NEES {:.2} (95 % band of χ²(24·{0})/{0}: [{:.2}, {:.2}])",
-            m.runs, m.mean_nees, m.nees_band.0, m.nees_band.1
+            m.runs,
+            m.mean_nees,
+            m.nees_band.0,
+            m.nees_band.1
         );
-        println!("max |error| over runs and axes: bias, scale [ppm], misalignment [mrad]");
+        outln!("max |error| over runs and axes: bias, scale [ppm], misalignment [mrad]");
         for r in mc_rows(m) {
-            println!("  {:<14} {:>14} {:>10} {:>10}", r[0], r[1], r[2], r[3]);
+            outln!("  {:<14} {:>14} {:>10} {:>10}", r[0], r[1], r[2], r[3]);
         }
     }
     if let Some(d) = &args.out {
-        println!(
+        outln!(
             "wrote {0}/calibration.csv, {0}/calibration.json, {0}/report.html, {0}/run.toml{1}",
             d.display(),
             if o.all.is_empty() {
@@ -417,7 +297,7 @@ fn write_report(
     dir: &std::path::Path,
     args: &Args,
     scn: &Scenario,
-    o: &Outcome<'_>,
+    o: &CalibrateResult,
     note: &str,
 ) -> Result<(), CliError> {
     let mut r = crate::report::Report::new(&format!("sdins calibrate: {}", scn.name));
@@ -452,7 +332,7 @@ fn write_report(
         ],
         &param_table(&o.rows),
     );
-    if let Some(m) = o.mc {
+    if let Some(m) = &o.mc {
         r.heading(&format!("Monte Carlo: {} runs", m.runs));
         r.para(&format!(
             "Mean NEES of the 24-vector {:.2}; two-sided 95 % band of χ²(24·{n})/{n}: [{:.2}, {:.2}].",
@@ -471,7 +351,7 @@ fn write_report(
             &mc_rows(m),
         );
     }
-    if let Some(f) = o.first.filter(|f| !f.unmodelled.is_empty()) {
+    if let Some(f) = o.first.as_ref().filter(|f| !f.unmodelled.is_empty()) {
         r.para(&format!(
             "Warning: the IMU model has terms the estimator does not model ({}): the 1σ is optimistic.",
             f.unmodelled.join(", ")

@@ -108,20 +108,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
     schuler_share(&mut r)?;
     let dest = out.join("report.html");
     r.write(&dest)?;
-    println!("\nreport: {}", dest.display());
+    outln!("\nreport: {}", dest.display());
     Ok(())
 }
 
 /// Section 1: Song–Lee Table 1 (Mach 1 due east, 90 min).
 fn song_lee_table1(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), CliError> {
-    println!("== 1. Song-Lee Table 1: Mach 1 due east, 90 min, 2 ms samples, 6 ms updates (docs/validation.md) ==");
+    outln!("== 1. Song-Lee Table 1: Mach 1 due east, 90 min, 2 ms samples, 6 ms updates (docs/validation.md) ==");
     let a1 = execute_full(&run_args("mach1-east", ALL, out.join("mach1-east"), quiet))?;
     print_table(&a1.scn, &a1.sums);
-    println!("paper (S1 Table 1, reconstructed magnitudes):");
-    println!(
-        "  Savage    pos 3.0, 47.1, 557.2 m   vel 3.1, 52.5, 971 mm/s   att 7.1, 0.5, 5.5 urad"
-    );
-    println!(
+    outln!("paper (S1 Table 1, reconstructed magnitudes):");
+    outln!("  Savage    pos 3.0, 47.1, 557.2 m   vel 3.1, 52.5, 971 mm/s   att 7.1, 0.5, 5.5 urad");
+    outln!(
         "  Proposed  pos 0.01, 0.7, 7.8 m     vel 0.05, 0.7, 13.7 mm/s  att 0.1, 0.01, 0.08 urad"
     );
     let mut ratio_text = String::new();
@@ -138,7 +136,7 @@ fn song_lee_table1(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result
             ))
             .min(ratio(sav.final_err.att_err_rad, sl.final_err.att_err_rad));
         ratio_text = format!("Smallest Savage/Song-Lee ratio over all nine components: {q:.1} (the paper claims > 50). East and down agree with the paper within 2 %; the north error does not: the paper prints 0.01 m, we and an independent reconstruction get 0.044 m. The paper states neither its latitude, constants nor exact evaluation time, and the north error of this due-east flight is the small residue of a Schuler oscillation, the component most sensitive to them; we report the difference rather than claim a reproduction.");
-        println!("  {ratio_text}");
+        outln!("  {ratio_text}");
     }
     let t1_header = [
         "row",
@@ -197,7 +195,7 @@ fn song_lee_table1(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result
 
 /// Section 2: the 90°/s turn at Mach 1.
 fn turn_90dps(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), CliError> {
-    println!("\n== 2. 90 deg/s turn from east to south at Mach 1 (docs/validation.md) ==");
+    outln!("\n== 2. 90 deg/s turn from east to south at Mach 1 (docs/validation.md) ==");
     // every update is an output epoch here, so that the end of the turn (the update
     // nearest t = 8 s; 8 s is not a multiple of ΔT = 6 ms) is in the series
     let mut a2_args = run_args("turn-90dps", ALL, out.join("turn-90dps"), quiet);
@@ -248,11 +246,14 @@ fn turn_90dps(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), 
             "".into(),
         ],
     ];
-    println!("attitude error |ε| at the end of the turn (t = 8 s):");
+    outln!("attitude error |ε| at the end of the turn (t = 8 s):");
     for row in &att_rows {
-        println!(
+        outln!(
             "  {:<42} {:>10}  ref {:>20}  S1 {}",
-            row[0], row[1], row[2], row[3]
+            row[0],
+            row[1],
+            row[2],
+            row[3]
         );
     }
     section(
@@ -268,7 +269,7 @@ fn turn_90dps(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), 
 
 /// Section 3: the dual-quaternion paper's case.
 fn dq_paper(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), CliError> {
-    println!("\n== 3. Dual-quaternion paper case: stationary, accelerate, S-turn, 1 Hz coning, 100 Hz IMU, 2 samples (docs/validation.md) ==");
+    outln!("\n== 3. Dual-quaternion paper case: stationary, accelerate, S-turn, 1 Hz coning, 100 Hz IMU, 2 samples (docs/validation.md) ==");
     let b = execute_full(&run_args("dq-paper", ALL, out.join("dq-paper"), quiet))?;
     print_table(&b.scn, &b.sums);
     let mut timing = String::new();
@@ -277,7 +278,7 @@ fn dq_paper(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), Cl
             "Execution time dual quaternion / Savage: {:.2} here (S2: 2.7 in MATLAB; reference prototype 2.2).",
             dq.wall_s / sav.wall_s.max(1e-12)
         );
-        println!("  {timing}");
+        outln!("  {timing}");
     }
     let hrow = |name: &str,
                 s: Option<&sdins_sim::nav::pipeline::RunSummary>,
@@ -315,11 +316,15 @@ fn dq_paper(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), Cl
             "2.66e−6",
         ),
     ];
-    println!("height and down-velocity errors at 420 s (S2: DQ better in height and v_D):");
+    outln!("height and down-velocity errors at 420 s (S2: DQ better in height and v_D):");
     for row in &b_rows {
-        println!(
+        outln!(
             "  {:<26} h {:>11} (ref {:>26})  vD {:>11} (ref {})",
-            row[0], row[1], row[2], row[3], row[4]
+            row[0],
+            row[1],
+            row[2],
+            row[3],
+            row[4]
         );
     }
     section(
@@ -335,12 +340,16 @@ fn dq_paper(r: &mut Report, out: &std::path::Path, quiet: bool) -> Result<(), Cl
 
 /// Section 4: initial alignment on the built-in `alignment` scenario.
 fn alignment(r: &mut Report) -> Result<(), CliError> {
-    println!("\n== 4. Initial alignment: 37.5N, roll/pitch/yaw 2/-3/40 deg, aviation-grade IMU (docs/theory/alignment.md) ==");
+    outln!("\n== 4. Initial alignment: 37.5N, roll/pitch/yaw 2/-3/40 deg, aviation-grade IMU (docs/theory/alignment.md) ==");
     let align_rows = alignment_summary()?;
     for row in &align_rows {
-        println!(
+        outln!(
             "  {:<34} φ N/E/D {:>9} {:>9} {:>10} μrad  {}",
-            row[0], row[1], row[2], row[3], row[4]
+            row[0],
+            row[1],
+            row[2],
+            row[3],
+            row[4]
         );
     }
     r.heading("4. Initial alignment");
@@ -355,7 +364,7 @@ fn alignment(r: &mut Report) -> Result<(), CliError> {
 /// Section 5: the Schuler share by sensor grade.
 fn schuler_share(r: &mut Report) -> Result<(), CliError> {
     // 5. Schuler share (docs/theory/error-analysis.md §"The Schuler share")
-    println!(
+    outln!(
         "\n== 5. Schuler share of the position error by sensor grade ([P2] Table 1, docs/theory/error-analysis.md) =="
     );
     let share = schuler_share_table_p2();
@@ -371,9 +380,12 @@ fn schuler_share(r: &mut Report) -> Result<(), CliError> {
         })
         .collect();
     for row in &share_rows {
-        println!(
+        outln!(
             "  {:<14} accel {:>6} ug  gyro {:>6} deg/h  share {:>6} %",
-            row[0], row[1], row[2], row[3]
+            row[0],
+            row[1],
+            row[2],
+            row[3]
         );
     }
     r.heading("5. Schuler share of the position error by sensor grade");

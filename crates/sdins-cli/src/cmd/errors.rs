@@ -85,7 +85,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let report = &out.report;
     if args.json {
         let s = serde_json::to_string_pretty(report).map_err(|e| CliError::Other(e.to_string()))?;
-        println!("{s}");
+        outln!("{s}");
     } else {
         print_table(report);
     }
@@ -274,11 +274,11 @@ fn write_folder(
 }
 
 fn print_table(r: &ErrorsReport) {
-    println!(
+    outln!(
         "Stationary free-inertial errors, L = {:.3}°, vertical channel held, R0 = {:.0} m, g = {:.6} m/s²",
         r.lat_deg, r.params.r0_m, r.params.g_mps2
     );
-    println!(
+    outln!(
         "NED gyro bias [°/h] = {:?}, accel bias [μg] = {:?}{}",
         r.gyro_bias_dph_ned,
         r.accel_bias_ug_ned,
@@ -287,10 +287,10 @@ fn print_table(r: &ErrorsReport) {
             .map(|g| format!(" (grade {g}, turn-on bias σ, ARW/VRW in σ)"))
             .unwrap_or_default()
     );
-    println!(
+    outln!(
         "closed = closed form of docs/theory/error-analysis.md; nonlin = nonlinear INS (body = NED, spherical earth R0/g, 20 Hz, songlee-complete, vertical held);\nlinear = 15-state model (same biases); 1σ = covariance with the biases as 1σ"
     );
-    println!(
+    outln!(
         "{:>6} | {:>10} {:>10} | {:>10} {:>10} | {:>10} {:>10} | {:>9} {:>9} | {:>9} {:>9} {:>9}",
         "t [h]",
         "dpN clsd",
@@ -312,7 +312,7 @@ fn print_table(r: &ErrorsReport) {
                 .map(f)
                 .unwrap_or_else(|| "—".to_string())
         };
-        println!(
+        outln!(
             "{:>6.2} | {:>10.1} {:>10.1} | {:>10} {:>10} | {:>10.1} {:>10.1} | {:>9.1} {:>9.1} | {:>9.4} {:>9} {:>9.4}",
             e.t_h,
             e.closed_form.dp_n[0],
@@ -334,24 +334,32 @@ fn print_share(json: bool) -> Result<(), CliError> {
     let rows: Vec<ShareRow> = schuler_share_table_p2();
     if json {
         let s = serde_json::to_string_pretty(&rows).map_err(|e| CliError::Other(e.to_string()))?;
-        println!("{s}");
+        outln!("{s}");
         return Ok(());
     }
-    println!(
+    outln!(
         "Schuler share (reconstruction of [P2] Table 1, docs/theory/error-analysis.md): t* = {T_STAR_S} s, L = 37.5°, R0 = 6371 km, g = 9.80665"
     );
-    println!(
+    outln!(
         "{:>13} {:>10} {:>10} {:>10} {:>14}",
-        "grade", "accel [μg]", "gyro [°/h]", "share [%]", "paper [%]"
+        "grade",
+        "accel [μg]",
+        "gyro [°/h]",
+        "share [%]",
+        "paper [%]"
     );
     for r in &rows {
         let paper = grade_by_name(&r.grade)
             .and_then(|g| g.p2.map(|b| b.share_pct))
             .map(|(a, b)| format!("{a:.1}–{b:.1}"))
             .unwrap_or_default();
-        println!(
+        outln!(
             "{:>13} {:>10.1} {:>10.4} {:>10.2} {:>14}",
-            r.grade, r.accel_bias_ug, r.gyro_bias_dph, r.share_pct, paper
+            r.grade,
+            r.accel_bias_ug,
+            r.gyro_bias_dph,
+            r.share_pct,
+            paper
         );
     }
     Ok(())

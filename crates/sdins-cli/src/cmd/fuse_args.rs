@@ -1,17 +1,22 @@
-//! The options of `sdins fuse`, shared by its scenario mode (`cmd/fuse.rs`) and its
-//! recorded-file mode (`cmd/fuse_files.rs`).
+//! The options of `sdins fuse`, shared by its scenario mode (`cmd/fuse.rs`), its
+//! recorded-file mode (`cmd/fuse_files.rs`) and its Monte Carlo (`cmd/fuse_mc.rs`), and
+//! their parsing into the library's typed request
+//! (`sdins_sim::fusion::request::FuseRequest`).
 
 use crate::error::CliError;
+use sdins_sim::fusion::files::InputColumns;
+use sdins_sim::fusion::request::{FilesData, FuseData, FuseRequest, FuseRunError, ScenarioData};
+use sdins_sim::scenario::Scenario;
 use std::path::PathBuf;
 
 /// Arguments of `sdins fuse`.
 #[derive(clap::Args, Debug)]
 #[command(
-    after_help = "The scenario's [gnss] table sets the receiver (default: 1 Hz, σ 1/1/2 m, 0.05/0.05/0.1 m/s).\n\nExample:\n  sdins fuse dq-paper --out out/fuse --json\n  sdins fuse --imu imu1.csv --gnss gnss.csv --navego-params imu1_params.txt --truth ref.csv --samples 1 --smooth"
+    after_help = "The scenario's [gnss] table sets the receiver (default: 1 Hz, σ 1/1/2 m, 0.05/0.05/0.1 m/s).\n\nExample:\n  sdins fuse dq-paper --out out/fuse --json\n  sdins fuse --imu imu1.csv --gnss gnss.csv --navego-params imu1_params.txt --truth ref.csv --samples 1 --smooth\n  sdins fuse dq-paper --grade tactical --no-gate --runs 100 --seed 1 --out out/fuse-mc\n  sdins fuse dq-paper --grade tactical --no-gate --runs 100 --seed 1 --shard 0/2 --out mc/s0\n  sdins fuse --merge mc/s0 mc/s1 --out mc/all"
 )]
 pub struct Args {
     /// built-in scenario name or scenario file (or give --imu and --gnss)
-    #[arg(required_unless_present = "imu", conflicts_with = "imu")]
+    #[arg(required_unless_present_any = ["imu", "merge"], conflicts_with = "imu")]
     pub scenario: Option<String>,
     /// recorded IMU file (with --gnss: fuse recorded data instead of a scenario)
     #[arg(long)]
@@ -28,7 +33,8 @@ pub struct Args {
     /// t_imu − t_gnss [s] when the two files' clocks differ by a constant
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub gnss_offset_s: f64,
-    /// the filter's IMU model from a grade preset (consumer, industrial, tactical, aviation, ...)
+    /// IMU grade preset (marine, aviation, intermediate, tactical, consumer): on a scenario
+    /// the simulated IMU errors and the filter's model, on recorded data the filter's model
     #[arg(long)]
     pub grade: Option<String>,
     /// the filter's IMU model from a NaveGo imuN_params.txt (static bias known, ±10 % residual)
@@ -90,12 +96,173 @@ pub struct Args {
     /// non-holonomic constraint σ [m/s] (off if absent)
     #[arg(long)]
     pub nhc_sigma_mps: Option<f64>,
+    /// output rows every S seconds (the updates nearest to k·S; default: scenarios the
+    /// covariance interval, recorded data every navigation update)
+    #[arg(long)]
+    pub every_s: Option<f64>,
+    /// scenario: stop after this time [s]
+    #[arg(long)]
+    pub until_s: Option<f64>,
+    /// largest age of a measurement at its arrival [s] (older ones are refused and counted)
+    #[arg(long)]
+    pub max_latency_s: Option<f64>,
+    /// scenario: a Monte Carlo of N runs (NEES per state block and NIS per measurement
+    /// kind per output epoch; fuse_mc_stats.csv, fuse_mc_state.json)
+    #[arg(long)]
+    pub runs: Option<u64>,
+    /// Monte Carlo seed of the IMU and GNSS errors (default: the scenario's [imu] seed)
+    #[arg(long, requires = "runs")]
+    pub seed: Option<u64>,
+    /// Monte Carlo: compute shard i of n (0-based, whole blocks of runs)
+    #[arg(long, requires = "runs")]
+    pub shard: Option<String>,
+    /// Monte Carlo: runs per block (all shards must use the same)
+    #[arg(long, requires = "runs", default_value_t = 16)]
+    pub block: u64,
+    /// Monte Carlo with --scale-factors-ppm: draw each run's true scale factors from the
+    /// filter's prior (instead of the scenario's)
+    #[arg(long, requires = "runs")]
+    pub draw_scale_factors: bool,
+    /// Monte Carlo: worker threads (default: all cores)
+    #[arg(long, requires = "runs")]
+    pub threads: Option<usize>,
+    /// merge the fuse Monte Carlo shard folders (or fuse_mc_state.json files) given
+    #[arg(long, num_args = 1.., value_name = "DIR", conflicts_with_all = ["scenario", "imu"])]
+    pub merge: Vec<PathBuf>,
+    /// merge: accept an incomplete set of shards
+    #[arg(long)]
+    pub allow_partial: bool,
+    /// no progress bar
+    #[arg(long)]
+    pub quiet: bool,
     /// print the summary as JSON
     #[arg(long)]
     pub json: bool,
     /// column maps of one's own files
     #[command(flatten)]
     pub columns: crate::args::ColumnsArgs,
+}
+
+/// Three comma-separated finite numbers.
+pub fn triple(name: &str, s: &str) -> Result<[f64; 3], CliError> {
+    let v: Vec<&str> = s.split(',').map(str::trim).collect();
+    if v.len() != 3 {
+        return Err(CliError::bad(format!(
+            "{name}: expected three comma-separated numbers, got `{s}`"
+        )));
+    }
+    let mut out = [0.0; 3];
+    for (o, t) in out.iter_mut().zip(&v) {
+        *o = t
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| CliError::bad(format!("{name}: `{t}` is not a finite number")))?;
+    }
+    Ok(out)
+}
+
+fn opt_triple(name: &str, s: &Option<String>) -> Result<Option<[f64; 3]>, CliError> {
+    s.as_deref().map(|t| triple(name, t)).transpose()
+}
+
+/// A library error as the CLI reports it (bad input: exit 2; cancelled: interrupted).
+pub fn run_err(e: FuseRunError) -> CliError {
+    if e.is_cancelled() {
+        CliError::Interrupted
+    } else {
+        CliError::bad(e.to_string())
+    }
+}
+
+/// The typed request of the command line.
+pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
+    let data = match (&a.imu, &a.scenario) {
+        (Some(imu), _) => {
+            for (flag, given) in [
+                ("--in-motion", a.in_motion),
+                ("--exact-start", a.exact_start),
+                ("--zupt-sigma-mps", a.zupt_sigma_mps.is_some()),
+                ("--runs", a.runs.is_some()),
+                ("--until-s", a.until_s.is_some()),
+            ] {
+                if given {
+                    return Err(CliError::bad(format!(
+                        "{flag} applies to scenarios; on recorded data give --attitude-deg (the heading from the first fixes' track) or --init"
+                    )));
+                }
+            }
+            let gnss = a
+                .gnss
+                .clone()
+                .ok_or_else(|| CliError::bad("--imu needs --gnss FILE"))?;
+            let (imu_map, gnss_map) = a.columns.resolve()?;
+            FuseData::Files(FilesData {
+                imu: (imu.clone(), a.imu_format.parse().map_err(CliError::bad)?),
+                gnss: (gnss, a.gnss_format.parse().map_err(CliError::bad)?),
+                gnss_offset_s: a.gnss_offset_s,
+                navego_params: a.navego_params.clone(),
+                init: a.init.clone(),
+                attitude_deg: opt_triple("--attitude-deg", &a.attitude_deg)?,
+                attitude_sigma_deg: opt_triple("--attitude-sigma-deg", &a.attitude_sigma_deg)?,
+                static_s: a.static_s,
+                lever_arm_m: opt_triple("--lever-arm-m", &a.lever_arm_m)?,
+                truth: a.truth.clone(),
+                columns: InputColumns {
+                    imu: imu_map,
+                    gnss: gnss_map,
+                },
+            })
+        }
+        (None, Some(name)) => {
+            for (flag, given) in [
+                ("--navego-params", a.navego_params.is_some()),
+                ("--init", a.init.is_some()),
+                ("--attitude-deg", a.attitude_deg.is_some()),
+                ("--static-s", a.static_s.is_some()),
+                ("--truth", a.truth.is_some()),
+                ("--lever-arm-m", a.lever_arm_m.is_some()),
+                ("--imu-columns", a.columns.imu_columns.is_some()),
+                ("--gnss-columns", a.columns.gnss_columns.is_some()),
+                ("--profile", a.columns.profile.is_some()),
+                ("--gnss-sigma", a.columns.gnss_sigma.is_some()),
+            ] {
+                if given {
+                    return Err(CliError::bad(format!(
+                        "{flag} applies to recorded data (--imu/--gnss); a scenario sets it in its [imu]/[gnss] tables"
+                    )));
+                }
+            }
+            FuseData::Scenario(ScenarioData {
+                scenario: Scenario::load(name)?,
+                run: a.run,
+                exact_start: a.exact_start,
+                in_motion: a.in_motion,
+                zupt_sigma_mps: a.zupt_sigma_mps,
+            })
+        }
+        (None, None) => {
+            return Err(CliError::bad("give a scenario, or --imu FILE --gnss FILE"));
+        }
+    };
+    let mut req = FuseRequest::new(data);
+    req.grade = a.grade.clone();
+    req.algo = a.algo.clone();
+    req.samples = a.samples;
+    req.cov_rate_hz = a.cov_rate_hz;
+    req.gate = !a.no_gate;
+    req.nhc_sigma_mps = a.nhc_sigma_mps;
+    req.smooth = a.smooth;
+    req.scale_factors = a
+        .scale_factors_ppm
+        .as_deref()
+        .map(scale_factor_prior)
+        .transpose()?;
+    req.every_s = a.every_s;
+    req.until_s = a.until_s;
+    req.max_latency_s = a.max_latency_s;
+    req.check().map_err(run_err)?;
+    Ok(req)
 }
 
 /// `--scale-factors-ppm ACCEL,GYRO`: prior σ of the scale-factor states, in (0, 1e5] ppm.

@@ -1,40 +1,18 @@
 //! `sdins fuse --imu FILE --gnss FILE`: the filter (and smoother) on recorded data. The
-//! work is `sdins_sim::fusion::files::fuse_files`; this parses, writes the CSVs, the report
-//! and prints.
+//! work is the library call `sdins_sim::fusion::request::fuse`; this writes the CSVs,
+//! the report and prints.
 
-use super::fuse_args::Args;
-use super::fuse_report::{ErrRow, FuseReportData, Thin};
-use crate::csv_out::{innovation_row, nav_row, CsvOut, INNOVATION_HEADER, NAV_HEADER};
+use super::fuse_args::{run_err, Args};
+use super::fuse_out::{rmse_rows, with_tables, Plotted};
+use super::fuse_report::{ErrRow, FuseReportData};
+use crate::csv_out::{nav_row, NAV_HEADER};
 use crate::error::CliError;
-use crate::output::AtomicFile;
-use sdins_core::aiding::ekf::{MeasKind, CHI2_999};
-use sdins_core::nav::AlgorithmSpec;
-use sdins_sim::fusion::files::{
-    fuse_files, FilesError, FilesInput, InitSource, InputColumns, SensorModelSource,
+use sdins_sim::fusion::files::FilesResult;
+use sdins_sim::fusion::records::{RecordPoint, TruthComparison, COMPARISON_AXES};
+use sdins_sim::fusion::request::{
+    fuse, FilesData, FuseData, FuseDetails, FuseOutcome, FuseOutput, FuseRequest, FuseRow,
 };
-use sdins_sim::fusion::records::{RecordEvent, RecordOptions, RecordPoint, COMPARISON_AXES};
-use sdins_sim::fusion::simulated::FuseError;
-use sdins_sim::io::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
-use sdins_sim::io::imu_file::ImuFormat;
-use std::path::PathBuf;
-
-fn triple(name: &str, s: &str) -> Result<[f64; 3], CliError> {
-    let v: Vec<&str> = s.split(',').map(str::trim).collect();
-    if v.len() != 3 {
-        return Err(CliError::bad(format!(
-            "{name}: expected three comma-separated numbers, got `{s}`"
-        )));
-    }
-    let mut out = [0.0; 3];
-    for (o, t) in out.iter_mut().zip(&v) {
-        *o = t
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| CliError::bad(format!("{name}: `{t}` is not a finite number")))?;
-    }
-    Ok(out)
-}
+use std::path::{Path, PathBuf};
 
 fn point_row(p: &RecordPoint) -> [f64; 19] {
     let mut row = [0.0; 19];
@@ -48,6 +26,8 @@ fn point_row(p: &RecordPoint) -> [f64; 19] {
 
 fn err_row(p: &RecordPoint, e: &[f64; 9]) -> ErrRow {
     let d = f64::to_degrees;
+    let s = &p.sigma_nav;
+    let se = &p.sigma_euler_rad;
     (
         p.t_s,
         [
@@ -62,15 +42,15 @@ fn err_row(p: &RecordPoint, e: &[f64; 9]) -> ErrRow {
             d(e[2]),
         ],
         [
-            p.sigma_nav[0],
-            p.sigma_nav[1],
-            p.sigma_nav[2],
-            p.sigma_nav[3],
-            p.sigma_nav[4],
-            p.sigma_nav[5],
-            d(p.sigma_euler_rad[0]),
-            d(p.sigma_euler_rad[1]),
-            d(p.sigma_euler_rad[2]),
+            s[0],
+            s[1],
+            s[2],
+            s[3],
+            s[4],
+            s[5],
+            d(se[0]),
+            d(se[1]),
+            d(se[2]),
         ],
     )
 }
@@ -89,98 +69,8 @@ const SIGMA_HEADER: [&str; 9] = [
     "sigma_yaw_deg",
 ];
 
-/// Run `sdins fuse` on files.
-pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
-    let gnss = args
-        .gnss
-        .clone()
-        .ok_or_else(|| CliError::bad("--imu needs --gnss FILE"))?;
-    if args.in_motion {
-        return Err(CliError::bad(
-            "--in-motion applies to scenarios; on recorded data give --attitude-deg (the heading from the first fixes' track) or --init",
-        ));
-    }
-    let imu_format: ImuFormat = args.imu_format.parse().map_err(CliError::bad)?;
-    let (imu_columns, gnss_columns) = args.columns.resolve()?;
-    if imu_columns.is_some() && args.imu_format != "auto" {
-        return Err(CliError::bad(
-            "--imu-format: the IMU file is read through a column map (--imu-columns or the profile): give one",
-        ));
-    }
-    if gnss_columns.is_some() && args.gnss_format != "auto" {
-        return Err(CliError::bad(
-            "--gnss-format: the GNSS file is read through a column map (--gnss-columns or the profile): give one",
-        ));
-    }
-    let gnss_format: GnssFormat = args.gnss_format.parse().map_err(CliError::bad)?;
-    let samples = args.samples.unwrap_or(2);
-    if !(1..=4).contains(&samples) {
-        return Err(CliError::bad(format!(
-            "--samples: must be 1..4, got {samples}"
-        )));
-    }
-    let algo = AlgorithmSpec::from_name(&args.algo, samples)
-        .ok_or_else(|| CliError::bad(format!("--algo: unknown algorithm `{}`", args.algo)))?;
-    let sensor =
-        SensorModelSource::from_options(args.grade.as_deref(), args.navego_params.as_deref())
-            .map_err(CliError::bad)?;
-    let attitude = match &args.attitude_deg {
-        Some(a) => Some(triple("--attitude-deg", a)?),
-        None => None,
-    };
-    let attitude_sigma = match &args.attitude_sigma_deg {
-        Some(s) => Some(triple("--attitude-sigma-deg", s)?),
-        None => None,
-    };
-    let init = InitSource::from_options(
-        args.init.as_deref(),
-        attitude,
-        attitude_sigma,
-        args.static_s,
-        args.navego_params.is_some(),
-    )
-    .map_err(CliError::bad)?;
-    let lever = match &args.lever_arm_m {
-        Some(s) => triple("--lever-arm-m", s)?,
-        None => [0.0; 3],
-    };
-    if !(args.gnss_offset_s.is_finite()) {
-        return Err(CliError::bad("--gnss-offset-s: must be finite"));
-    }
-    let input = FilesInput {
-        imu: (imu.clone(), imu_format),
-        gnss: (gnss.clone(), gnss_format),
-        gnss_options: GnssReadOptions::default(),
-        clock: if args.gnss_offset_s == 0.0 {
-            ImuClock::SameAsGnss
-        } else {
-            ImuClock::Offset {
-                t_imu_minus_t_gnss_s: args.gnss_offset_s,
-            }
-        },
-        sensor,
-        init,
-        truth: args.truth.clone(),
-        check_after_s: 30.0,
-        columns: InputColumns {
-            imu: imu_columns,
-            gnss: gnss_columns,
-        },
-    };
-    let opts = RecordOptions {
-        algo,
-        cov_rate_hz: args.cov_rate_hz,
-        gate_chi2: if args.no_gate { None } else { Some(CHI2_999) },
-        lever_arm_b_m: lever,
-        nhc_sigma_mps: args.nhc_sigma_mps,
-        smooth: args.smooth,
-        scale_factors: args
-            .scale_factors_ppm
-            .as_deref()
-            .map(super::fuse_args::scale_factor_prior)
-            .transpose()?,
-        ..RecordOptions::default()
-    };
+/// The default output folder: `sdins-out/fuse-<IMU file stem>`.
+fn default_out(imu: &Path) -> PathBuf {
     let stem = imu
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -195,235 +85,229 @@ pub fn run(args: Args, imu: PathBuf) -> Result<(), CliError> {
             }
         })
         .collect();
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("sdins-out/fuse-{stem}")));
+    PathBuf::from(format!("sdins-out/fuse-{stem}"))
+}
+
+/// Run `sdins fuse` on files.
+pub fn run(args: &Args, req: &FuseRequest) -> Result<(), CliError> {
+    let FuseData::Files(d) = &req.data else {
+        return Err(CliError::bad("give --imu FILE --gnss FILE"));
+    };
+    let out = args.out.clone().unwrap_or_else(|| default_out(&d.imu.0));
     // nav.csv and smoothed.csv get one row per navigation update (the IMU file's size
     // bounds it; checked before anything is written)
-    let imu_bytes = std::fs::metadata(&imu).map_or(0.0, |m| m.len() as f64);
+    let imu_bytes = std::fs::metadata(&d.imu.0).map_or(0.0, |m| m.len() as f64);
+    let samples = req.samples.unwrap_or(2) as f64;
     crate::output::check_size(
         "nav.csv (and smoothed.csv)",
-        imu_bytes / 40.0 / samples as f64 + 1.0,
+        imu_bytes / 40.0 / samples + 1.0,
         380.0,
         "split the IMU file or raise --samples",
     )?;
     crate::output::claim(&out)?;
-    let mut nav = AtomicFile::create(&out.join("nav.csv"))?;
-    let mut inn = AtomicFile::create(&out.join("innovations.csv"))?;
-    let mut smo = if args.smooth {
-        Some(AtomicFile::create(&out.join("smoothed.csv"))?)
-    } else {
-        None
-    };
-    let point_header = [NAV_HEADER.as_slice(), &SIGMA_HEADER].concat();
-    let mut nav_csv = CsvOut::new(&mut nav, &point_header)?;
-    let mut smo_csv = match smo.as_mut() {
-        Some(f) => Some(CsvOut::new(f, &point_header)?),
-        None => None,
-    };
-    let mut inn_csv = CsvOut::new(&mut inn, &INNOVATION_HEADER)?;
-    let mut werr: Option<CliError> = None;
-    let mut last_fwd: Option<RecordPoint> = None;
-    let mut t_start = None;
-    let mut fwd_rows = Thin::<ErrRow>::new();
-    let mut smo_rows = Thin::<ErrRow>::new();
-    let mut gnss_rows: Vec<(f64, f64, usize, bool)> = Vec::new();
-    let res = fuse_files(&input, &opts, &crate::progress::token(), |ev, err| {
-        if let Some(e) = err {
-            match ev {
-                RecordEvent::Forward(p) => fwd_rows.push(err_row(p, e)),
-                RecordEvent::Smoothed(p) => smo_rows.push(err_row(p, e)),
-                _ => {}
-            }
-        }
-        let r = match ev {
-            RecordEvent::Forward(p) => {
-                t_start.get_or_insert(p.t_s);
-                last_fwd = Some(*p);
-                nav_csv.row(&point_row(p))
-            }
-            RecordEvent::Smoothed(p) => match smo_csv.as_mut() {
-                Some(f) => f.row(&point_row(p)),
-                None => Ok(()),
-            },
-            RecordEvent::Update(u) => {
-                let t = t_start.unwrap_or(0.0) + u.t_s;
-                if u.kind == MeasKind::Gnss {
-                    gnss_rows.push((t, u.nis, u.dof, u.accepted));
+    let mut plot = Plotted::default();
+    let mut last: Option<RecordPoint> = None;
+    let header = [NAV_HEADER.as_slice(), &SIGMA_HEADER].concat();
+    let cancel = crate::progress::token();
+    let o = with_tables(&out, req.smooth, &header, |t| {
+        fuse(req, &cancel, &mut |ev| match ev {
+            FuseOutput::Forward(FuseRow::Files(p, err)) => {
+                if let Some(e) = err {
+                    plot.forward.push(err_row(p, e));
                 }
-                inn_csv.row(&innovation_row(t, u))
+                last = Some(*p);
+                t.nav(&point_row(p));
             }
-            _ => Ok(()),
-        };
-        if let Err(e) = r {
-            werr.get_or_insert(e);
-        }
-    });
-    if let Some(e) = werr {
-        return Err(e);
-    }
-    let r = match res {
-        Ok(r) => r,
-        Err(FilesError::Fuse(FuseError::Cancelled(_))) => return Err(CliError::Interrupted),
-        Err(e) => return Err(CliError::bad(e.to_string())),
-    };
-    nav_csv.finish()?;
-    inn_csv.finish()?;
-    smo_csv.map(CsvOut::finish).transpose()?;
-    nav.commit()?;
-    inn.commit()?;
-    if let Some(f) = smo {
-        f.commit()?;
-    }
-    let v3 = |v: &sdins_core::math::Vec3| [v.x, v.y, v.z];
-    let cmp = |c: &Option<sdins_sim::fusion::records::TruthComparison>| {
-        c.as_ref().map(|c| {
-            let rmse = c.rmse();
-            let inside = c.inside_3sigma();
-            let mut m = serde_json::Map::new();
-            for (i, name) in COMPARISON_AXES.iter().enumerate() {
-                let v = if i < 3 { rmse[i].to_degrees() } else { rmse[i] };
-                m.insert(
-                    (*name).to_string(),
-                    serde_json::json!({"rmse": v, "inside_3sigma": inside[i]}),
-                );
+            FuseOutput::Smoothed(FuseRow::Files(p, err)) => {
+                if let Some(e) = err {
+                    plot.smoothed.push(err_row(p, e));
+                }
+                t.smoothed(&point_row(p));
             }
-            m.insert("matched_epochs".into(), c.matched().into());
-            serde_json::Value::Object(m)
+            FuseOutput::Update(u) => {
+                plot.update(u);
+                t.update(u);
+            }
+            _ => {}
         })
+        .map_err(run_err)
+    })?;
+    let FuseDetails::Files(r) = &o.details else {
+        return Err(CliError::Other(
+            "fuse on files returned no file result".into(),
+        ));
     };
-    let summary = serde_json::json!({
-        "imu": imu.display().to_string(),
-        "imu_format": r.imu_format.name(),
-        "imu_samples": r.imu_samples,
-        "imu_dt_s": r.imu_dt_s,
-        "gnss": gnss.display().to_string(),
-        "gnss_format": r.gnss_format.name(),
-        "fixes_in_span": r.fixes_in_span,
-        "fixes_before_imu": r.fixes_outside.0,
-        "fixes_after_imu": r.fixes_outside.1,
-        "fixes_used": r.summary.fixes_used,
-        "rejected": r.summary.rejected,
-        "algo": args.algo,
-        "samples": samples,
-        "nav_updates": r.summary.nav_updates,
-        "t_start_s": r.summary.t_start_s,
-        "accel_bias_est_mps2": v3(&r.summary.final_bias.0),
-        "gyro_bias_est_rps": v3(&r.summary.final_bias.1),
-        "accel_scale_est_ppm": v3(&(r.summary.final_scale.0 * 1e6)),
-        "gyro_scale_est_ppm": v3(&(r.summary.final_scale.1 * 1e6)),
-        "final": last_fwd.map(|p| serde_json::json!({
-            "t_s": p.t_s, "lat_deg": p.state.lat_rad.to_degrees(), "lon_deg": p.state.lon_rad.to_degrees(), "h_m": p.state.h_m
-        })),
-        "forward_vs_truth": cmp(&r.forward),
-        "smoothed_vs_truth": cmp(&r.smoothed),
-        "units": "rmse: roll/pitch/yaw deg, v m/s, N/E/D m",
-    });
-    let mut fields = toml::Table::new();
-    fields.insert("imu".into(), imu.display().to_string().into());
-    fields.insert("gnss".into(), gnss.display().to_string().into());
-    fields.insert("algo".into(), args.algo.clone().into());
-    fields.insert("samples".into(), (samples as i64).into());
-    fields.insert("cov_rate_hz".into(), args.cov_rate_hz.into());
-    fields.insert("gate".into(), (!args.no_gate).into());
-    fields.insert("smooth".into(), args.smooth.into());
-    if !r.inputs.is_empty() {
-        let mut t = toml::Table::new();
-        for rep in &r.inputs {
-            t.insert(rep.kind.to_string(), rep.to_toml().into());
-        }
-        fields.insert("inputs".into(), t.into());
+    if !plot.forward.pts.is_empty() || !plot.gnss.is_empty() {
+        report(&out, args, d, &o, r, &plot)?;
     }
-    let rm = |c: &Option<sdins_sim::fusion::records::TruthComparison>, name: &str| {
-        c.as_ref().map(|c| {
-            let v = c.rmse();
-            (
-                name.to_string(),
-                [
-                    v[6],
-                    v[7],
-                    v[8],
-                    v[3],
-                    v[4],
-                    v[5],
-                    v[0].to_degrees(),
-                    v[1].to_degrees(),
-                    v[2].to_degrees(),
-                ],
-            )
-        })
-    };
-    let rmse: Vec<(String, [f64; 9])> = [rm(&r.forward, "forward"), rm(&r.smoothed, "smoothed")]
-        .into_iter()
-        .flatten()
-        .collect();
-    if !fwd_rows.pts.is_empty() || !gnss_rows.is_empty() {
-        let fix_interval = gnss_rows
-            .windows(2)
-            .map(|w| w[1].0 - w[0].0)
-            .fold(f64::INFINITY, f64::min);
-        super::fuse_report::write(
-            &out,
-            &FuseReportData {
-                title: format!("sdins fuse: {}", imu.display()),
-                intro: format!(
-                    "{} ({} samples at {} Hz) with {} ({} fixes used, {} rejected), algorithm {} N = {samples}, covariance at {} Hz{}.",
-                    imu.display(),
-                    r.imu_samples,
-                    1.0 / r.imu_dt_s,
-                    gnss.display(),
-                    r.summary.fixes_used,
-                    r.summary.rejected,
-                    args.algo,
-                    args.cov_rate_hz,
-                    match &args.truth {
-                        Some(t) => format!("; reference {}", t.display()),
-                        None => "; no reference: the error plots are empty, give --truth".into(),
-                    }
-                ),
-                att_names: ["roll", "pitch", "yaw"],
-                forward: &fwd_rows,
-                smoothed: args.smooth.then_some(&smo_rows),
-                gnss: &gnss_rows,
-                fix_interval_s: if fix_interval.is_finite() { fix_interval } else { 1.0 },
-                rmse,
-            },
-        )?;
-    }
-    crate::report::write_run_toml(&out, fields)?;
+    crate::report::write_run_toml(&out, run_toml(args, d, r))?;
     for rep in &r.inputs {
         eprintln!("{}", rep.summary());
     }
     for w in &r.imu_warnings {
-        eprintln!("warning: {}: {w}", imu.display());
+        eprintln!("warning: {}: {w}", d.imu.0.display());
     }
     for w in &r.gnss_report.warnings {
-        eprintln!("warning: {}: {w}", gnss.display());
+        eprintln!("warning: {}: {w}", d.gnss.0.display());
     }
     if args.json {
-        println!("{summary:#}");
+        outln!("{:#}", summary(args, d, &o, r, last.as_ref()));
     } else {
-        println!(
-            "sdins fuse {} + {}: {} IMU samples ({}), {} fixes used ({} outside the IMU record skipped), {} rejected; wrote {}",
-            imu.display(),
-            gnss.display(),
-            r.imu_samples,
-            r.imu_format.name(),
-            r.summary.fixes_used,
-            r.fixes_outside.0 + r.fixes_outside.1,
-            r.summary.rejected,
-            out.display()
-        );
-        for (name, c) in [("forward", &r.forward), ("smoothed", &r.smoothed)] {
-            if let Some(c) = c {
-                let rm = c.rmse();
-                println!(
-                    "  {name} RMSE vs truth: roll/pitch/yaw {:.4}/{:.4}/{:.4} deg, v N/E/D {:.4}/{:.4}/{:.4} m/s, N/E/D {:.3}/{:.3}/{:.3} m",
-                    rm[0].to_degrees(), rm[1].to_degrees(), rm[2].to_degrees(), rm[3], rm[4], rm[5], rm[6], rm[7], rm[8]
-                );
-            }
-        }
+        print(d, r, &out);
     }
     Ok(())
+}
+
+fn report(
+    out: &Path,
+    args: &Args,
+    d: &FilesData,
+    o: &FuseOutcome,
+    r: &FilesResult,
+    plot: &Plotted,
+) -> Result<(), CliError> {
+    // the comparison gives roll, pitch, yaw, v, N, E, D; the report N, E, D, v, attitude
+    let order = |v: [f64; 9]| [v[6], v[7], v[8], v[3], v[4], v[5], v[0], v[1], v[2]];
+    super::fuse_report::write(
+        out,
+        &FuseReportData {
+            title: format!("sdins fuse: {}", d.imu.0.display()),
+            intro: format!(
+                "{} ({} samples at {} Hz) with {} ({} fixes used, {} rejected, {} late), algorithm {} N = {}, covariance at {} Hz{}.",
+                d.imu.0.display(),
+                r.imu_samples,
+                1.0 / r.imu_dt_s,
+                d.gnss.0.display(),
+                o.fixes,
+                o.rejected,
+                o.late,
+                args.algo,
+                o.algo.samples,
+                args.cov_rate_hz,
+                match &d.truth {
+                    Some(t) => format!("; reference {}", t.display()),
+                    None => "; no reference: the error plots are empty, give --truth".into(),
+                }
+            ),
+            att_names: ["roll", "pitch", "yaw"],
+            forward: &plot.forward,
+            smoothed: args.smooth.then_some(&plot.smoothed),
+            gnss: &plot.gnss,
+            fix_interval_s: plot.fix_interval_s(),
+            rmse: rmse_rows(
+                &[
+                    ("forward", o.rms_forward.map(order)),
+                    ("smoothed", o.rms_smoothed.map(order)),
+                ],
+                6,
+            ),
+        },
+    )
+}
+
+fn cmp_json(c: &Option<TruthComparison>) -> Option<serde_json::Value> {
+    c.as_ref().map(|c| {
+        let rmse = c.rmse();
+        let inside = c.inside_3sigma();
+        let mut m = serde_json::Map::new();
+        for (i, name) in COMPARISON_AXES.iter().enumerate() {
+            let v = if i < 3 { rmse[i].to_degrees() } else { rmse[i] };
+            m.insert(
+                (*name).to_string(),
+                serde_json::json!({"rmse": v, "inside_3sigma": inside[i]}),
+            );
+        }
+        m.insert("matched_epochs".into(), c.matched().into());
+        serde_json::Value::Object(m)
+    })
+}
+
+fn summary(
+    args: &Args,
+    d: &FilesData,
+    o: &FuseOutcome,
+    r: &FilesResult,
+    last: Option<&RecordPoint>,
+) -> serde_json::Value {
+    let v3 = |v: &sdins_core::math::Vec3| [v.x, v.y, v.z];
+    serde_json::json!({
+        "imu": d.imu.0.display().to_string(),
+        "imu_format": r.imu_format.name(),
+        "imu_samples": r.imu_samples,
+        "imu_dt_s": r.imu_dt_s,
+        "gnss": d.gnss.0.display().to_string(),
+        "gnss_format": r.gnss_format.name(),
+        "fixes_in_span": r.fixes_in_span,
+        "fixes_before_imu": r.fixes_outside.0,
+        "fixes_after_imu": r.fixes_outside.1,
+        "fixes_used": o.fixes,
+        "rejected": o.rejected,
+        "late": o.late,
+        "algo": args.algo,
+        "samples": o.algo.samples,
+        "grade": args.grade,
+        "states": o.layout.n(),
+        "nav_updates": o.nav_updates,
+        "t_start_s": r.summary.t_start_s,
+        "accel_bias_est_mps2": v3(&o.bias_est.0),
+        "gyro_bias_est_rps": v3(&o.bias_est.1),
+        "accel_scale_est_ppm": v3(&(o.scale_est.0 * 1e6)),
+        "gyro_scale_est_ppm": v3(&(o.scale_est.1 * 1e6)),
+        "final": last.map(|p| serde_json::json!({
+            "t_s": p.t_s, "lat_deg": p.state.lat_rad.to_degrees(), "lon_deg": p.state.lon_rad.to_degrees(), "h_m": p.state.h_m
+        })),
+        "forward_vs_truth": cmp_json(&r.forward),
+        "smoothed_vs_truth": cmp_json(&r.smoothed),
+        "inputs": r.inputs.iter().map(|rep| (rep.kind.to_string(), serde_json::Value::String(rep.summary()))).collect::<serde_json::Map<_, _>>(),
+        "units": "rmse: roll/pitch/yaw deg, v m/s, N/E/D m",
+    })
+}
+
+fn run_toml(args: &Args, d: &FilesData, r: &FilesResult) -> toml::Table {
+    let mut f = toml::Table::new();
+    f.insert("imu".into(), d.imu.0.display().to_string().into());
+    f.insert("gnss".into(), d.gnss.0.display().to_string().into());
+    f.insert("algo".into(), args.algo.clone().into());
+    f.insert("samples".into(), (args.samples.unwrap_or(2) as i64).into());
+    f.insert("cov_rate_hz".into(), args.cov_rate_hz.into());
+    f.insert("gate".into(), (!args.no_gate).into());
+    f.insert("smooth".into(), args.smooth.into());
+    if let Some(g) = &args.grade {
+        f.insert("grade".into(), g.clone().into());
+    }
+    if let Some(e) = args.every_s {
+        f.insert("every_s".into(), e.into());
+    }
+    if !r.inputs.is_empty() {
+        // the column maps' time bases, clock origin and offsets (docs/own-data.md)
+        let mut t = toml::Table::new();
+        for rep in &r.inputs {
+            t.insert(rep.kind.to_string(), rep.to_toml().into());
+        }
+        f.insert("inputs".into(), t.into());
+    }
+    f
+}
+
+fn print(d: &FilesData, r: &FilesResult, out: &Path) {
+    outln!(
+        "sdins fuse {} + {}: {} IMU samples ({}), {} fixes used ({} outside the IMU record skipped), {} rejected; wrote {}",
+        d.imu.0.display(),
+        d.gnss.0.display(),
+        r.imu_samples,
+        r.imu_format.name(),
+        r.summary.fixes_used,
+        r.fixes_outside.0 + r.fixes_outside.1,
+        r.summary.rejected,
+        out.display()
+    );
+    for (name, c) in [("forward", &r.forward), ("smoothed", &r.smoothed)] {
+        if let Some(c) = c {
+            let rm = c.rmse();
+            outln!(
+                "  {name} RMSE vs truth: roll/pitch/yaw {:.4}/{:.4}/{:.4} deg, v N/E/D {:.4}/{:.4}/{:.4} m/s, N/E/D {:.3}/{:.3}/{:.3} m",
+                rm[0].to_degrees(), rm[1].to_degrees(), rm[2].to_degrees(), rm[3], rm[4], rm[5], rm[6], rm[7], rm[8]
+            );
+        }
+    }
 }

@@ -78,7 +78,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     write_outputs(&args.out, &merged, &stats)?;
     if args.json {
         let v = summary_json(&merged, &stats, &args.out);
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?
         );

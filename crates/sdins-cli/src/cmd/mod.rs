@@ -9,6 +9,8 @@ pub mod errors;
 pub mod fuse;
 pub mod fuse_args;
 pub mod fuse_files;
+pub mod fuse_mc;
+pub mod fuse_out;
 pub mod fuse_report;
 pub mod merge;
 pub mod montecarlo;

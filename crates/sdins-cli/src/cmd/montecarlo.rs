@@ -233,7 +233,7 @@ pub fn summary_json(state: &McState, stats: &McStats, out: &Path) -> serde_json:
 
 /// Print a short table of the final epoch.
 pub fn print_summary(state: &McState, stats: &McStats, out: &Path) {
-    println!(
+    outln!(
         "Monte Carlo {} / {}: {} of {} runs (seed {}, block {}), {} epochs{}",
         state.job.scenario,
         state.job.algo,
@@ -249,22 +249,31 @@ pub fn print_summary(state: &McState, stats: &McStats, out: &Path) {
         }
     );
     if let (Some(t), Some(row)) = (stats.times_s.last(), stats.cells.last()) {
-        println!("final epoch t = {t} s");
-        println!(
+        outln!("final epoch t = {t} s");
+        outln!(
             "{:>10} {:>12} {:>12} {:>12} {:>12} {:>12}",
-            "channel", "mean", "sigma", "p05", "p50", "p95"
+            "channel",
+            "mean",
+            "sigma",
+            "p05",
+            "p50",
+            "p95"
         );
         for (c, s) in sdins_sim::analysis::montecarlo::CHANNELS
             .iter()
             .zip(row.iter())
         {
-            println!(
+            outln!(
                 "{c:>10} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e}",
-                s.mean, s.sigma, s.p05, s.p50, s.p95
+                s.mean,
+                s.sigma,
+                s.p05,
+                s.p50,
+                s.p95
             );
         }
     }
-    println!("files in {}", out.display());
+    outln!("files in {}", out.display());
 }
 
 /// The job as the library takes it.
@@ -324,7 +333,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     write_outputs(&out, &state, &stats)?;
     if args.json {
         let v = summary_json(&state, &stats, &out);
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?
         );

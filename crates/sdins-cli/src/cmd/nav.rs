@@ -101,7 +101,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if args.json {
         let v = summary_json(&args, &plan, rec.wall_s, rec.errors.last(), final_state);
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?
         );
@@ -176,12 +176,12 @@ fn print_summary(
 ) {
     let (data, spec) = (&plan.data, &plan.spec);
     if let Some(why) = &data.detection {
-        println!("{}: {why}", args.imu.display());
+        outln!("{}: {why}", args.imu.display());
     }
     for w in &data.warnings {
-        println!("{}: warning: {w}", args.imu.display());
+        outln!("{}: warning: {w}", args.imu.display());
     }
-    println!(
+    outln!(
         "{}: {} samples at {} s, {} updates in {:.3} s (navigation only)",
         spec.kind.name(),
         data.increments.len(),
@@ -190,11 +190,11 @@ fn print_summary(
         wall
     );
     if let Some(e) = last {
-        println!(
+        outln!(
             "final errors at t = {} s: pos N,E,D {:.4e} {:.4e} {:.4e} m; vel {:.3e} {:.3e} {:.3e} m/s; att {:.3e} {:.3e} {:.3e} rad",
             e.t_s, e.pos_err_ned_m[0], e.pos_err_ned_m[1], e.pos_err_ned_m[2], e.vel_err_ned_mps[0], e.vel_err_ned_mps[1],
             e.vel_err_ned_mps[2], e.att_err_rad[0], e.att_err_rad[1], e.att_err_rad[2]
         );
     }
-    println!("files in {}", out.display());
+    outln!("files in {}", out.display());
 }

@@ -598,14 +598,14 @@ fn write_report(o: &Outcome) -> Result<(), CliError> {
 
 /// Print a summary table of final errors.
 pub fn print_table(scn: &Scenario, sums: &[RunSummary]) {
-    println!(
+    outln!(
         "scenario {} ({} s, {} Hz IMU, {} samples/update)",
         scn.name,
         scn.duration_s(),
         scn.imu.rate_hz,
         sums.first().map_or(0, |s| s.samples)
     );
-    println!(
+    outln!(
         "{:<17} {:>11} {:>11} {:>11} | {:>10} {:>10} {:>10} | {:>10} {:>10} {:>10} | {:>8} {:>9}",
         "algo",
         "pos N m",
@@ -622,7 +622,7 @@ pub fn print_table(scn: &Scenario, sums: &[RunSummary]) {
     );
     for s in sums {
         let e = &s.final_err;
-        println!(
+        outln!(
             "{:<17} {:>11.4e} {:>11.4e} {:>11.4e} | {:>10.3e} {:>10.3e} {:>10.3e} | {:>10.3e} {:>10.3e} {:>10.3e} | {:>8.3} {:>9.2}",
             s.algo, e.pos_err_ned_m[0], e.pos_err_ned_m[1], e.pos_err_ned_m[2], e.vel_err_ned_mps[0], e.vel_err_ned_mps[1],
             e.vel_err_ned_mps[2], e.att_err_rad[0], e.att_err_rad[1], e.att_err_rad[2], s.wall_s,
@@ -636,13 +636,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (scn, sums, out) = execute(&args)?;
     if args.json {
         let v = serde_json::json!({ "scenario": scn.name, "results": sums });
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| CliError::Other(e.to_string()))?
         );
     } else {
         print_table(&scn, &sums);
-        println!(
+        outln!(
             "errors at t = {} s; files in {}",
             sums.first().map_or(0.0, |s| s.final_err.t_s),
             out.display()

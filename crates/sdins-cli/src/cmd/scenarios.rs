@@ -50,7 +50,7 @@ fn import(args: &Args) -> Result<(), CliError> {
     // validate the result as every scenario is (envelope check included)
     sdins_sim::scenario::Scenario::from_toml(&toml, &file.display().to_string())
         .map_err(|e| CliError::bad(e.to_string()))?;
-    print!("{toml}");
+    out!("{toml}");
     Ok(())
 }
 
@@ -66,15 +66,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     match args.name {
         None => {
-            println!("built-in scenarios (print one with `sdins scenarios NAME`):");
+            outln!("built-in scenarios (print one with `sdins scenarios NAME`):");
             for b in BUILTINS {
-                println!("  {:<12} {}", b.name, b.summary);
+                outln!("  {:<12} {}", b.name, b.summary);
             }
             Ok(())
         }
         Some(n) => match builtin(&n) {
             Some(b) => {
-                print!("{}", b.toml);
+                out!("{}", b.toml);
                 Ok(())
             }
             None => Err(CliError::bad(format!(

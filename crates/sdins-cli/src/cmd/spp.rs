@@ -77,14 +77,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         SppRunError::Cancelled(_) => CliError::Interrupted,
         other => CliError::bad(other.to_string()),
     })?;
-    println!("week,tow_s,x_m,y_m,z_m,clock_bias_m,n_sats,pdop,v_n_mps,v_e_mps,v_d_mps");
+    outln!("week,tow_s,x_m,y_m,z_m,clock_bias_m,n_sats,pdop,v_n_mps,v_e_mps,v_d_mps");
     for e in &run.epochs {
         let s = &e.solution;
         let v = e
             .velocity
             .map(|v| format!("{:.3},{:.3},{:.3}", v.v_n_mps.x, v.v_n_mps.y, v.v_n_mps.z))
             .unwrap_or_else(|| ",,".into());
-        println!(
+        outln!(
             "{},{:.3},{:.3},{:.3},{:.3},{:.3},{},{:.2},{v}",
             e.t.week,
             e.t.sow_s,

@@ -1,78 +1,86 @@
-//! Loosely coupled INS/GNSS error-state extended Kalman filter with closed-loop correction
-//! (Groves 2nd ed. §14.1–§14.3), on top of any [`Mechanization`]. No allocation per step:
-//! every matrix is a fixed-size nalgebra value.
+//! Error-state extended Kalman filter with closed-loop correction (Groves 2nd ed.
+//! §14.1–§14.3) on top of any [`Mechanization`], with a runtime state layout
+//! ([`super::layout`]) at a fixed capacity and one measurement interface
+//! ([`super::meas`]). No allocation: every matrix is a fixed-size value and every product
+//! runs over the active dimension `n` of the layout.
 //!
 //! ## State and conventions
-//! The 15 error states of [`super::error_model`] (δL, δλ, δh; δv^n; ε; b_a; b_g), all
-//! **estimate − truth**, or 21 with the accelerometer and gyro scale factors
-//! (`Ekf<M, 21>`; states 15–20 = `s − ŝ`, random constants with prior σ from P0 and no
-//! process noise). Attitude: convention G of `docs/conventions.md`,
-//! `Ĉ_b^n = (I + [ε×]) C_b^n`. The bias states are the residual errors of the
-//! *compensated* sensor outputs (`f̂ − f`, `ω̂ − ω`, i.e. true bias − estimated bias), so
-//! that `δv̇ ∋ C_b^n b_a` and `ε̇ ∋ C_b^n b_g` as in the error model.
+//! The layout's blocks: navigation (δL, δλ, δh; δv^n; ε) **estimate − truth**, sensor
+//! parameters (IMU biases, optional scale factors, other sensor blocks) **truth −
+//! estimate** (the residual error of the compensated output), so that `δv̇ ∋ C_b^n b_a`
+//! and `ε̇ ∋ C_b^n b_g` as in [`super::error_model`]. Attitude: convention G,
+//! `Ĉ_b^n = (I + [ε×]) C_b^n`.
 //!
 //! ## Propagation
 //! The navigation state is advanced every update by the mechanization with compensated
-//! increments `(Δθ − b̂_g δt) ⊘ (1 + ŝ_g)`, `(Δv − b̂_a δt) ⊘ (1 + ŝ_a)` (per axis; the exact
-//! inverse of the sensor model `f̃ = (1 + s) f + b`; `ŝ = 0` in the 15-state filter). The covariance is propagated at a lower rate,
-//! every `cov_updates` navigation updates (and at every measurement), over the interval
-//! `τ` since the last covariance epoch:
+//! increments `(Δθ − b̂_g δt) ⊘ (1 + ŝ_g)`, `(Δv − b̂_a δt) ⊘ (1 + ŝ_a)` (per axis, the
+//! exact inverse of `f̃ = (1 + s) f + b`; `ŝ = 0` without the scale-factor blocks). The
+//! covariance is propagated every `cov_updates` navigation updates (and at every
+//! measurement) over the interval `τ` since the last covariance epoch:
 //! * `F` of the error model at the epoch's state with the interval-mean specific force
-//!   `f^n = Σ Ĉ_b^n Δv / τ`, plus the bias models: a first-order Gauss–Markov bias of
-//!   steady-state σ and correlation time T has `ḃ = −b/T + w`, `q = 2σ²/T`; `T = ∞` is a
-//!   random constant (optionally plus a random walk of density K, `q = K²`); in the
-//!   21-state filter the scale-factor columns `∂δv̇/∂δs_a = C_b^n diag(f^b)` and
-//!   `∂ε̇/∂δs_g = C_b^n diag(ω_ib^b)` are the interval means `Σ Ĉ diag(Δv)/τ` and
-//!   `Σ Ĉ diag(Δθ)/τ` (Groves 2nd ed. §14.2, the "additional IMU error states");
+//!   `f^n = Σ Ĉ_b^n Δv / τ`, the scale-factor columns `Σ Ĉ diag(Δv)/τ`, `Σ Ĉ diag(Δθ)/τ`
+//!   (Groves §14.2, "additional IMU error states"), and each block's process model;
 //! * `Φ = I + Fτ + (Fτ)²/2 + (Fτ)³/6` (Groves (3.34) truncated, §14.2.3);
-//! * `Q = ½(Φ Q_c Φᵀ + Q_c) τ` (trapezoidal rule), `Q_c = G diag(ARW², VRW², q_b) Gᵀ`, the
-//!   white noises entering through `C_b^n` (Groves §14.2.2);
+//! * `Q = ½(Φ Q_c Φᵀ + Q_c) τ` (trapezoidal rule), `Q_c = G diag(ARW², VRW², q) Gᵀ` with the
+//!   white noises entering through `C_b^n` (Groves §14.2.2), plus the exact discrete noise
+//!   of blocks that declare one (the receiver clock);
 //! * `P⁻ = Φ P Φᵀ + Q`, symmetrised.
 //!
-//! ## Measurements (innovation `ν = ĥ(x̂) − z = H x + noise`)
-//! * GNSS position of the antenna at lever arm `l` (body): `p̂_a = p̂ + Ĉ_b^n l` (Groves
-//!   (14.110)); `ν_p = T (L̂_a − L, λ̂_a − λ, ĥ_a − h)` with `T = diag(R_M+h, (R_N+h)cos L, −1)`
-//!   \[m, NED\]; `H_p = [T, 0, −[(Ĉ l)×], 0, 0]`.
-//! * GNSS velocity: `v̂_a = v̂ + Ĉ (ω̂_eb^b × l)`, `ω_eb^b = ω_ib^b − C_n^b ω_ie^n` (Groves
-//!   (14.111)); `H_v = [0, I, −[(Ĉ(ω × l))×], 0, −Ĉ [l×]]`, and in the 21-state filter
-//!   `−Ĉ [l×] diag(ω_ib^b)` in the gyro scale-factor columns.
-//! * Time of validity: a fix with time `t` inside the last navigation interval
-//!   `(t_{k−1}, t_k]` is compared with the state interpolated to `t` with constant
-//!   acceleration over the interval: `v(t) = v_k − a τ`, `p(t) = p_k − τ (v_k − ½ a τ)`,
-//!   `τ = t_k − t`, `a = (v_k − v_{k−1})/(t_k − t_{k−1})`; the error state is taken as
-//!   constant over τ (it changes on the Schuler time scale). The attitude used for the
-//!   lever arm is `Ĉ(t) = Ĉ_k exp(−[ω_ib^b τ ×])` (the navigation-frame rotation over τ,
-//!   ≤ 1e-4 rad/s · τ, is neglected).
-//! * ZUPT: `ν = v̂^n`, `H = [0, I, 0, 0, 0]`; triggered by the caller (a flag).
-//! * NHC (body frame; the vehicle frame is the body frame here): `ν = (Ĉᵀ v̂)_{y,z}`,
-//!   `H = rows y, z of [0, Ĉᵀ, Ĉᵀ[v̂×], 0, 0]`.
-//!
-//! ## Update
+//! ## Update ([`Ekf::update`], one entry point for every measurement)
 //! `S = H P Hᵀ + R` (Cholesky; failure is [`FilterError::NotPositiveDefinite`]),
 //! `NIS = νᵀ S⁻¹ ν`, `K = P Hᵀ S⁻¹`, `x̂ = K ν`, Joseph form
-//! `P⁺ = (I − KH) P (I − KH)ᵀ + K R Kᵀ` (Groves (3.82)... (3.85) family), symmetrised.
-//! Then the closed-loop correction (Groves §14.1.1): `L −= x̂_L`, …, `v −= δv̂`,
-//! `Ĉ ← exp(−[ε̂×]) Ĉ`, `b̂_a += x̂_ba`, `b̂_g += x̂_bg` (and `ŝ += x̂_s`), `x̂ = 0`.
+//! `P⁺ = (I − KH) P (I − KH)ᵀ + K R Kᵀ` (Groves (3.86)), symmetrised. Then the closed-loop
+//! correction (Groves §14.1.1): `L −= x̂_L`, …, `v −= δv̂`, `Ĉ ← exp(−[ε̂×]) Ĉ`, and every
+//! sensor parameter `p̂ += x̂_p`; `x̂ = 0`.
+//!
+//! ## Measurement timing
+//! * Time of validity inside the last navigation interval `(t_{k−1}, t_k]`: the state at
+//!   `t` by constant acceleration over the interval, `v(t) = v_k − aτ`,
+//!   `p(t) = p_k − τ(v_k − ½aτ)`, `a = (v_k − v_{k−1})/(t_k − t_{k−1})`, `τ = t_k − t`,
+//!   attitude for lever arms `Ĉ(t) = Ĉ_k exp(−[ω_ib^b τ×])`; the error state is taken as
+//!   constant over τ.
+//! * Earlier, up to `max_latency_s` (and the history: [`super::history`]): the same
+//!   interpolation in the stored interval that holds `t`, the model evaluated there, then
+//!   back-propagated to now: `H_now = H_then Φ(t_then, t_now)` and
+//!   `ν' = ν − H_then Σ_i Φ(t_then, t_i) δx̂_i` for the corrections `δx̂_i` applied since,
+//!   with `Φ(t_{i−1}, t_i) = Φ_i⁻¹ ≈ I − F_iτ_i + (F_iτ_i)²/2 − (F_iτ_i)³/6` rebuilt from the
+//!   stored epochs (the interval holding `t_then` with its own F over the part after it).
+//!   Approximation: the process noise between `t_then` and now is neglected in the
+//!   measurement model (see `docs/theory/ins-gnss.md` for the bound).
+//! * Older, or not covered by the history: refused, counted ([`Ekf::late_total`]) and
+//!   reported (`UpdateReport::late`).
 //!
 //! ## Gating and its policy
-//! A GNSS fix whose NIS exceeds the threshold of its degrees of freedom is rejected and
-//! counted. After `max_consecutive_rejections` consecutive rejections the filter assumes
-//! that it, not the receiver, has diverged: the position (and, with a velocity fix,
-//! velocity) rows and columns of P are cleared, their diagonal blocks set to 100 R, and the
-//! fix is applied ungated (a reset of position/velocity onto GNSS).
+//! A gated measurement ([`Measurement::gated`], the GNSS fixes) whose NIS exceeds the
+//! threshold of its degrees of freedom is rejected and counted. After
+//! `max_consecutive_rejections` consecutive rejections of one kind the filter assumes that
+//! it, not the sensor, has diverged: [`Measurement::reset`] re-seeds the covariance of the
+//! observed states and the measurement is applied ungated.
 
-use super::error_model::{
-    f_matrix, position_scale, transition, ModelPoint, StateMatN, StateVecN, I_ATT, I_BA, I_BG,
-    I_POS, I_SA, I_SG, I_VEL, N_STATES,
+use super::error_model::{f_matrix, position_scale, ModelPoint, N_STATES};
+use super::history::{nav_entry_at, EpochEntry, NavEntry, Ring, HIST_EPOCHS, HIST_UPDATES};
+use super::layout::{BlockKind, Cov, Process, StateLayout, XVec};
+use super::linalg::{
+    chol_solve, cholesky, dot, mul, mul_tr, propagate as propagate_p, symmetrize, transition, HMat,
+    KMat, MVec, MAX_ROWS,
 };
+pub use super::meas::{GnssMeasurement, MeasKind};
+use super::meas::{MeasError, MeasModel, MeasPoint, Measurement, Nhc, Zupt};
 use crate::coning::Increment;
 use crate::earth::EarthModel;
-use crate::math::{skew, Mat3, Quat, Vec3};
+use crate::math::{Mat3, Quat, Vec3};
 use crate::nav::{wrap_pi, Mechanization, NavState};
-use nalgebra::{SMatrix, SVector};
+pub use error::FilterError;
 
-/// 99.9 % quantiles of χ² with 1…6 degrees of freedom (default gate).
-pub const CHI2_999: [f64; 6] = [10.828, 13.816, 16.266, 18.467, 20.515, 22.458];
+mod error;
+
+/// 99.9 % quantiles of χ² with 1…12 degrees of freedom (default gate).
+pub const CHI2_999: [f64; MAX_ROWS] = [
+    10.828, 13.816, 16.266, 18.467, 20.515, 22.458, 24.322, 26.124, 27.877, 29.588, 31.264, 32.909,
+];
+
+/// Default largest latency of a measurement \[s\].
+pub const DEFAULT_MAX_LATENCY_S: f64 = 1.0;
 
 /// Sensor noise and bias models of the filter (SI units, per body axis).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -111,6 +119,34 @@ impl Default for NoiseModel {
     }
 }
 
+impl NoiseModel {
+    /// The bias processes per axis (accelerometer, gyro): Gauss–Markov plus random walk,
+    /// `q = K² + 2σ²/T`, `F = −1/T` (a random constant with `T = ∞` and `K = 0`).
+    pub fn bias_processes(&self) -> ([Process; 3], [Process; 3]) {
+        (
+            core::array::from_fn(|i| {
+                Process::gauss_markov_rw(
+                    self.accel_bias_gm_mps2[i],
+                    self.accel_bias_tau_s[i],
+                    self.accel_bias_rw[i],
+                )
+            }),
+            core::array::from_fn(|i| {
+                Process::gauss_markov_rw(
+                    self.gyro_bias_gm_rps[i],
+                    self.gyro_bias_tau_s[i],
+                    self.gyro_bias_rw[i],
+                )
+            }),
+        )
+    }
+    /// The 15-state layout with these bias processes.
+    pub fn layout(&self) -> StateLayout {
+        let (a, g) = self.bias_processes();
+        StateLayout::ins(a, g)
+    }
+}
+
 /// Filter configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EkfConfig {
@@ -120,44 +156,14 @@ pub struct EkfConfig {
     pub dt_s: f64,
     /// navigation updates per covariance epoch (≥ 1)
     pub cov_updates: usize,
-    /// sensor noise and bias models
+    /// white sensor noise (ARW, VRW) driving velocity and attitude
     pub noise: NoiseModel,
-    /// GNSS antenna lever arm from the IMU, body frame \[m\]
-    pub lever_arm_b_m: Vec3,
-    /// NIS gate for GNSS fixes by degrees of freedom 1…6 (`None`: no gating)
-    pub gate_chi2: Option<[f64; 6]>,
-    /// consecutive GNSS rejections before the reset policy (≥ 1)
+    /// NIS gate by degrees of freedom 1…12 (`None`: no gating)
+    pub gate_chi2: Option<[f64; MAX_ROWS]>,
+    /// consecutive rejections of one kind before the reset policy (≥ 1)
     pub max_consecutive_rejections: u32,
-}
-
-/// A GNSS fix as the filter sees it (the antenna's geodetic position, optionally NED
-/// velocity, with their NED covariances).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GnssMeasurement {
-    /// time of validity \[s\] (the navigation time base)
-    pub t_s: f64,
-    /// antenna latitude \[rad\]
-    pub lat_rad: f64,
-    /// antenna longitude \[rad\]
-    pub lon_rad: f64,
-    /// antenna ellipsoidal height \[m\]
-    pub h_m: f64,
-    /// NED position covariance \[m²\]
-    pub pos_cov_ned_m2: Mat3,
-    /// NED velocity \[m/s\] and covariance \[(m/s)²\]
-    pub vel: Option<(Vec3, Mat3)>,
-}
-
-/// Kind of a measurement update.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum MeasKind {
-    /// GNSS position (3) or position + velocity (6)
-    Gnss,
-    /// zero-velocity update
-    Zupt,
-    /// non-holonomic constraint (body y, z velocity)
-    Nhc,
+    /// largest accepted age of a measurement at its application \[s\]
+    pub max_latency_s: f64,
 }
 
 /// Outcome of one measurement.
@@ -165,125 +171,90 @@ pub enum MeasKind {
 pub struct UpdateReport {
     /// filter time at the update \[s\]
     pub t_s: f64,
+    /// the measurement's time of validity \[s\]
+    pub t_valid_s: f64,
     /// measurement kind
     pub kind: MeasKind,
     /// degrees of freedom (measurement dimension)
     pub dof: usize,
-    /// innovation ν (first `dof` entries) \[m, m/s\]
-    pub innovation: [f64; 6],
+    /// innovation ν = ĥ − z (first `dof` entries; back-propagated to the update time
+    /// for a delayed measurement)
+    pub innovation: [f64; MAX_ROWS],
     /// its standard deviations √diag(S)
-    pub sigma: [f64; 6],
-    /// normalised innovation squared νᵀ S⁻¹ ν
+    pub sigma: [f64; MAX_ROWS],
+    /// normalised innovation squared νᵀ S⁻¹ ν (NaN when refused as late)
     pub nis: f64,
-    /// applied (false: rejected by the gate)
+    /// applied (false: rejected by the gate, or late)
     pub accepted: bool,
     /// applied after the reset policy (consecutive rejections)
     pub forced: bool,
+    /// refused: older than the largest latency or than the history
+    pub late: bool,
 }
-
-/// What the filter refuses to continue with.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum FilterError {
-    /// A covariance (P or an innovation covariance S) is not positive definite or not finite.
-    NotPositiveDefinite {
-        /// filter time \[s\]
-        t_s: f64,
-        /// which matrix
-        what: &'static str,
-    },
-    /// The navigation state became non-finite.
-    NonFiniteState {
-        /// filter time \[s\]
-        t_s: f64,
-    },
-    /// A measurement has a non-finite value.
-    BadMeasurement {
-        /// filter time \[s\]
-        t_s: f64,
-    },
-}
-
-impl core::fmt::Display for FilterError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            FilterError::NotPositiveDefinite { t_s, what } => write!(
-                f,
-                "epoch t = {t_s} s: {what} is not finite or not positive definite"
-            ),
-            FilterError::NonFiniteState { t_s } => {
-                write!(f, "epoch t = {t_s} s: navigation state is not finite")
-            }
-            FilterError::BadMeasurement { t_s } => {
-                write!(f, "epoch t = {t_s} s: measurement has a non-finite value")
-            }
-        }
-    }
-}
-
-impl core::error::Error for FilterError {}
 
 /// One covariance epoch k, what a Rauch–Tung–Striebel smoother needs (see
 /// [`super::rts`]): `P(k|k−1) = Φ P(k−1|k−1) Φᵀ + Q`, the covariance after the epoch's
 /// measurements `P(k|k)`, and the sum of the closed-loop corrections `δx̂` applied at the
 /// epoch (the error of the state *before* the corrections is the error after them plus
-/// `dx`).
+/// `dx`). Only the leading `n × n` blocks are meaningful.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CovEpoch<const N: usize = N_STATES> {
+pub struct CovEpoch {
     /// time \[s\]
     pub t_s: f64,
+    /// active dimension
+    pub n: usize,
     /// transition Φ(k, k−1) used from the previous epoch
-    pub phi: StateMatN<N>,
+    pub phi: Cov,
     /// predicted covariance P(k|k−1)
-    pub p_pred: StateMatN<N>,
+    pub p_pred: Cov,
     /// covariance after the epoch's measurements P(k|k) (filled by [`Ekf::take_epoch`])
-    pub p_post: StateMatN<N>,
+    pub p_post: Cov,
     /// sum of the corrections applied at the epoch (filled by [`Ekf::take_epoch`])
-    pub dx: StateVecN<N>,
+    pub dx: XVec,
 }
 
 /// A navigation state corrected by an error estimate `x` (estimate − truth, the states of
 /// [`super::error_model`]): `L −= δL`, `λ −= δλ`, `h −= δh`, `v −= δv`,
 /// `Ĉ ← exp(−[ε×]) Ĉ` (Groves §14.1.1). The filter's closed-loop correction and the
 /// smoother's re-applied corrections both use it (only the first 9 states are read).
-pub fn correct_nav_state<const N: usize>(state: &NavState, x: &StateVecN<N>) -> NavState {
+pub fn correct_nav_state(state: &NavState, x: &XVec) -> NavState {
     let mut s = *state;
-    s.lat_rad -= x[I_POS];
-    s.lon_rad = wrap_pi(s.lon_rad - x[I_POS + 1]);
-    s.h_m -= x[I_POS + 2];
-    s.v_n_mps -= x.fixed_rows::<3>(I_VEL).into_owned();
-    let eps: Vec3 = x.fixed_rows::<3>(I_ATT).into_owned();
+    s.lat_rad -= x[0];
+    s.lon_rad = wrap_pi(s.lon_rad - x[1]);
+    s.h_m -= x[2];
+    s.v_n_mps -= Vec3::new(x[3], x[4], x[5]);
+    let eps = Vec3::new(x[6], x[7], x[8]);
     s.c_b_n = Quat::from_rotvec(&(-eps)).to_dcm() * s.c_b_n;
     s
 }
 
-/// The filter: `N = 15` (biases) or `N = 21` (biases and scale factors).
+/// The filter.
 #[derive(Clone, Debug)]
-pub struct Ekf<M: Mechanization, const N: usize = N_STATES> {
+pub struct Ekf<M: Mechanization> {
     mech: M,
     cfg: EkfConfig,
-    p: StateMatN<N>,
-    b_a: Vec3,
-    b_g: Vec3,
-    /// scale-factor estimates (zero in the 15-state filter)
-    s_a: Vec3,
-    s_g: Vec3,
-    /// Σ Ĉ diag(Δv) and Σ Ĉ diag(Δθ) since the covariance epoch (21 states)
-    sa_acc: Mat3,
-    sg_acc: Mat3,
+    layout: StateLayout,
+    p: Cov,
+    /// sensor-parameter estimates at their block offsets
+    est: XVec,
     prev: NavState,
     cur: NavState,
-    /// Σ Ĉ Δv since the covariance epoch, and its interval
+    /// Σ Ĉ Δv, Σ Ĉ diag(Δv), Σ Ĉ diag(Δθ) since the covariance epoch, and its interval
     f_acc: Vec3,
+    sa_acc: Mat3,
+    sg_acc: Mat3,
     tau_acc: f64,
     updates_acc: usize,
     /// compensated rate of the last update \[rad/s\]
     omega_ib_b: Vec3,
-    last_epoch: Option<CovEpoch<N>>,
+    last_epoch: Option<CovEpoch>,
     /// corrections applied since the last covariance epoch
-    dx_acc: StateVecN<N>,
-    consecutive_rejections: u32,
+    dx_acc: XVec,
+    consecutive: [u32; MeasKind::COUNT],
     rejected_total: u64,
+    late_total: u64,
+    nav_hist: Ring<NavEntry, HIST_UPDATES>,
+    epoch_hist: Ring<EpochEntry, HIST_EPOCHS>,
 }
 
 fn finite_state(s: &NavState) -> bool {
@@ -294,88 +265,121 @@ fn finite_state(s: &NavState) -> bool {
         && s.c_b_n.iter().all(|x| x.is_finite())
 }
 
-fn cov_ok<const N: usize>(p: &StateMatN<N>) -> bool {
-    p.iter().all(|x| x.is_finite()) && (0..N).all(|i| p[(i, i)] >= 0.0)
+fn cov_ok(p: &Cov, n: usize) -> bool {
+    (0..n).all(|j| (0..n).all(|i| p[(i, j)].is_finite())) && (0..n).all(|i| p[(i, i)] >= 0.0)
 }
 
-impl<M: Mechanization, const N: usize> Ekf<M, N> {
-    /// Whether the filter carries the scale-factor states.
-    const SCALE_FACTORS: bool = {
-        assert!(
-            N == N_STATES || N == N_STATES + 6,
-            "the filter has 15 or 21 states"
-        );
-        N > N_STATES
-    };
+fn vec3_at(x: &XVec, o: Option<usize>) -> Vec3 {
+    o.map_or(Vec3::zeros(), |o| Vec3::new(x[o], x[o + 1], x[o + 2]))
+}
 
-    /// New filter on `mech` (at its initial state), initial covariance `p0`, initial bias
-    /// estimates `b_a0` \[m/s²\], `b_g0` \[rad/s\]; scale-factor estimates start at zero
-    /// ([`Ekf::with_scale_factors`] sets them).
-    pub fn new(mech: M, cfg: EkfConfig, p0: StateMatN<N>, b_a0: Vec3, b_g0: Vec3) -> Self {
-        let _ = Self::SCALE_FACTORS;
+impl<M: Mechanization> Ekf<M> {
+    /// New filter on `mech` (at its initial state) with the state layout `layout`, initial
+    /// covariance `p0` (leading `n × n` block used) and initial parameter estimates `est0`
+    /// (b̂_a \[m/s²\] at 9–11, b̂_g \[rad/s\] at 12–14, the other blocks at their offsets).
+    pub fn new(mech: M, cfg: EkfConfig, layout: StateLayout, p0: &Cov, est0: &XVec) -> Self {
         let s = mech.state();
+        let n = layout.n();
+        let mut p = Cov::zeros();
+        for j in 0..n {
+            for i in 0..n {
+                p[(i, j)] = (p0[(i, j)] + p0[(j, i)]) * 0.5;
+            }
+        }
+        let mut est = XVec::zeros();
+        for i in 9..n {
+            est[i] = est0[i];
+        }
+        let entry = EpochEntry {
+            t_s: s.t_s,
+            tau_s: 0.0,
+            lat_rad: s.lat_rad,
+            h_m: s.h_m,
+            v_n_mps: s.v_n_mps,
+            c_b_n: s.c_b_n,
+            f_n_mps2: Vec3::zeros(),
+            sa: Mat3::zeros(),
+            sg: Mat3::zeros(),
+            dx: XVec::zeros(),
+        };
         Self {
             mech,
             cfg,
-            p: (p0 + p0.transpose()) * 0.5,
-            b_a: b_a0,
-            b_g: b_g0,
-            s_a: Vec3::zeros(),
-            s_g: Vec3::zeros(),
-            sa_acc: Mat3::zeros(),
-            sg_acc: Mat3::zeros(),
+            layout,
+            p,
+            est,
             prev: s,
             cur: s,
             f_acc: Vec3::zeros(),
+            sa_acc: Mat3::zeros(),
+            sg_acc: Mat3::zeros(),
             tau_acc: 0.0,
             updates_acc: 0,
             omega_ib_b: Vec3::zeros(),
             last_epoch: None,
-            dx_acc: StateVecN::<N>::zeros(),
-            consecutive_rejections: 0,
+            dx_acc: XVec::zeros(),
+            consecutive: [0; MeasKind::COUNT],
             rejected_total: 0,
+            late_total: 0,
+            nav_hist: Ring::new(NavEntry {
+                prev: s,
+                cur: s,
+                omega_ib_b: Vec3::zeros(),
+            }),
+            epoch_hist: Ring::new(entry),
         }
-    }
-
-    /// Start the scale-factor estimates at `s_a0`, `s_g0` (dimensionless, e.g. 1e-4 =
-    /// 100 ppm); ignored by the 15-state filter.
-    pub fn with_scale_factors(mut self, s_a0: Vec3, s_g0: Vec3) -> Self {
-        if Self::SCALE_FACTORS {
-            self.s_a = s_a0;
-            self.s_g = s_g0;
-        }
-        self
     }
 
     /// Current navigation state (corrected).
     pub fn state(&self) -> NavState {
         self.cur
     }
-    /// Current covariance.
-    pub fn covariance(&self) -> &StateMatN<N> {
+    /// Current covariance (leading `n × n` block).
+    pub fn covariance(&self) -> &Cov {
         &self.p
+    }
+    /// The state layout.
+    pub fn layout(&self) -> &StateLayout {
+        &self.layout
+    }
+    /// Sensor-parameter estimates at their block offsets (zero in the navigation blocks).
+    pub fn estimates(&self) -> &XVec {
+        &self.est
     }
     /// Estimated biases (accelerometer \[m/s²\], gyro \[rad/s\]).
     pub fn biases(&self) -> (Vec3, Vec3) {
-        (self.b_a, self.b_g)
+        (vec3_at(&self.est, Some(9)), vec3_at(&self.est, Some(12)))
     }
-    /// Estimated scale factors (accelerometer, gyro; dimensionless; zero with 15 states).
+    /// Estimated scale factors (accelerometer, gyro; dimensionless; zero without the
+    /// scale-factor blocks).
     pub fn scale_factors(&self) -> (Vec3, Vec3) {
-        (self.s_a, self.s_g)
+        (
+            vec3_at(&self.est, self.layout.offset(BlockKind::AccelScale)),
+            vec3_at(&self.est, self.layout.offset(BlockKind::GyroScale)),
+        )
     }
-    /// GNSS fixes rejected by the gate so far.
+    /// Gated measurements rejected by the gate so far.
     pub fn rejected_total(&self) -> u64 {
         self.rejected_total
+    }
+    /// Measurements refused as older than the largest latency (or the history).
+    pub fn late_total(&self) -> u64 {
+        self.late_total
     }
     /// The configuration.
     pub fn config(&self) -> &EkfConfig {
         &self.cfg
     }
+    /// The mechanization.
+    pub fn mechanization(&self) -> &M {
+        &self.mech
+    }
+
     /// Take the covariance epoch recorded since the last call (for a smoother), with the
     /// current covariance as `P(k|k)` and the corrections applied since the epoch began.
     /// Call it after each navigation update and its measurements: an epoch not taken
     /// before the next covariance propagation is replaced.
-    pub fn take_epoch(&mut self) -> Option<CovEpoch<N>> {
+    pub fn take_epoch(&mut self) -> Option<CovEpoch> {
         self.last_epoch.take().map(|mut e| {
             e.p_post = self.p;
             e.dx = self.dx_acc;
@@ -385,37 +389,41 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
 
     /// The initial epoch (time of the initial state, `Φ = I`, `P(0|−1) = P(0|0) = P0`,
     /// no correction): the first record of a smoother log.
-    pub fn initial_epoch(&self) -> CovEpoch<N> {
+    pub fn initial_epoch(&self) -> CovEpoch {
         CovEpoch {
             t_s: self.cur.t_s,
-            phi: StateMatN::<N>::identity(),
+            n: self.layout.n(),
+            phi: Cov::identity(),
             p_pred: self.p,
             p_post: self.p,
-            dx: StateVecN::<N>::zeros(),
+            dx: XVec::zeros(),
         }
-    }
-    /// The mechanization.
-    pub fn mechanization(&self) -> &M {
-        &self.mech
     }
 
     /// Advance one navigation update with the N raw samples; the covariance every
     /// `cov_updates` updates.
     pub fn propagate(&mut self, samples: &[Increment]) -> Result<(), FilterError> {
         let dt = self.cfg.dt_s;
+        let (b_a, b_g) = self.biases();
+        let (s_a, s_g) = self.scale_factors();
         let mut comp = [Increment::default(); 4];
         let n = samples.len().min(4);
         let mut dv_sum = Vec3::zeros();
         let mut dth_sum = Vec3::zeros();
-        let (k_g, k_a) = (Vec3::repeat(1.0) + self.s_g, Vec3::repeat(1.0) + self.s_a);
+        let (k_g, k_a) = (Vec3::repeat(1.0) + s_g, Vec3::repeat(1.0) + s_a);
         for (c, s) in comp.iter_mut().zip(samples.iter()) {
             *c = Increment::new(
-                (s.dtheta_b_rad - self.b_g * dt).component_div(&k_g),
-                (s.dv_b_mps - self.b_a * dt).component_div(&k_a),
+                (s.dtheta_b_rad - b_g * dt).component_div(&k_g),
+                (s.dv_b_mps - b_a * dt).component_div(&k_a),
             );
             dv_sum += c.dv_b_mps;
             dth_sum += c.dtheta_b_rad;
         }
+        self.nav_hist.push(NavEntry {
+            prev: self.prev,
+            cur: self.cur,
+            omega_ib_b: self.omega_ib_b,
+        });
         let c_before = self.cur.c_b_n;
         self.mech.update(&comp[..n]);
         self.prev = self.cur;
@@ -431,8 +439,10 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
         };
         let c_mid = 0.5 * (c_before + self.cur.c_b_n);
         self.f_acc += c_mid * dv_sum;
-        if Self::SCALE_FACTORS {
+        if self.layout.has(BlockKind::AccelScale) {
             self.sa_acc += c_mid * Mat3::from_diagonal(&dv_sum);
+        }
+        if self.layout.has(BlockKind::GyroScale) {
             self.sg_acc += c_mid * Mat3::from_diagonal(&dth_sum);
         }
         self.tau_acc += tau;
@@ -443,6 +453,43 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
         Ok(())
     }
 
+    /// F and Q_c of the layout at a stored epoch (see the module documentation).
+    fn system(&self, e: &EpochEntry, f: &mut Cov, qc: Option<&mut Cov>) {
+        let pt = ModelPoint::on_earth(
+            &self.cfg.earth,
+            e.lat_rad,
+            e.h_m,
+            e.v_n_mps,
+            e.c_b_n,
+            e.f_n_mps2,
+        );
+        let f15 = f_matrix(&pt, true, false);
+        f.fill(0.0);
+        f.fixed_view_mut::<N_STATES, N_STATES>(0, 0).copy_from(&f15);
+        if let Some(o) = self.layout.offset(BlockKind::AccelScale) {
+            f.fixed_view_mut::<3, 3>(3, o).copy_from(&e.sa);
+        }
+        if let Some(o) = self.layout.offset(BlockKind::GyroScale) {
+            f.fixed_view_mut::<3, 3>(6, o).copy_from(&e.sg);
+        }
+        let mut dummy = Cov::zeros();
+        let qc = match qc {
+            Some(q) => {
+                q.fill(0.0);
+                let nm = &self.cfg.noise;
+                let c = e.c_b_n;
+                let sq = |v: &Vec3| Mat3::from_diagonal(&v.component_mul(v));
+                q.fixed_view_mut::<3, 3>(3, 3)
+                    .copy_from(&(c * sq(&nm.vrw_mps_per_sqrt_s) * c.transpose()));
+                q.fixed_view_mut::<3, 3>(6, 6)
+                    .copy_from(&(c * sq(&nm.arw_rad_per_sqrt_s) * c.transpose()));
+                q
+            }
+            None => &mut dummy,
+        };
+        self.layout.add_processes(f, qc);
+    }
+
     /// Propagate P over the interval accumulated since the last covariance epoch (no-op if
     /// it is empty).
     pub fn propagate_covariance(&mut self) -> Result<(), FilterError> {
@@ -450,52 +497,45 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
         if tau <= 0.0 {
             return Ok(());
         }
-        let s = &self.cur;
-        let f_n = self.f_acc / tau;
-        let pt = ModelPoint::on_earth(&self.cfg.earth, s.lat_rad, s.h_m, s.v_n_mps, s.c_b_n, f_n);
-        let f15 = f_matrix(&pt, true, false);
-        let mut f = StateMatN::<N>::zeros();
-        f.fixed_view_mut::<N_STATES, N_STATES>(0, 0).copy_from(&f15);
-        if Self::SCALE_FACTORS {
-            f.fixed_view_mut::<3, 3>(I_VEL, I_SA)
-                .copy_from(&(self.sa_acc / tau));
-            f.fixed_view_mut::<3, 3>(I_ATT, I_SG)
-                .copy_from(&(self.sg_acc / tau));
-        }
-        let nm = &self.cfg.noise;
-        let mut qc = StateMatN::<N>::zeros();
-        let c = s.c_b_n;
-        let sq = |v: &Vec3| Mat3::from_diagonal(&v.component_mul(v));
-        qc.fixed_view_mut::<3, 3>(I_VEL, I_VEL)
-            .copy_from(&(c * sq(&nm.vrw_mps_per_sqrt_s) * c.transpose()));
-        qc.fixed_view_mut::<3, 3>(I_ATT, I_ATT)
-            .copy_from(&(c * sq(&nm.arw_rad_per_sqrt_s) * c.transpose()));
-        for i in 0..3 {
-            let (ta, sa) = (nm.accel_bias_tau_s[i], nm.accel_bias_gm_mps2[i]);
-            let (tg, sg) = (nm.gyro_bias_tau_s[i], nm.gyro_bias_gm_rps[i]);
-            let mut qa = nm.accel_bias_rw[i] * nm.accel_bias_rw[i];
-            let mut qg = nm.gyro_bias_rw[i] * nm.gyro_bias_rw[i];
-            if ta.is_finite() && ta > 0.0 {
-                f[(I_BA + i, I_BA + i)] = -1.0 / ta;
-                qa += 2.0 * sa * sa / ta;
+        let n = self.layout.n();
+        let s = self.cur;
+        let entry = EpochEntry {
+            t_s: s.t_s,
+            tau_s: tau,
+            lat_rad: s.lat_rad,
+            h_m: s.h_m,
+            v_n_mps: s.v_n_mps,
+            c_b_n: s.c_b_n,
+            f_n_mps2: self.f_acc / tau,
+            sa: self.sa_acc / tau,
+            sg: self.sg_acc / tau,
+            dx: XVec::zeros(),
+        };
+        let (mut f, mut qc, mut phi, mut t, mut q) = (
+            Cov::zeros(),
+            Cov::zeros(),
+            Cov::zeros(),
+            Cov::zeros(),
+            Cov::zeros(),
+        );
+        self.system(&entry, &mut f, Some(&mut qc));
+        transition(&mut phi, &f, tau, n);
+        mul(&mut t, &phi, &qc, n);
+        mul_tr(&mut q, &t, &phi, n);
+        let half = 0.5 * tau;
+        for j in 0..n {
+            for i in 0..n {
+                q[(i, j)] = (q[(i, j)] + qc[(i, j)]) * half;
             }
-            if tg.is_finite() && tg > 0.0 {
-                f[(I_BG + i, I_BG + i)] = -1.0 / tg;
-                qg += 2.0 * sg * sg / tg;
-            }
-            qc[(I_BA + i, I_BA + i)] = qa;
-            qc[(I_BG + i, I_BG + i)] = qg;
         }
-        let phi = transition(&f, tau);
-        let q = (phi * qc * phi.transpose() + qc) * (0.5 * tau);
-        let p = phi * self.p * phi.transpose() + q;
-        self.p = (p + p.transpose()) * 0.5;
+        self.layout.add_exact_q(&mut q, tau);
+        propagate_p(&mut self.p, &phi, &q, n);
         self.f_acc = Vec3::zeros();
         self.sa_acc = Mat3::zeros();
         self.sg_acc = Mat3::zeros();
         self.tau_acc = 0.0;
         self.updates_acc = 0;
-        if !cov_ok(&self.p) {
+        if !cov_ok(&self.p, n) {
             return Err(FilterError::NotPositiveDefinite {
                 t_s: s.t_s,
                 what: "propagated covariance P",
@@ -503,20 +543,24 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
         }
         self.last_epoch = Some(CovEpoch {
             t_s: s.t_s,
+            n,
             phi,
             p_pred: self.p,
             p_post: self.p,
-            dx: StateVecN::<N>::zeros(),
+            dx: XVec::zeros(),
         });
-        self.dx_acc = StateVecN::<N>::zeros();
+        if let Some(last) = self.epoch_hist.back_mut(0) {
+            last.dx = self.dx_acc;
+        }
+        self.epoch_hist.push(entry);
+        self.dx_acc = XVec::zeros();
         Ok(())
     }
 
-    /// The navigation state interpolated to time `t_s` inside (or just before) the last
-    /// update interval, constant acceleration (see the module documentation): (lat, lon,
-    /// h, v^n).
-    fn state_at(&self, t_s: f64) -> (f64, f64, f64, Vec3) {
-        let (p, c) = (&self.prev, &self.cur);
+    /// The state at `t_s` inside the interval `(prev, cur]` by constant acceleration (see
+    /// the module documentation): (lat, lon, h, v^n).
+    fn state_at(&self, prev: &NavState, cur: &NavState, t_s: f64) -> (f64, f64, f64, Vec3) {
+        let (p, c) = (prev, cur);
         let dt = c.t_s - p.t_s;
         let tau = c.t_s - t_s;
         let a = if dt > 0.0 {
@@ -537,189 +581,263 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
         )
     }
 
-    /// Process a GNSS fix whose time of validity lies in the last update interval.
-    pub fn update_gnss(&mut self, m: &GnssMeasurement) -> Result<UpdateReport, FilterError> {
-        let t_now = self.cur.t_s;
-        let finite = m.t_s.is_finite()
-            && m.lat_rad.is_finite()
-            && m.lon_rad.is_finite()
-            && m.h_m.is_finite()
-            && m.pos_cov_ned_m2.iter().all(|x| x.is_finite())
-            && m.vel
-                .is_none_or(|(v, c)| v.iter().chain(c.iter()).all(|x| x.is_finite()));
-        if !finite {
-            return Err(FilterError::BadMeasurement { t_s: t_now });
-        }
-        self.propagate_covariance()?;
-        let (lat, lon, h, v) = self.state_at(m.t_s);
-        // attitude at the time of validity: rotated back by the body rate over τ
-        let tau = self.cur.t_s - m.t_s;
-        let c = self.cur.c_b_n * Quat::from_rotvec(&(-self.omega_ib_b * tau)).to_dcm();
-        let l = self.cfg.lever_arm_b_m;
-        let r = self.cfg.earth.radii(lat);
-        let (_, cl) = libm::sincos(lat);
-        let t = position_scale(r.r_m_m, r.r_n_m, cl, h);
-        let cl_n = c * l;
-        // antenna position predicted: p + C l (NED offset → curvilinear)
-        let nu_p = Vec3::new(
-            (lat - m.lat_rad) * t.x + cl_n.x,
-            wrap_pi(lon - m.lon_rad) * t.y + cl_n.y,
-            -(h - m.h_m) + cl_n.z,
-        );
-        let mut h_p = SMatrix::<f64, 3, N>::zeros();
-        for i in 0..3 {
-            h_p[(i, I_POS + i)] = t[i];
-        }
-        h_p.fixed_view_mut::<3, 3>(0, I_ATT)
-            .copy_from(&(-skew(&cl_n)));
-        let gate = self.cfg.gate_chi2;
-        match m.vel {
-            None => {
-                let rep = self.gated::<3>(&h_p, &nu_p, &m.pos_cov_ned_m2, gate, false)?;
-                Ok(rep)
-            }
-            Some((v_meas, v_cov)) => {
-                let w_ie_n = self.cfg.earth.omega_ie_n(lat);
-                let w_eb = self.omega_ib_b - c.transpose() * w_ie_n;
-                let wl = c * w_eb.cross(&l);
-                let nu_v = v + wl - v_meas;
-                let mut hm = SMatrix::<f64, 6, N>::zeros();
-                hm.fixed_view_mut::<3, N>(0, 0).copy_from(&h_p);
-                for i in 0..3 {
-                    hm[(3 + i, I_VEL + i)] = 1.0;
-                }
-                hm.fixed_view_mut::<3, 3>(3, I_ATT).copy_from(&(-skew(&wl)));
-                hm.fixed_view_mut::<3, 3>(3, I_BG)
-                    .copy_from(&(-(c * skew(&l))));
-                if Self::SCALE_FACTORS {
-                    let w = Mat3::from_diagonal(&self.omega_ib_b);
-                    hm.fixed_view_mut::<3, 3>(3, I_SG)
-                        .copy_from(&(-(c * skew(&l) * w)));
-                }
-                let mut nu = SVector::<f64, 6>::zeros();
-                nu.fixed_rows_mut::<3>(0).copy_from(&nu_p);
-                nu.fixed_rows_mut::<3>(3).copy_from(&nu_v);
-                let mut rm = SMatrix::<f64, 6, 6>::zeros();
-                rm.fixed_view_mut::<3, 3>(0, 0).copy_from(&m.pos_cov_ned_m2);
-                rm.fixed_view_mut::<3, 3>(3, 3).copy_from(&v_cov);
-                self.gated::<6>(&hm, &nu, &rm, gate, true)
-            }
+    fn point<'a>(
+        &'a self,
+        prev: &NavState,
+        cur: &NavState,
+        omega: Vec3,
+        t_s: f64,
+    ) -> MeasPoint<'a> {
+        let (lat, lon, h, v) = self.state_at(prev, cur, t_s);
+        let tau = cur.t_s - t_s;
+        MeasPoint {
+            t_s,
+            lat_rad: lat,
+            lon_rad: lon,
+            h_m: h,
+            v_n_mps: v,
+            c_b_n: cur.c_b_n * Quat::from_rotvec(&(-omega * tau)).to_dcm(),
+            omega_ib_b: omega,
+            earth: &self.cfg.earth,
+            layout: &self.layout,
+            est: &self.est,
         }
     }
 
-    fn gated<const D: usize>(
-        &mut self,
-        h: &SMatrix<f64, D, N>,
-        nu: &SVector<f64, D>,
-        r: &SMatrix<f64, D, D>,
-        gate: Option<[f64; 6]>,
-        with_vel: bool,
-    ) -> Result<UpdateReport, FilterError> {
-        let threshold = gate.map(|g| g[D - 1]);
-        let rep = self.update(MeasKind::Gnss, h, nu, r, threshold)?;
-        if rep.accepted {
-            self.consecutive_rejections = 0;
-            return Ok(rep);
+    /// Apply a measurement (the one entry point): timing, model, gate and its policy,
+    /// Joseph-form update, closed-loop correction.
+    pub fn update(&mut self, m: &dyn Measurement) -> Result<UpdateReport, FilterError> {
+        let t_now = self.cur.t_s;
+        let t_v = m.t_valid_s();
+        let step = (self.cur.t_s - self.prev.t_s).max(1e-9);
+        if !t_v.is_finite() || t_v > t_now + step {
+            return Err(FilterError::BadMeasurement { t_s: t_now });
         }
-        self.rejected_total += 1;
-        self.consecutive_rejections += 1;
-        if self.consecutive_rejections < self.cfg.max_consecutive_rejections.max(1) {
-            return Ok(rep);
+        self.propagate_covariance()?;
+        let bad = |e: MeasError| match e {
+            MeasError::NonFinite => FilterError::BadMeasurement { t_s: t_now },
+            MeasError::MissingBlock(block) => FilterError::MissingBlock { t_s: t_now, block },
+        };
+        let mut model = MeasModel::zeros(0);
+        if t_v >= self.prev.t_s {
+            let pt = self.point(&self.prev, &self.cur, self.omega_ib_b, t_v);
+            m.evaluate(&pt, &mut model).map_err(bad)?;
+            return self.apply(m, &model, None);
         }
-        // reset policy: decorrelate position (and velocity) and re-seed them from the fix
-        self.consecutive_rejections = 0;
-        let t = h.fixed_view::<3, 3>(0, I_POS).diagonal();
-        for i in 0..3 {
-            self.p.row_mut(I_POS + i).fill(0.0);
-            self.p.column_mut(I_POS + i).fill(0.0);
-            if with_vel {
-                self.p.row_mut(I_VEL + i).fill(0.0);
-                self.p.column_mut(I_VEL + i).fill(0.0);
+        let entry = if t_now - t_v <= self.cfg.max_latency_s {
+            nav_entry_at(&self.nav_hist, t_v).copied()
+        } else {
+            None
+        };
+        let back = entry.map(|e| {
+            let pt = self.point(&e.prev, &e.cur, e.omega_ib_b, t_v);
+            let r = m.evaluate(&pt, &mut model);
+            r.map(|_| e.cur.t_s)
+        });
+        let t_entry = match back {
+            Some(r) => r.map_err(bad)?,
+            None => return Ok(self.refuse_late(m)),
+        };
+        let then_model = model.clone();
+        if !self.back_propagate(&mut model, t_v, t_entry) {
+            return Ok(self.refuse_late(m));
+        }
+        self.apply(m, &model, Some(&then_model))
+    }
+
+    fn refuse_late(&mut self, m: &dyn Measurement) -> UpdateReport {
+        self.late_total += 1;
+        UpdateReport {
+            t_s: self.cur.t_s,
+            t_valid_s: m.t_valid_s(),
+            kind: m.kind(),
+            dof: 0,
+            innovation: [0.0; MAX_ROWS],
+            sigma: [0.0; MAX_ROWS],
+            nis: f64::NAN,
+            accepted: false,
+            forced: false,
+            late: true,
+        }
+    }
+
+    /// Map a model evaluated at `t_then` (in the navigation interval ending at `t_entry`)
+    /// to the current error state: `H ← H Φ(t_then, now)`, `ν ← ν − Σ H Φ(t_then, t_i) δx̂_i`
+    /// over the corrections after `t_entry`. `false` when the epoch history does not reach
+    /// back to `t_then`.
+    fn back_propagate(&self, model: &mut MeasModel, t_then: f64, t_entry: f64) -> bool {
+        let n = self.layout.n();
+        let d = model.dim;
+        // the epochs after t_then, oldest first; the first one's interval must hold t_then
+        let mut k_first = None;
+        for k in 0..self.epoch_hist.len() {
+            match self.epoch_hist.back(k) {
+                Some(e) if e.t_s > t_then => k_first = Some(k),
+                _ => break,
             }
         }
-        for i in 0..3 {
-            for j in 0..3 {
-                self.p[(I_POS + i, I_POS + j)] = 100.0 * r[(i, j)] / (t[i] * t[j]);
-                if with_vel {
-                    self.p[(I_VEL + i, I_VEL + j)] = 100.0 * r[(3 + i, 3 + j)];
+        let Some(k_first) = k_first else {
+            return false;
+        };
+        match self.epoch_hist.back(k_first) {
+            Some(e) if e.t_s - e.tau_s <= t_then => {}
+            _ => return false,
+        }
+        let (mut f, mut phi_inv) = (Cov::zeros(), Cov::zeros());
+        let mut h = model.h;
+        let mut s = MVec::zeros();
+        for k in (0..=k_first).rev() {
+            let Some(e) = self.epoch_hist.back(k) else {
+                return false;
+            };
+            let span = if k == k_first {
+                e.t_s - t_then
+            } else {
+                e.tau_s
+            };
+            self.system(e, &mut f, None);
+            transition(&mut phi_inv, &f, -span, n);
+            // h ← h Φ⁻¹ (d × n)
+            let mut next = HMat::zeros();
+            for r in 0..d {
+                for j in 0..n {
+                    let mut acc = 0.0;
+                    for i in 0..n {
+                        acc += h[(r, i)] * phi_inv[(i, j)];
+                    }
+                    next[(r, j)] = acc;
+                }
+            }
+            h = next;
+            if e.t_s > t_entry {
+                let dx = if k == 0 { &self.dx_acc } else { &e.dx };
+                for r in 0..d {
+                    let mut acc = 0.0;
+                    for j in 0..n {
+                        acc += h[(r, j)] * dx[j];
+                    }
+                    s[r] += acc;
                 }
             }
         }
-        let mut forced = self.update(MeasKind::Gnss, h, nu, r, None)?;
+        for r in 0..d {
+            model.nu[r] -= s[r];
+        }
+        model.h = h;
+        true
+    }
+
+    /// Gate, policy and Joseph update of an evaluated model.
+    fn apply(
+        &mut self,
+        m: &dyn Measurement,
+        model: &MeasModel,
+        then_model: Option<&MeasModel>,
+    ) -> Result<UpdateReport, FilterError> {
+        let kind = m.kind();
+        let d = model.dim.clamp(1, MAX_ROWS);
+        let threshold = if m.gated() {
+            self.cfg.gate_chi2.map(|g| g[d - 1])
+        } else {
+            None
+        };
+        let mut rep = self.joseph(kind, model, threshold)?;
+        rep.t_valid_s = m.t_valid_s();
+        if !m.gated() {
+            return Ok(rep);
+        }
+        let c = &mut self.consecutive[kind.index()];
+        if rep.accepted {
+            *c = 0;
+            return Ok(rep);
+        }
+        self.rejected_total += 1;
+        *c += 1;
+        if *c < self.cfg.max_consecutive_rejections.max(1) {
+            return Ok(rep);
+        }
+        *c = 0;
+        m.reset(&mut self.p, then_model.unwrap_or(model), &self.layout);
+        let mut forced = self.joseph(kind, model, None)?;
+        forced.t_valid_s = m.t_valid_s();
         forced.forced = true;
         Ok(forced)
     }
 
-    /// Zero-velocity update with per-axis σ \[m/s\] (the caller decides when the vehicle is
-    /// at rest).
-    pub fn update_zupt(&mut self, sigma_mps: f64) -> Result<UpdateReport, FilterError> {
-        self.propagate_covariance()?;
-        let mut h = SMatrix::<f64, 3, N>::zeros();
-        for i in 0..3 {
-            h[(i, I_VEL + i)] = 1.0;
-        }
-        let r = SMatrix::<f64, 3, 3>::identity() * (sigma_mps * sigma_mps);
-        let nu = self.cur.v_n_mps;
-        self.update(MeasKind::Zupt, &h, &nu, &r, None)
-    }
-
-    /// Non-holonomic constraint: body-frame lateral and vertical velocity zero, σ \[m/s\].
-    pub fn update_nhc(&mut self, sigma_mps: f64) -> Result<UpdateReport, FilterError> {
-        self.propagate_covariance()?;
-        let ct = self.cur.c_b_n.transpose();
-        let v = self.cur.v_n_mps;
-        let v_b = ct * v;
-        let hv = ct;
-        let ha = ct * skew(&v);
-        let mut h = SMatrix::<f64, 2, N>::zeros();
-        for (row, axis) in [1usize, 2].iter().enumerate() {
-            for j in 0..3 {
-                h[(row, I_VEL + j)] = hv[(*axis, j)];
-                h[(row, I_ATT + j)] = ha[(*axis, j)];
-            }
-        }
-        let nu = SVector::<f64, 2>::new(v_b.y, v_b.z);
-        let r = SMatrix::<f64, 2, 2>::identity() * (sigma_mps * sigma_mps);
-        self.update(MeasKind::Nhc, &h, &nu, &r, None)
-    }
-
-    /// Generic update (Joseph form) with optional gate; applies the closed-loop correction.
-    fn update<const D: usize>(
+    /// Joseph-form update with an optional gate; applies the closed-loop correction.
+    fn joseph(
         &mut self,
         kind: MeasKind,
-        h: &SMatrix<f64, D, N>,
-        nu: &SVector<f64, D>,
-        r: &SMatrix<f64, D, D>,
+        model: &MeasModel,
         threshold: Option<f64>,
     ) -> Result<UpdateReport, FilterError> {
+        const R: usize = MAX_ROWS;
         let t_s = self.cur.t_s;
-        let pht = self.p * h.transpose();
-        let s = h * pht + r;
-        let s = (s + s.transpose()) * 0.5;
-        let chol = s.cholesky().ok_or(FilterError::NotPositiveDefinite {
-            t_s,
-            what: "innovation covariance S",
-        })?;
-        let nis = nu.dot(&chol.solve(nu));
+        let n = self.layout.n();
+        let d = model.dim.clamp(1, R);
+        let (h, nu, r) = (&model.h, &model.nu, &model.r);
+        // P Hᵀ (n × d)
+        let mut pht = KMat::zeros();
+        for c in 0..d {
+            for i in 0..n {
+                pht[(i, c)] = self.p[(i, 0)] * h[(c, 0)];
+            }
+            for k in 1..n {
+                let hk = h[(c, k)];
+                for i in 0..n {
+                    pht[(i, c)] += self.p[(i, k)] * hk;
+                }
+            }
+        }
+        // S = H P Hᵀ + R, symmetrised
+        let mut s = [0.0f64; R * R];
+        for b in 0..d {
+            for a in 0..d {
+                let mut acc = h[(a, 0)] * pht[(0, b)];
+                for k in 1..n {
+                    acc += h[(a, k)] * pht[(k, b)];
+                }
+                s[b * R + a] = acc + r[(a, b)];
+            }
+        }
+        for b in 0..d {
+            for a in b..d {
+                let v = (s[b * R + a] + s[a * R + b]) * 0.5;
+                s[b * R + a] = v;
+                s[a * R + b] = v;
+            }
+        }
         let mut rep = UpdateReport {
             t_s,
+            t_valid_s: t_s,
             kind,
-            dof: D,
-            innovation: [0.0; 6],
-            sigma: [0.0; 6],
-            nis,
+            dof: d,
+            innovation: [0.0; R],
+            sigma: [0.0; R],
+            nis: f64::NAN,
             accepted: true,
             forced: false,
+            late: false,
         };
-        for i in 0..D.min(6) {
+        for i in 0..d {
             rep.innovation[i] = nu[i];
-            rep.sigma[i] = libm::sqrt(s[(i, i)]);
+            rep.sigma[i] = libm::sqrt(s[i * R + i]);
         }
+        let mut l = s;
+        let not_pd = FilterError::NotPositiveDefinite {
+            t_s,
+            what: "innovation covariance S",
+        };
+        if !cholesky(&mut l, R, d) {
+            return Err(not_pd);
+        }
+        let mut y = [0.0; R];
+        y[..d].copy_from_slice(&nu.as_slice()[..d]);
+        chol_solve(&l, R, d, &mut y);
+        let nis = dot(&nu.as_slice()[..d], &y[..d]);
+        rep.nis = nis;
         if !nis.is_finite() {
-            return Err(FilterError::NotPositiveDefinite {
-                t_s,
-                what: "innovation covariance S",
-            });
+            return Err(not_pd);
         }
         if let Some(th) = threshold {
             if nis > th {
@@ -727,13 +845,64 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
                 return Ok(rep);
             }
         }
-        // K = P Hᵀ S⁻¹  (solve S Kᵀ = H P)
-        let k: SMatrix<f64, N, D> = chol.solve(&pht.transpose()).transpose();
-        let x = k * nu;
-        let ikh = StateMatN::<N>::identity() - k * h;
-        let p = ikh * self.p * ikh.transpose() + k * r * k.transpose();
-        self.p = (p + p.transpose()) * 0.5;
-        if !cov_ok(&self.p) {
+        // K = P Hᵀ S⁻¹: row i of K solves S kᵢ = (P Hᵀ)ᵢ
+        let mut k = KMat::zeros();
+        for i in 0..n {
+            let mut row = [0.0; R];
+            for (c, v) in row.iter_mut().enumerate().take(d) {
+                *v = pht[(i, c)];
+            }
+            chol_solve(&l, R, d, &mut row);
+            for c in 0..d {
+                k[(i, c)] = row[c];
+            }
+        }
+        // x = K ν
+        let mut x = XVec::zeros();
+        for i in 0..n {
+            x[i] = k[(i, 0)] * nu[0];
+        }
+        for c in 1..d {
+            for i in 0..n {
+                x[i] += k[(i, c)] * nu[c];
+            }
+        }
+        // I − K H
+        let mut ikh = Cov::zeros();
+        for j in 0..n {
+            for i in 0..n {
+                let mut acc = k[(i, 0)] * h[(0, j)];
+                for c in 1..d {
+                    acc += k[(i, c)] * h[(c, j)];
+                }
+                ikh[(i, j)] = if i == j { 1.0 } else { 0.0 } - acc;
+            }
+        }
+        // (I − KH) P (I − KH)ᵀ + K R Kᵀ
+        let (mut a, mut b) = (Cov::zeros(), Cov::zeros());
+        mul(&mut a, &ikh, &self.p, n);
+        mul_tr(&mut b, &a, &ikh, n);
+        let mut kr = KMat::zeros();
+        for c2 in 0..d {
+            for i in 0..n {
+                let mut acc = k[(i, 0)] * r[(0, c2)];
+                for c in 1..d {
+                    acc += k[(i, c)] * r[(c, c2)];
+                }
+                kr[(i, c2)] = acc;
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                let mut acc = kr[(i, 0)] * k[(j, 0)];
+                for c in 1..d {
+                    acc += kr[(i, c)] * k[(j, c)];
+                }
+                self.p[(i, j)] = b[(i, j)] + acc;
+            }
+        }
+        symmetrize(&mut self.p, n);
+        if !cov_ok(&self.p, n) {
             return Err(FilterError::NotPositiveDefinite {
                 t_s,
                 what: "updated covariance P",
@@ -746,15 +915,13 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
         Ok(rep)
     }
 
-    /// Closed-loop correction of the navigation state and biases with the error estimate.
-    fn apply_correction(&mut self, x: &StateVecN<N>) {
+    /// Closed-loop correction of the navigation state and the sensor parameters.
+    fn apply_correction(&mut self, x: &XVec) {
+        let n = self.layout.n();
         self.dx_acc += x;
         let s = correct_nav_state(&self.cur, x);
-        self.b_a += x.fixed_rows::<3>(I_BA).into_owned();
-        self.b_g += x.fixed_rows::<3>(I_BG).into_owned();
-        if Self::SCALE_FACTORS {
-            self.s_a += x.fixed_rows::<3>(I_SA).into_owned();
-            self.s_g += x.fixed_rows::<3>(I_SG).into_owned();
+        for i in 9..n {
+            self.est[i] += x[i];
         }
         // the interpolation base moves with the state
         let d_lat = s.lat_rad - self.cur.lat_rad;
@@ -765,5 +932,23 @@ impl<M: Mechanization, const N: usize> Ekf<M, N> {
         self.prev.v_n_mps += s.v_n_mps - self.cur.v_n_mps;
         self.mech.correct_state(&s);
         self.cur = self.mech.state();
+    }
+
+    /// GNSS fix (position, optionally velocity): [`Ekf::update`] with a
+    /// [`GnssMeasurement`].
+    pub fn update_gnss(&mut self, m: &GnssMeasurement) -> Result<UpdateReport, FilterError> {
+        self.update(m)
+    }
+
+    /// Zero-velocity update now, σ per axis \[m/s\].
+    pub fn update_zupt(&mut self, sigma_mps: f64) -> Result<UpdateReport, FilterError> {
+        let t_s = self.cur.t_s;
+        self.update(&Zupt { t_s, sigma_mps })
+    }
+
+    /// Non-holonomic constraint now, σ \[m/s\].
+    pub fn update_nhc(&mut self, sigma_mps: f64) -> Result<UpdateReport, FilterError> {
+        let t_s = self.cur.t_s;
+        self.update(&Nhc { t_s, sigma_mps })
     }
 }

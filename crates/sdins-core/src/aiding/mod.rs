@@ -1,8 +1,13 @@
-//! Aided navigation: the linear navigation-error model and the INS/GNSS error-state
-//! Kalman filter with closed-loop correction (see `docs/theory/ins-gnss.md`), and the
-//! stationarity (zero-velocity) detector (`docs/theory/aiding-sensors.md`).
+//! Aided navigation: the linear navigation-error model, the state layout, the measurement
+//! interface and the error-state Kalman filter with closed-loop correction, and the
+//! Rauch–Tung–Striebel smoother step (see `docs/theory/ins-gnss.md`); the stationarity
+//! (zero-velocity) detector (`docs/theory/aiding-sensors.md`).
 
 pub mod ekf;
 pub mod error_model;
+pub mod history;
+pub mod layout;
+pub mod linalg;
+pub mod meas;
 pub mod rts;
 pub mod stationarity;

@@ -26,42 +26,50 @@
 //! `P(k+1|k)`.
 
 use super::ekf::{CovEpoch, FilterError};
-#[cfg(test)]
-use super::error_model::{StateMat, StateVec};
-use super::error_model::{StateMatN, StateVecN, N_STATES};
+use super::layout::{Cov, XVec, MAX_STATES};
+use super::linalg::{chol_solve, cholesky, mul, mul_tr, mul_vec, symmetrize};
 
-/// The smoothed error estimate and covariance at one epoch.
+/// The smoothed error estimate and covariance at one epoch (leading `n` entries).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Smoothed<const N: usize = N_STATES> {
+pub struct Smoothed {
     /// `ê⁺_k`: smoothed estimate of the error of the forward corrected state
-    pub dx: StateVecN<N>,
+    pub dx: XVec,
     /// smoothed covariance `P_s(k)`
-    pub p: StateMatN<N>,
+    pub p: Cov,
 }
 
-impl<const N: usize> Smoothed<N> {
+impl Smoothed {
     /// The start of the backward pass at the last epoch: `ê = 0`, `P_s = P(N|N)`.
-    pub fn last(epoch: &CovEpoch<N>) -> Self {
+    pub fn last(epoch: &CovEpoch) -> Self {
         Self {
-            dx: StateVecN::<N>::zeros(),
+            dx: XVec::zeros(),
             p: epoch.p_post,
         }
     }
 }
 
 /// One backward step: from the smoothed result at epoch k+1 (`next`, whose forward record
-/// is `rec_next`) to epoch k (forward record `rec`).
-pub fn rts_step<const N: usize>(
-    rec: &CovEpoch<N>,
-    rec_next: &CovEpoch<N>,
-    next: &Smoothed<N>,
-) -> Result<Smoothed<N>, FilterError> {
+/// is `rec_next`) to epoch k (forward record `rec`), over the active dimension of
+/// `rec_next`.
+pub fn rts_step(
+    rec: &CovEpoch,
+    rec_next: &CovEpoch,
+    next: &Smoothed,
+) -> Result<Smoothed, FilterError> {
+    let n = rec_next.n.min(MAX_STATES);
     let pp = &rec_next.p_pred;
     // P(k+1|k) restricted to the states that carry variance
-    let scale = pp.diagonal().amax().max(f64::MIN_POSITIVE);
-    let mut active = [false; N];
+    let mut scale = 0.0f64;
+    for i in 0..n {
+        let d = pp[(i, i)].abs();
+        if d > scale {
+            scale = d;
+        }
+    }
+    let scale = scale.max(f64::MIN_POSITIVE);
+    let mut active = [false; MAX_STATES];
     let mut m = *pp;
-    for (i, a) in active.iter_mut().enumerate() {
+    for (i, a) in active.iter_mut().enumerate().take(n) {
         *a = pp[(i, i)] > scale * 1e-300;
         if !*a {
             m.row_mut(i).fill(0.0);
@@ -69,22 +77,52 @@ pub fn rts_step<const N: usize>(
             m[(i, i)] = 1.0;
         }
     }
-    let chol = m.cholesky().ok_or(FilterError::NotPositiveDefinite {
-        t_s: rec_next.t_s,
-        what: "predicted covariance P(k+1|k) in the smoother",
-    })?;
+    if !cholesky(m.as_mut_slice(), MAX_STATES, n) {
+        return Err(FilterError::NotPositiveDefinite {
+            t_s: rec_next.t_s,
+            what: "predicted covariance P(k+1|k) in the smoother",
+        });
+    }
     // A = P Φᵀ M⁻¹  ⇔  M Aᵀ = Φ P
-    let b = rec_next.phi * rec.p_post;
-    let mut a = chol.solve(&b).transpose();
-    for (j, act) in active.iter().enumerate() {
+    let mut b = Cov::zeros();
+    mul(&mut b, &rec_next.phi, &rec.p_post, n);
+    let mut a = Cov::zeros();
+    let mut col = [0.0; MAX_STATES];
+    for j in 0..n {
+        for (i, c) in col.iter_mut().enumerate().take(n) {
+            *c = b[(i, j)];
+        }
+        chol_solve(m.as_slice(), MAX_STATES, n, &mut col);
+        // column j of Aᵀ = row j of A
+        for (i, c) in col.iter().enumerate().take(n) {
+            a[(j, i)] = *c;
+        }
+    }
+    for (j, act) in active.iter().enumerate().take(n) {
         if !act {
             a.column_mut(j).fill(0.0);
         }
     }
-    let dx = a * (next.dx + rec_next.dx);
-    let p = rec.p_post + a * (next.p - pp) * a.transpose();
-    let p = (p + p.transpose()) * 0.5;
-    if !(p.iter().all(|x| x.is_finite()) && dx.iter().all(|x| x.is_finite())) {
+    let v = next.dx + rec_next.dx;
+    let dx = mul_vec(&a, &v, n);
+    let mut d = Cov::zeros();
+    for j in 0..n {
+        for i in 0..n {
+            d[(i, j)] = next.p[(i, j)] - pp[(i, j)];
+        }
+    }
+    let (mut t, mut u) = (Cov::zeros(), Cov::zeros());
+    mul(&mut t, &a, &d, n);
+    mul_tr(&mut u, &t, &a, n);
+    let mut p = Cov::zeros();
+    for j in 0..n {
+        for i in 0..n {
+            p[(i, j)] = rec.p_post[(i, j)] + u[(i, j)];
+        }
+    }
+    symmetrize(&mut p, n);
+    let finite = (0..n).all(|j| dx[j].is_finite() && (0..n).all(|i| p[(i, j)].is_finite()));
+    if !finite {
         return Err(FilterError::NotPositiveDefinite {
             t_s: rec.t_s,
             what: "smoothed covariance",
@@ -134,10 +172,11 @@ mod tests {
         // state is (nominal − truth); the correction δx̂ = K (nominal − z)
         let blank = CovEpoch {
             t_s: 0.0,
-            phi: StateMat::identity(),
-            p_pred: StateMat::identity(),
-            p_post: StateMat::identity(),
-            dx: StateVec::zeros(),
+            n: 15,
+            phi: Cov::identity(),
+            p_pred: Cov::identity(),
+            p_post: Cov::identity(),
+            dx: XVec::zeros(),
         };
         let mut recs = [blank; N];
         let mut nominal = [0.0; N];
@@ -180,10 +219,11 @@ mod tests {
     fn zero_variance_states_do_not_break_the_step() {
         let mut rec = CovEpoch {
             t_s: 0.0,
-            phi: StateMat::identity(),
-            p_pred: StateMat::identity(),
-            p_post: StateMat::identity(),
-            dx: StateVec::zeros(),
+            n: 15,
+            phi: Cov::identity(),
+            p_pred: Cov::identity(),
+            p_post: Cov::identity(),
+            dx: XVec::zeros(),
         };
         rec.p_post[(14, 14)] = 0.0;
         let mut next = rec;

@@ -278,6 +278,19 @@ pub struct AllanReport {
     pub curves: Vec<AllanCurve>,
     /// one fit per channel
     pub fits: Vec<AllanFit>,
+    /// is the record static (an Allan deviation assumes it)? None for records shorter
+    /// than two test windows or without noise
+    pub static_check: Option<super::static_check::StaticCheck>,
+}
+
+impl AllanReport {
+    /// The warnings the result carries (a record that does not look static).
+    pub fn warnings(&self) -> Vec<String> {
+        self.static_check
+            .and_then(|c| c.warning("an Allan deviation"))
+            .into_iter()
+            .collect()
+    }
 }
 
 /// The six Allan curves and fits (gyro x, y, z, accelerometer x, y, z) of FRD
@@ -292,7 +305,13 @@ pub fn analyse(incs: &[sdins_core::coning::Increment], dt_s: f64) -> AllanReport
         curves.push(allan_deviation(&rate, dt_s));
     }
     let fits = curves.iter().map(fit).collect();
-    AllanReport { curves, fits }
+    let mut report = AllanReport {
+        curves,
+        fits,
+        static_check: None,
+    };
+    report.static_check = super::static_check::check(incs, dt_s, &report);
+    report
 }
 
 #[cfg(test)]

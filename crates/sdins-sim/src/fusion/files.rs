@@ -10,17 +10,17 @@ use crate::fusion::records::{
     TruthComparison,
 };
 use crate::fusion::simulated::{FuseError, InitSigma};
+use crate::io::columns::ColumnsError;
+use crate::io::gnss_columns::{read_gnss_columns, GnssColumns};
+use crate::io::gnss_file::TimeBase;
 use crate::io::gnss_file::{
     clip_to_imu_span, imu_span_s, read_gnss_file, to_imu_time, GnssFileError, GnssFormat,
     GnssReadOptions, GnssReadReport, ImuClock,
 };
-use crate::io::columns::ColumnsError;
-use crate::io::gnss_columns::{read_gnss_columns, GnssColumns};
-use crate::io::gnss_file::TimeBase;
 use crate::io::imu_columns::{read_imu_columns, ImuColumns, InputReport};
 use crate::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
-use crate::io::time::{ClockScale, RunClock};
 use crate::io::navego_params::{read_navego_imu_params, NavegoImuParams, ParamsError};
+use crate::io::time::{ClockScale, RunClock};
 use crate::io::truth_file::{read_truth, TruthFileError};
 use crate::sensors::imu_error::ImuErrorModel;
 use sdins_core::nav::InitialState;
@@ -241,7 +241,10 @@ pub fn fuse_files(
                     crate::io::columns::TimeKind::GpsSow
                         if c.gps_week.is_none() && c.map.get("week").is_none() =>
                     {
-                        (alone(ClockScale::GpsWeekUnknown), TimeBase::GpsSecondsOfWeek)
+                        (
+                            alone(ClockScale::GpsWeekUnknown),
+                            TimeBase::GpsSecondsOfWeek,
+                        )
                     }
                     _ => (alone(ClockScale::Gpst), TimeBase::GpsSecondsSinceEpoch),
                 },

@@ -1,8 +1,13 @@
-//! Aided navigation: INS/GNSS fusion on scenarios ([`simulated`]) and on recorded data
-//! ([`records`], with the file front end [`files`]), and the Rauch–Tung–Striebel smoother
-//! ([`smoother`]). The filter itself is `sdins_core::aiding`.
+//! Aided navigation: one fusion loop ([`engine`]) over a stream of events, fed by
+//! scenarios ([`simulated`], the stream from [`scenario_stream`]) and by recorded data
+//! ([`records`], with the file front end [`files`]); the Rauch–Tung–Striebel smoother
+//! ([`smoother`]); the `sdins fuse` request as one library call ([`request`]). The filter
+//! itself is `sdins_core::aiding`.
 
+pub mod engine;
 pub mod files;
 pub mod records;
+pub mod request;
+pub mod scenario_stream;
 pub mod simulated;
 pub mod smoother;

@@ -28,25 +28,27 @@
 //! `sdins_core::aiding::ekf`).
 
 use crate::cancel::CancelToken;
-use crate::fusion::simulated::{noise_from_model, FuseError, InitSigma, ScaleFactorPrior};
-use crate::fusion::smoother::SmootherLog;
+use crate::fusion::engine::{run_engine, EngineEvent, Event, Row, Start};
+use crate::fusion::simulated::{
+    engine_config, noise_from_model, FuseError, InitSigma, ScaleFactorPrior,
+};
 use crate::io::imu_file::ImuData;
 use crate::io::navego_params::NavegoImuParams;
 use crate::sensors::gnss_fix::GnssFix;
 use crate::sensors::imu_error::{ImuErrorModel, DEG};
-use sdins_core::aiding::ekf::{
-    correct_nav_state, Ekf, EkfConfig, GnssMeasurement, NoiseModel, UpdateReport, CHI2_999,
-};
+use sdins_core::aiding::ekf::{NoiseModel, UpdateReport, CHI2_999, DEFAULT_MAX_LATENCY_S};
 use sdins_core::aiding::error_model::{
-    position_scale, StateMat, StateMatN, StateVecN, I_ATT, I_BA, I_BG, I_POS, I_SA, I_SG, I_VEL,
-    N_STATES, N_STATES_SF,
+    position_scale, StateMat, I_ATT, I_BA, I_BG, I_POS, I_VEL, N_STATES,
 };
+use sdins_core::aiding::layout::{BlockKind, Cov, StateLayout, XVec};
+use sdins_core::aiding::linalg::MAX_ROWS;
+use sdins_core::aiding::meas::MeasKind;
 use sdins_core::align::coarse::{align as coarse_align, CoarseMethod, StaticMean};
 use sdins_core::align::Site;
 use sdins_core::coning::Increment;
 use sdins_core::earth::EarthModel;
-use sdins_core::math::{c_b_n_from_euler, Euler, Mat3, Quat, Vec3};
-use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, NavState};
+use sdins_core::math::{c_b_n_from_euler, Euler, Mat3, Vec3};
+use sdins_core::nav::{AlgorithmSpec, InitialState, NavState};
 
 /// The filter's model of a recorded IMU: noise and bias models, bias priors and the
 /// known bias that is subtracted (initial bias estimate).
@@ -154,8 +156,8 @@ pub struct RecordOptions {
     pub earth: EarthModel,
     /// covariance propagation rate \[Hz\]
     pub cov_rate_hz: f64,
-    /// NIS gate by dof 1…6 (None: no gating)
-    pub gate_chi2: Option<[f64; 6]>,
+    /// NIS gate by dof 1…12 (None: no gating)
+    pub gate_chi2: Option<[f64; MAX_ROWS]>,
     /// consecutive rejections before the reset policy
     pub max_consecutive_rejections: u32,
     /// GNSS antenna lever arm, body FRD \[m\]
@@ -167,6 +169,10 @@ pub struct RecordOptions {
     pub smooth: bool,
     /// estimate accelerometer and gyro scale factors (the 21-state filter)
     pub scale_factors: Option<ScaleFactorPrior>,
+    /// output rows near `t_start + k·every_s` \[s\] (None: every navigation update)
+    pub every_s: Option<f64>,
+    /// largest latency of a measurement \[s\]
+    pub max_latency_s: f64,
 }
 
 impl Default for RecordOptions {
@@ -181,11 +187,13 @@ impl Default for RecordOptions {
             nhc_sigma_mps: None,
             smooth: false,
             scale_factors: None,
+            every_s: None,
+            max_latency_s: DEFAULT_MAX_LATENCY_S,
         }
     }
 }
 
-/// One output point (a navigation update).
+/// One output point (an output row of the loop: by default every navigation update).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RecordPoint {
     /// time on the IMU file's clock \[s\]
@@ -227,6 +235,8 @@ pub struct RecordSummary {
     pub fixes_used: u64,
     /// fixes rejected by the gate
     pub rejected: u64,
+    /// measurements refused as late
+    pub late: u64,
     /// navigation updates
     pub nav_updates: u64,
     /// covariance epochs
@@ -241,6 +251,8 @@ pub struct RecordSummary {
     pub final_scale: (Vec3, Vec3),
     /// bytes held by the smoother log (0 without smoothing)
     pub smoother_bytes: usize,
+    /// the state layout
+    pub layout: StateLayout,
 }
 
 /// The matrix `M` of the first-order Euler-angle errors in terms of the attitude error
@@ -275,7 +287,7 @@ struct Sig {
     scale: [f64; 6],
 }
 
-fn sigmas<const N: usize>(p: &StateMatN<N>, c_b_n: &Mat3, scale: &Vec3) -> Sig {
+fn sigmas(p: &Cov, layout: &StateLayout, c_b_n: &Mat3, scale: &Vec3) -> Sig {
     let sd = |i: usize| p[(i, i)].max(0.0).sqrt();
     let mut nav = [0.0; 9];
     for i in 0..3 {
@@ -296,9 +308,13 @@ fn sigmas<const N: usize>(p: &StateMatN<N>, c_b_n: &Mat3, scale: &Vec3) -> Sig {
         *bi = sd(I_BA + i);
     }
     let mut sf = [0.0; 6];
-    if N > N_STATES {
-        for (i, si) in sf.iter_mut().enumerate() {
-            *si = sd(I_SA + i);
+    if let (Some(a), Some(g)) = (
+        layout.offset(BlockKind::AccelScale),
+        layout.offset(BlockKind::GyroScale),
+    ) {
+        for i in 0..3 {
+            sf[i] = sd(a + i);
+            sf[3 + i] = sd(g + i);
         }
     }
     Sig {
@@ -309,51 +325,48 @@ fn sigmas<const N: usize>(p: &StateMatN<N>, c_b_n: &Mat3, scale: &Vec3) -> Sig {
     }
 }
 
-/// Sensor-error estimates of an epoch: biases and scale factors (accel, gyro).
-type Est = ((Vec3, Vec3), (Vec3, Vec3));
-
 fn scale_at(earth: &EarthModel, s: &NavState) -> Vec3 {
     let r = earth.radii(s.lat_rad);
     position_scale(r.r_m_m, r.r_n_m, s.lat_rad.cos(), s.h_m)
 }
 
-/// Compact forward state kept for the smoother (88 bytes).
-#[derive(Clone, Copy, Debug)]
-struct Compact {
-    t_s: f64,
-    lat: f64,
-    lon: f64,
-    h: f64,
-    v: [f64; 3],
-    q: [f64; 4],
-}
-
-impl Compact {
-    fn of(s: &NavState) -> Self {
-        let q = Quat::from_dcm(&s.c_b_n);
-        Self {
-            t_s: s.t_s,
-            lat: s.lat_rad,
-            lon: s.lon_rad,
-            h: s.h_m,
-            v: [s.v_n_mps.x, s.v_n_mps.y, s.v_n_mps.z],
-            q: [q.w, q.x, q.y, q.z],
-        }
-    }
-    fn state(&self) -> NavState {
-        NavState {
-            t_s: self.t_s,
-            lat_rad: self.lat,
-            lon_rad: self.lon,
-            h_m: self.h,
-            v_n_mps: Vec3::from(self.v),
-            c_b_n: Quat::new(self.q[0], self.q[1], self.q[2], self.q[3]).to_dcm(),
-        }
-    }
-}
-
 fn opt_err(name: &'static str, msg: impl Into<String>) -> FuseError {
     FuseError::Option(name, msg.into())
+}
+
+/// The event stream of a record: the IMU samples from the navigation start, each fix
+/// delivered before the sample during which it arrives (its time is its time of validity
+/// and its arrival).
+struct RecordStream<'a> {
+    incs: &'a [Increment],
+    fixes: &'a [GnssFix],
+    t_start_s: f64,
+    dt_s: f64,
+    i: usize,
+    f: usize,
+}
+
+impl Iterator for RecordStream<'_> {
+    type Item = Event;
+    fn next(&mut self) -> Option<Event> {
+        let inc = self.incs.get(self.i)?;
+        let t_end = self.t_start_s + self.dt_s * (self.i + 1) as f64;
+        if let Some(fix) = self.fixes.get(self.f) {
+            if fix.t_s <= t_end + 1e-6 {
+                self.f += 1;
+                return Some(Event::Gnss {
+                    fix: *fix,
+                    arrival_s: fix.t_s,
+                });
+            }
+        }
+        self.i += 1;
+        Some(Event::Imu {
+            t_s: t_end,
+            inc: *inc,
+            truth: None,
+        })
+    }
 }
 
 /// Run the filter (and the smoother) over recorded data. `fixes` must be on the IMU
@@ -366,42 +379,173 @@ pub fn fuse_records(
     init: &RecordInit,
     opts: &RecordOptions,
     cancel: &CancelToken,
-    observe: impl FnMut(RecordEvent<'_>),
-) -> Result<RecordSummary, FuseError> {
-    match opts.scale_factors {
-        None => records_impl::<N_STATES>(imu, fixes, model, init, opts, cancel, observe),
-        Some(_) => records_impl::<N_STATES_SF>(imu, fixes, model, init, opts, cancel, observe),
-    }
-}
-
-fn records_impl<const N: usize>(
-    imu: &ImuData,
-    fixes: &[GnssFix],
-    model: &RecordModel,
-    init: &RecordInit,
-    opts: &RecordOptions,
-    cancel: &CancelToken,
     mut observe: impl FnMut(RecordEvent<'_>),
 ) -> Result<RecordSummary, FuseError> {
     let dt = imu.dt_s;
     let n = opts.algo.samples.clamp(1, 4);
-    let nav_rate = 1.0 / (dt * n as f64);
-    if !(opts.cov_rate_hz.is_finite() && opts.cov_rate_hz > 0.0 && opts.cov_rate_hz <= nav_rate) {
-        return Err(opt_err(
-            "cov_rate_hz",
-            format!("must be in (0, {nav_rate}] Hz, got {}", opts.cov_rate_hz),
-        ));
-    }
-    let cov_updates = (nav_rate / opts.cov_rate_hz).round().max(1.0) as usize;
     let earth = opts.earth;
     let lever = Vec3::from(opts.lever_arm_b_m);
     if fixes.is_empty() {
         return Err(opt_err("gnss", "no GNSS fix inside the IMU record"));
     }
+    let (start_k, init_state, p0, skip_fixes) = initial(imu, fixes, model, init, &earth, lever)?;
+    crate::io::initial::validate_initial_state(&init_state)
+        .map_err(|e| opt_err("init", e.to_string()))?;
+    if !p0.iter().all(|x| x.is_finite()) {
+        return Err(opt_err("init", "initial covariance is not finite"));
+    }
+    let mut layout = model.noise.layout();
+    let mut p0n = Cov::zeros();
+    p0n.fixed_view_mut::<N_STATES, N_STATES>(0, 0)
+        .copy_from(&p0);
+    if let Some(sp) = &opts.scale_factors {
+        sp.validate()?;
+        layout = layout
+            .with_scale_factors()
+            .map_err(|e| opt_err("scale_factors", e.to_string()))?;
+        let (a, g) = (
+            layout.offset(BlockKind::AccelScale),
+            layout.offset(BlockKind::GyroScale),
+        );
+        if let (Some(a), Some(g)) = (a, g) {
+            for i in 0..3 {
+                p0n[(a + i, a + i)] = (sp.accel_ppm[i] * 1e-6).powi(2);
+                p0n[(g + i, g + i)] = (sp.gyro_ppm[i] * 1e-6).powi(2);
+            }
+        }
+    }
+    let mut est0 = XVec::zeros();
+    for i in 0..3 {
+        est0[I_BA + i] = model.accel_bias0_mps2[i];
+        est0[I_BG + i] = model.gyro_bias0_rps[i];
+    }
     // record start: the first interval begins one sample before the first stamp
+    let t_rec0 = imu.t0_s - dt;
+    let t_start = t_rec0 + dt * start_k as f64;
+    let samples = &imu.increments[start_k.min(imu.increments.len())..];
+    let total = (samples.len() / n) as u64;
+    let mut cfg = engine_config(
+        opts.algo,
+        earth,
+        dt,
+        opts.cov_rate_hz,
+        model.noise,
+        lever,
+        Some(opts.every_s.unwrap_or(dt * n as f64)),
+        total,
+    )?;
+    cfg.gate_chi2 = opts.gate_chi2;
+    cfg.max_consecutive_rejections = opts.max_consecutive_rejections;
+    cfg.max_latency_s = opts.max_latency_s;
+    cfg.nhc_sigma_mps = opts.nhc_sigma_mps;
+    cfg.smooth = opts.smooth;
+    // fixes before the navigation start (and the initialising one) are not used
+    let mut first = skip_fixes;
+    while first < fixes.len() && fixes[first].t_s - t_start <= 1e-9 {
+        first += 1;
+    }
+    let mut stream = RecordStream {
+        incs: samples,
+        fixes: &fixes[first.min(fixes.len())..],
+        t_start_s: t_start,
+        dt_s: dt,
+        i: 0,
+        f: 0,
+    };
+    let start = Start {
+        t_start_s: t_start,
+        state: init_state,
+        layout,
+        p0: p0n,
+        est0,
+        truth: None,
+    };
+    // σ of the forward rows change only at covariance epochs (cached by epoch), of the
+    // smoothed rows they come from the backward pass
+    let mut cached: Option<(usize, Sig)> = None;
+    let mut smoothed: Vec<Sig> = Vec::new();
+    let point = |row: &Row<'_>, sig: &Sig| {
+        let (a, g) = (
+            row.layout.offset(BlockKind::AccelScale),
+            row.layout.offset(BlockKind::GyroScale),
+        );
+        RecordPoint {
+            t_s: row.t_s,
+            state: *row.state,
+            bias: (vec3_at(row.est, Some(I_BA)), vec3_at(row.est, Some(I_BG))),
+            sigma_nav: sig.nav,
+            sigma_euler_rad: sig.eul,
+            sigma_bias: sig.bias,
+            scale: (vec3_at(row.est, a), vec3_at(row.est, g)),
+            sigma_scale: sig.scale,
+        }
+    };
+    let mut sink = |ev: EngineEvent<'_>| match ev {
+        EngineEvent::Forward(row) => {
+            let sig = match (cached, row.p) {
+                (Some((e, s)), _) if e == row.epoch => s,
+                (_, Some(p)) => {
+                    let c = row.cov_state;
+                    let s = sigmas(p, row.layout, &c.c_b_n, &scale_at(&earth, c));
+                    cached = Some((row.epoch, s));
+                    s
+                }
+                _ => Sig::default(),
+            };
+            observe(RecordEvent::Forward(&point(row, &sig)));
+        }
+        EngineEvent::Update(u) => observe(RecordEvent::Update(u)),
+        EngineEvent::SmoothedCov { epoch, p, state } => {
+            if smoothed.len() <= epoch {
+                smoothed.resize(epoch + 1, Sig::default());
+            }
+            smoothed[epoch] = sigmas(p, &layout, &state.c_b_n, &scale_at(&earth, state));
+        }
+        EngineEvent::Smoothed(row) => {
+            let sig = smoothed.get(row.epoch).copied().unwrap_or_default();
+            observe(RecordEvent::Smoothed(&point(row, &sig)));
+        }
+    };
+    let s = run_engine(&mut stream, &start, &cfg, cancel, &mut sink)?;
+    let c = s.counts[MeasKind::Gnss.index()];
+    let (a, g) = (
+        s.layout.offset(BlockKind::AccelScale),
+        s.layout.offset(BlockKind::GyroScale),
+    );
+    Ok(RecordSummary {
+        fixes_used: c.applied + c.rejected + c.late,
+        rejected: c.rejected,
+        late: s.counts.iter().map(|c| c.late).sum(),
+        nav_updates: s.nav_updates,
+        cov_epochs: s.cov_epochs,
+        t_start_s: t_start,
+        init: init_state,
+        final_bias: (vec3_at(&s.est, Some(I_BA)), vec3_at(&s.est, Some(I_BG))),
+        final_scale: (vec3_at(&s.est, a), vec3_at(&s.est, g)),
+        smoother_bytes: s.smoother_bytes,
+        layout: s.layout,
+    })
+}
+
+fn vec3_at(x: &XVec, o: Option<usize>) -> Vec3 {
+    o.map_or(Vec3::zeros(), |o| Vec3::new(x[o], x[o + 1], x[o + 2]))
+}
+
+/// The initial state of a record: (first sample index, state, P0 of the 15 states, fixes
+/// used to initialise).
+fn initial(
+    imu: &ImuData,
+    fixes: &[GnssFix],
+    model: &RecordModel,
+    init: &RecordInit,
+    earth: &EarthModel,
+    lever: Vec3,
+) -> Result<(usize, InitialState, StateMat, usize), FuseError> {
+    let dt = imu.dt_s;
     let t_rec0 = imu.t0_s - dt;
     let mut p0 = StateMat::zeros();
     let mut skip_fixes = 0usize;
+    let earth = *earth;
     let (start_k, init_state) = match *init {
         RecordInit::Given { state, sigma } => {
             let sc = {
@@ -488,176 +632,7 @@ fn records_impl<const N: usize>(
         p0[(I_BA + i, I_BA + i)] = model.accel_bias_sigma_mps2[i].powi(2);
         p0[(I_BG + i, I_BG + i)] = model.gyro_bias_sigma_rps[i].powi(2);
     }
-    crate::io::initial::validate_initial_state(&init_state)
-        .map_err(|e| opt_err("init", e.to_string()))?;
-    if !p0.iter().all(|x| x.is_finite()) {
-        return Err(opt_err("init", "initial covariance is not finite"));
-    }
-    let mut p0n = StateMatN::<N>::zeros();
-    p0n.fixed_view_mut::<N_STATES, N_STATES>(0, 0)
-        .copy_from(&p0);
-    if let (Some(sp), true) = (&opts.scale_factors, N > N_STATES) {
-        sp.validate()?;
-        for i in 0..3 {
-            p0n[(I_SA + i, I_SA + i)] = (sp.accel_ppm[i] * 1e-6).powi(2);
-            p0n[(I_SG + i, I_SG + i)] = (sp.gyro_ppm[i] * 1e-6).powi(2);
-        }
-    }
-    let t_start = t_rec0 + dt * start_k as f64;
-    let mech = AnyMechanization::new(&opts.algo, earth, dt, &init_state);
-    let cfg = EkfConfig {
-        earth,
-        dt_s: dt,
-        cov_updates,
-        noise: model.noise,
-        lever_arm_b_m: lever,
-        gate_chi2: opts.gate_chi2,
-        max_consecutive_rejections: opts.max_consecutive_rejections,
-    };
-    let mut ekf = Ekf::<_, N>::new(mech, cfg, p0n, model.accel_bias0_mps2, model.gyro_bias0_rps);
-    let samples = &imu.increments[start_k.min(imu.increments.len())..];
-    let total = samples.len() / n;
-    let mut log_and_track = opts.smooth.then(|| {
-        let epochs = total / cov_updates + 2;
-        (
-            SmootherLog::<N>::with_capacity(epochs),
-            Vec::<Compact>::with_capacity(total + 1),
-            Vec::<(Est, Mat3, Vec3)>::with_capacity(epochs),
-        )
-    });
-    // σ change only at covariance epochs and updates: computed there, reused in between
-    let sig_of = |ekf: &Ekf<AnyMechanization, N>| {
-        let s = ekf.state();
-        sigmas(ekf.covariance(), &s.c_b_n, &scale_at(&earth, &s))
-    };
-    let point = |ekf: &Ekf<AnyMechanization, N>, sig: &Sig| {
-        let s = ekf.state();
-        RecordPoint {
-            t_s: t_start + s.t_s,
-            state: s,
-            bias: ekf.biases(),
-            sigma_nav: sig.nav,
-            sigma_euler_rad: sig.eul,
-            sigma_bias: sig.bias,
-            scale: ekf.scale_factors(),
-            sigma_scale: sig.scale,
-        }
-    };
-    let est = |ekf: &Ekf<AnyMechanization, N>| -> Est { (ekf.biases(), ekf.scale_factors()) };
-    let mut sig_now = sig_of(&ekf);
-    if let Some((log, track, bias)) = log_and_track.as_mut() {
-        log.push(&ekf.initial_epoch())?;
-        track.push(Compact::of(&ekf.state()));
-        let s = ekf.state();
-        bias.push((est(&ekf), s.c_b_n, scale_at(&earth, &s)));
-    }
-    observe(RecordEvent::Forward(&point(&ekf, &sig_now)));
-    let mut next_fix = skip_fixes;
-    // fixes before the navigation start are not used
-    while next_fix < fixes.len() && fixes[next_fix].t_s - t_start <= 1e-9 {
-        next_fix += 1;
-    }
-    let first_used = next_fix;
-    let mut cov_epochs = 0u64;
-    for (k, chunk) in samples.chunks_exact(n).enumerate() {
-        if k % 1024 == 0 {
-            cancel.check()?;
-        }
-        ekf.propagate(chunk)?;
-        let t_nav = ekf.state().t_s;
-        while next_fix < fixes.len() && fixes[next_fix].t_s - t_start <= t_nav + 1e-9 {
-            let f = fixes[next_fix];
-            next_fix += 1;
-            let m = GnssMeasurement {
-                t_s: f.t_s - t_start,
-                lat_rad: f.lat_rad,
-                lon_rad: f.lon_rad,
-                h_m: f.h_m,
-                pos_cov_ned_m2: f.pos_cov_ned_m2,
-                vel: f.vel,
-            };
-            let rep = ekf.update_gnss(&m)?;
-            observe(RecordEvent::Update(&rep));
-        }
-        if (k + 1) % cov_updates == 0 {
-            if let Some(sig) = opts.nhc_sigma_mps {
-                let rep = ekf.update_nhc(sig)?;
-                observe(RecordEvent::Update(&rep));
-            }
-        }
-        let ep = ekf.take_epoch();
-        if ep.is_some() {
-            cov_epochs += 1;
-            sig_now = sig_of(&ekf);
-        }
-        if let (Some(ep), Some((log, _, bias))) = (ep, log_and_track.as_mut()) {
-            log.push(&ep)?;
-            let s = ekf.state();
-            bias.push((est(&ekf), s.c_b_n, scale_at(&earth, &s)));
-        }
-        if let Some((_, track, _)) = log_and_track.as_mut() {
-            track.push(Compact::of(&ekf.state()));
-        }
-        observe(RecordEvent::Forward(&point(&ekf, &sig_now)));
-    }
-    let mut smoother_bytes = 0;
-    if let Some((log, track, bias)) = log_and_track {
-        smoother_bytes = log.bytes();
-        // σ of the smoothed epochs, from the backward pass
-        let mut sig: Vec<Sig> = vec![Sig::default(); log.len()];
-        let corr = log.smooth(cancel, |k, _, sm| {
-            if let (Some(slot), Some((_, c, sc))) = (sig.get_mut(k), bias.get(k)) {
-                *slot = sigmas(&sm.p, c, sc);
-            }
-        })?;
-        let mut e = 0usize;
-        for (i, c) in track.iter().enumerate() {
-            if i % 4096 == 0 {
-                cancel.check()?;
-            }
-            while e + 1 < corr.len() && log.t_s(e + 1).is_some_and(|t| t <= c.t_s + 1e-9) {
-                e += 1;
-            }
-            let x: StateVecN<N> = corr.at(e, c.t_s);
-            let fwd = c.state();
-            let s = correct_nav_state(&fwd, &x);
-            let (((ba, bg), (sa, sg)), _, _) = bias[e];
-            let sg_e = sig[e];
-            let scale = if N > N_STATES {
-                (
-                    sa + x.fixed_rows::<3>(I_SA).into_owned(),
-                    sg + x.fixed_rows::<3>(I_SG).into_owned(),
-                )
-            } else {
-                (sa, sg)
-            };
-            let p = RecordPoint {
-                t_s: t_start + s.t_s,
-                state: s,
-                bias: (
-                    ba + x.fixed_rows::<3>(I_BA).into_owned(),
-                    bg + x.fixed_rows::<3>(I_BG).into_owned(),
-                ),
-                sigma_nav: sg_e.nav,
-                sigma_euler_rad: sg_e.eul,
-                sigma_bias: sg_e.bias,
-                scale,
-                sigma_scale: sg_e.scale,
-            };
-            observe(RecordEvent::Smoothed(&p));
-        }
-    }
-    Ok(RecordSummary {
-        fixes_used: (next_fix - first_used) as u64,
-        rejected: ekf.rejected_total(),
-        nav_updates: total as u64,
-        cov_epochs,
-        t_start_s: t_start,
-        init: init_state,
-        final_bias: ekf.biases(),
-        final_scale: ekf.scale_factors(),
-        smoother_bytes,
-    })
+    Ok((start_k, init_state, p0, skip_fixes))
 }
 
 /// Errors of output points against a reference trajectory, matched by time: RMSE of
@@ -875,7 +850,7 @@ mod tests {
         for j in 0..3 {
             let mut eps = Vec3::zeros();
             eps[j] = h;
-            let cp = Quat::from_rotvec(&eps).to_dcm() * c;
+            let cp = sdins_core::math::Quat::from_rotvec(&eps).to_dcm() * c;
             let e = sdins_core::math::euler_from_c_b_n(&cp);
             let d = [
                 (e.roll_rad - e0.roll_rad) / h,

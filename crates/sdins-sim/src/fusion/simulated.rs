@@ -1,56 +1,50 @@
-//! INS/GNSS fusion on a scenario: truth → IMU errors → GNSS → error-state filter
-//! (`sdins_core::aiding::ekf`) → errors against the truth, with the filter's covariance.
+//! INS/GNSS fusion on a scenario: the exact truth → IMU errors → GNSS fixes → the one
+//! fusion loop ([`crate::fusion::engine`]) → errors against the truth, with the filter's
+//! covariance.
 //!
-//! * Filter noise from the scenario's IMU error model: ARW, VRW, turn-on bias σ (prior
-//!   of random-constant bias states), Gauss–Markov bias (σ, T; `q = 2σ²/T`), rate random
-//!   walk; the fixed bias is known (initial estimate). With
-//!   [`FuseOptions::scale_factors`] the filter has 21 states and estimates the
-//!   accelerometer and gyro scale factors (random constants, prior σ from the option,
-//!   initial estimate 0); the scenario's `accel_scale_ppm` / `gyro_scale_ppm` plus the
-//!   diagonal of the misalignment matrices are then the true values. Not modelled (and
-//!   therefore not to be simulated in consistency runs): scale factor (15-state filter),
-//!   scale asymmetry, off-diagonal misalignment, g-sensitivity, flicker, quantization,
-//!   saturation.
+//! * Filter model from the scenario's IMU error model ([`noise_from_model`]): ARW, VRW,
+//!   turn-on bias σ (prior of random-constant bias states), Gauss–Markov bias (σ, T;
+//!   `q = 2σ²/T`), rate random walk; the fixed bias is known (initial estimate). With
+//!   [`FuseOptions::scale_factors`] the layout adds the accelerometer and gyro scale
+//!   factors (random constants, prior σ from the option, initial estimate 0); the
+//!   scenario's `accel_scale_ppm` / `gyro_scale_ppm` plus the diagonal of the misalignment
+//!   matrices are then the true values. Not modelled (and therefore not to be simulated in
+//!   consistency runs): scale factor (without those blocks), scale asymmetry, off-diagonal
+//!   misalignment, g-sensitivity, flicker, quantization, saturation.
+//! * The stream ([`crate::fusion::scenario_stream`]): every IMU sample with its truth, the
+//!   fixes of the GNSS simulator as they are generated (time of validity = tag − known
+//!   latency, arrival = tag), and, with a ZUPT, the truth's rest state.
 //! * Initial errors: position/velocity/attitude σ of [`FuseOptions::init_sigma`], drawn
 //!   per run from P0 (`draw_initial_errors`, stream channel 10–12 of the GNSS seed) or
 //!   zero; the attitude error is applied as `Ĉ = exp([ε×]) C` (convention G). The
 //!   linearised filter is limited to initial attitude σ ≤ 10° per axis (larger is
-//!   rejected: in-motion alignment from an unknown heading is not part of this filter).
-//! * ZUPT is triggered by the scenario truth (speed below a threshold), NHC is applied
-//!   whenever the truth is not at rest; both at the covariance rate.
-//! * The observer sees every covariance epoch (true error in the filter's state
-//!   coordinates and P, after that epoch's measurements) and every measurement report.
-//! * With [`FuseOptions::smooth`], the covariance epochs are logged
-//!   ([`crate::fusion::smoother::SmootherLog`]) and, after the forward pass, the
-//!   Rauch–Tung–Striebel smoother's epochs arrive as [`FuseEvent::Smoothed`] in time
-//!   order (true error of the smoothed state and the smoothed covariance).
+//!   rejected; [`FuseOptions::in_motion`] starts from the GNSS track instead).
+//! * Output rows (the loop's epoch rule; by default every covariance interval, so each row
+//!   is a covariance epoch): the true error in the filter's state coordinates and P,
+//!   after that update's measurements ([`FuseEvent::Epoch`]); every measurement report;
+//!   with [`FuseOptions::smooth`] the smoothed rows in time order ([`FuseEvent::Smoothed`]:
+//!   the true error of the smoothed state and the smoothed covariance).
 
 use crate::cancel::{CancelToken, Cancelled};
-use crate::fusion::smoother::{SmootherError, SmootherLog};
-use crate::nav::pipeline::nav_error;
+use crate::fusion::engine::{run_engine, EngineConfig, EngineError, EngineEvent, Row};
+use crate::fusion::scenario_stream::{scenario_start, ScenarioStream};
+use crate::fusion::smoother::SmootherError;
+use crate::nav::pipeline::{nav_error, NavError};
 use crate::scenario::Scenario;
-use crate::sensors::gnss::{GnssConfig, GnssConfigError, GnssSimulator};
-use crate::sensors::gnss_fix::GnssFix;
-use crate::sensors::imu_error::{
-    ImuErrorModel, ImuErrorState, DEG, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H,
-};
+use crate::sensors::gnss::{GnssConfig, GnssConfigError};
+use crate::sensors::imu_error::{ImuErrorModel, DEG, DPH, DPHPSH, DPSH, MPS_PER_SQRT_H};
 use crate::sensors::imu_error::{UG, UG_PER_SQRT_H, UG_PER_SQRT_HZ};
 use crate::truth::{lon_diff, TruthGenerator, TruthSample};
 use nalgebra::{SMatrix, SVector};
-use rand::SeedableRng;
-use rand_chacha::ChaCha20Rng;
-use rand_distr::{Distribution, StandardNormal};
 use sdins_core::aiding::ekf::{
-    correct_nav_state, Ekf, EkfConfig, FilterError, GnssMeasurement, NoiseModel, UpdateReport,
-    CHI2_999,
+    FilterError, NoiseModel, UpdateReport, CHI2_999, DEFAULT_MAX_LATENCY_S,
 };
-use sdins_core::aiding::error_model::{
-    StateMat, StateMatN, StateVec, I_ATT, I_BA, I_BG, I_POS, I_SA, I_SG, I_VEL, N_STATES,
-    N_STATES_SF,
-};
-use sdins_core::coning::Increment;
-use sdins_core::math::{Mat3, Quat, Vec3};
-use sdins_core::nav::{AlgorithmSpec, AnyMechanization, InitialState, NavState};
+use sdins_core::aiding::error_model::{StateMat, I_ATT, I_POS, I_VEL, N_STATES};
+use sdins_core::aiding::layout::{BlockKind, Cov, StateLayout, XVec};
+use sdins_core::aiding::linalg::MAX_ROWS;
+use sdins_core::earth::EarthModel;
+use sdins_core::math::{Mat3, Vec3};
+use sdins_core::nav::{AlgorithmSpec, NavState};
 
 /// Initial 1σ errors of position \[m NED\], velocity \[m/s NED\], attitude \[rad NED\].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,8 +78,8 @@ pub struct FuseOptions {
     pub init_sigma: InitSigma,
     /// draw the initial errors from P0 (else start at the truth)
     pub draw_initial_errors: bool,
-    /// NIS gate thresholds by dof 1…6 (None: no gating)
-    pub gate_chi2: Option<[f64; 6]>,
+    /// NIS gate thresholds by dof 1…12 (None: no gating)
+    pub gate_chi2: Option<[f64; MAX_ROWS]>,
     /// consecutive rejections before the reset policy
     pub max_consecutive_rejections: u32,
     /// ZUPT σ \[m/s\] and the truth speed below which the vehicle is at rest \[m/s\]
@@ -102,6 +96,11 @@ pub struct FuseOptions {
     pub in_motion: Option<InMotionInit>,
     /// estimate accelerometer and gyro scale factors (the 21-state filter) with this prior
     pub scale_factors: Option<ScaleFactorPrior>,
+    /// output rows near `t_start + k·every_s` \[s\] (None: the covariance interval, so
+    /// that every row is a covariance epoch)
+    pub every_s: Option<f64>,
+    /// largest latency of a measurement \[s\]
+    pub max_latency_s: f64,
 }
 
 /// Prior 1σ of the scale-factor states of the 21-state filter, per body axis \[ppm\].
@@ -186,6 +185,8 @@ impl Default for FuseOptions {
             smooth: false,
             in_motion: None,
             scale_factors: None,
+            every_s: None,
+            max_latency_s: DEFAULT_MAX_LATENCY_S,
         }
     }
 }
@@ -214,34 +215,68 @@ pub enum FuseError {
     Cancelled(#[from] Cancelled),
 }
 
-/// One covariance epoch: the true error in the filter's state coordinates
-/// (δL, δλ, δh; δv; ε; accel residual bias `b − b̂`; gyro residual bias) and P.
+impl From<EngineError> for FuseError {
+    fn from(e: EngineError) -> Self {
+        match e {
+            EngineError::Option(k, m) => FuseError::Option(k, m),
+            EngineError::Filter(f) => FuseError::Filter(f),
+            EngineError::Smoother(s) => FuseError::Smoother(s),
+            EngineError::Cancelled(c) => FuseError::Cancelled(c),
+        }
+    }
+}
+
+/// One output row of a scenario run: the true error in the filter's state coordinates
+/// (navigation `estimate − truth`; sensor parameters `truth − estimate`, zero for blocks
+/// whose truth is unknown) and the filter's covariance (leading n × n).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FuseEpoch {
     /// time \[s\]
     pub t_s: f64,
     /// true error
-    pub err: StateVec,
+    pub err: XVec,
     /// filter covariance
-    pub p: StateMat,
+    pub p: Cov,
+    /// the state layout
+    pub layout: StateLayout,
     /// scale from (δL, δλ, δh) to metres NED
     pub pos_scale: Vec3,
     /// the navigation errors in user units
-    pub nav: crate::nav::pipeline::NavError,
+    pub nav: NavError,
     /// the true attitude at the epoch
-    pub c_b_n_true: sdins_core::math::Mat3,
-    /// 21-state filter: the scale-factor states (accel 0–2, gyro 3–5)
-    pub scale_factors: Option<ScaleFactorEpoch>,
+    pub c_b_n_true: Mat3,
+    /// the filter's navigation state (its `t_s` counts from the navigation start)
+    pub state: NavState,
+    /// the filter's sensor-parameter estimates (at their block offsets)
+    pub est: XVec,
 }
 
-/// The scale-factor states of an epoch of the 21-state filter: true error `s − ŝ`
-/// (dimensionless; accelerometer x, y, z then gyro x, y, z) and its covariance block.
+/// The scale-factor states of a row (accelerometer x, y, z then gyro x, y, z): true error
+/// `s − ŝ` (dimensionless) and its covariance block.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ScaleFactorEpoch {
     /// true error `s − ŝ`
     pub err: SVector<f64, 6>,
     /// the filter's covariance of those states
     pub p: SMatrix<f64, 6, 6>,
+}
+
+/// `xᵀ P⁻¹ x` of a block (∞ when P is not positive definite).
+fn nees_of(err: &XVec, p: &Cov, i0: usize, d: usize) -> f64 {
+    let mut m = [0.0f64; 9];
+    let mut x = [0.0f64; 3];
+    for i in 0..d {
+        x[i] = err[i0 + i];
+        for j in 0..d {
+            m[j * 3 + i] = p[(i0 + i, i0 + j)];
+        }
+    }
+    if !sdins_core::aiding::linalg::cholesky(&mut m, 3, d) {
+        return f64::INFINITY;
+    }
+    let mut y = x;
+    sdins_core::aiding::linalg::chol_solve(&m, 3, d, &mut y);
+    sdins_core::aiding::linalg::dot(&x[..d], &y[..d])
 }
 
 impl ScaleFactorEpoch {
@@ -256,15 +291,17 @@ impl ScaleFactorEpoch {
 impl FuseEpoch {
     /// NEES of the 3-state block starting at `i0` (`I_POS`, `I_VEL`, `I_ATT`, …).
     pub fn nees_block(&self, i0: usize) -> f64 {
-        let x = self.err.fixed_rows::<3>(i0).into_owned();
-        let p = self.p.fixed_view::<3, 3>(i0, i0).into_owned();
-        p.cholesky().map_or(f64::INFINITY, |c| x.dot(&c.solve(&x)))
+        nees_of(&self.err, &self.p, i0, 3)
+    }
+    /// NEES of a block of the layout (None when the layout lacks it).
+    pub fn nees(&self, kind: BlockKind) -> Option<f64> {
+        self.layout
+            .block(kind)
+            .map(|b| nees_of(&self.err, &self.p, b.offset, b.dim))
     }
     /// Horizontal (N, E) position NEES (2 dof).
     pub fn nees_horizontal(&self) -> f64 {
-        let x = self.err.fixed_rows::<2>(I_POS).into_owned();
-        let p = self.p.fixed_view::<2, 2>(I_POS, I_POS).into_owned();
-        p.cholesky().map_or(f64::INFINITY, |c| x.dot(&c.solve(&x)))
+        nees_of(&self.err, &self.p, I_POS, 2)
     }
     /// 1σ of state `i` in user units (position in metres).
     pub fn sigma(&self, i: usize) -> f64 {
@@ -275,27 +312,39 @@ impl FuseEpoch {
             s
         }
     }
+    /// The scale-factor states (when the layout has both scale-factor blocks).
+    pub fn scale_factors(&self) -> Option<ScaleFactorEpoch> {
+        let a = self.layout.offset(BlockKind::AccelScale)?;
+        let g = self.layout.offset(BlockKind::GyroScale)?;
+        let idx = [a, a + 1, a + 2, g, g + 1, g + 2];
+        Some(ScaleFactorEpoch {
+            err: SVector::<f64, 6>::from_fn(|i, _| self.err[idx[i]]),
+            p: SMatrix::<f64, 6, 6>::from_fn(|i, j| self.p[(idx[i], idx[j])]),
+        })
+    }
 }
 
 /// What the observer receives.
 #[derive(Clone, Copy, Debug)]
 #[non_exhaustive]
 pub enum FuseEvent<'a> {
-    /// a covariance epoch of the forward filter
+    /// a forward output row
     Epoch(&'a FuseEpoch),
-    /// a measurement update (GNSS, ZUPT, NHC)
+    /// a measurement update (GNSS, ZUPT, NHC; times on the scenario clock)
     Update(&'a UpdateReport),
-    /// a smoothed epoch (after the forward pass, in time order)
+    /// a smoothed output row (after the forward pass, in time order)
     Smoothed(&'a FuseEpoch),
 }
 
 /// Summary of a fused run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FuseSummary {
-    /// GNSS fixes simulated
+    /// GNSS fixes processed (applied, rejected or refused as late)
     pub fixes: u64,
     /// GNSS fixes rejected by the gate
     pub rejected: u64,
+    /// measurements refused as late
+    pub late: u64,
     /// true constant biases (accel \[m/s²\], gyro \[rad/s\])
     pub true_bias: (Vec3, Vec3),
     /// final bias estimates
@@ -308,6 +357,10 @@ pub struct FuseSummary {
     pub est_scale: (Vec3, Vec3),
     /// navigation updates
     pub nav_updates: u64,
+    /// the state layout
+    pub layout: StateLayout,
+    /// the scenario time of the navigation start \[s\] (0 unless in-motion)
+    pub t_start_s: f64,
 }
 
 /// The filter's noise model and bias prior from an IMU error model: (noise, σ_ba, σ_bg,
@@ -341,6 +394,16 @@ pub fn noise_from_model(m: &ImuErrorModel) -> (NoiseModel, Vec3, Vec3, Vec3, Vec
     )
 }
 
+/// The true scale factors of an IMU error model (dimensionless): `s + M_ii` (the
+/// misalignment matrix's diagonal adds to the scale factor, see [`crate::sensors::imu_error`]).
+pub fn true_scale_factors(m: &ImuErrorModel) -> (Vec3, Vec3) {
+    let sf = |s: [f64; 3], mis: [[f64; 3]; 3]| Vec3::from_fn(|i, _| s[i] * 1e-6 + mis[i][i] * 1e-3);
+    (
+        sf(m.accel_scale_ppm, m.accel_misalignment_mrad),
+        sf(m.gyro_scale_ppm, m.gyro_misalignment_mrad),
+    )
+}
+
 /// Run the filter on the scenario with the GNSS settings, as run number `run` (IMU and
 /// GNSS errors and initial errors of that run).
 pub fn fuse_scenario(
@@ -360,6 +423,62 @@ pub fn scenario_truth(scn: &Scenario) -> Vec<TruthSample> {
     TruthGenerator::new(&scn.trajectory, cfg).collect()
 }
 
+/// The true sensor errors of a run, in the filter's coordinates.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Truths {
+    pub(crate) ba: Vec3,
+    pub(crate) bg: Vec3,
+    pub(crate) sf: Option<(Vec3, Vec3)>,
+}
+
+/// The row's true error and covariance.
+fn epoch_of(
+    row: &Row<'_>,
+    p: &Cov,
+    truth: &TruthSample,
+    earth: &EarthModel,
+    tr: &Truths,
+) -> FuseEpoch {
+    let st = row.state;
+    let ne = nav_error(earth, st, truth);
+    let mut err = XVec::zeros();
+    err[0] = st.lat_rad - truth.lat_rad;
+    err[1] = lon_diff(st.lon_rad, truth.lon_rad);
+    err[2] = st.h_m - truth.h_m;
+    let est = row.est;
+    for i in 0..3 {
+        err[I_VEL + i] = ne.vel_err_ned_mps[i];
+        err[I_ATT + i] = ne.att_err_rad[i];
+        err[9 + i] = tr.ba[i] - est[9 + i];
+        err[12 + i] = tr.bg[i] - est[12 + i];
+    }
+    if let Some((sa, sg)) = tr.sf {
+        for (kind, v) in [(BlockKind::AccelScale, sa), (BlockKind::GyroScale, sg)] {
+            if let Some(o) = row.layout.offset(kind) {
+                for i in 0..3 {
+                    err[o + i] = v[i] - est[o + i];
+                }
+            }
+        }
+    }
+    let r = earth.radii(truth.lat_rad);
+    FuseEpoch {
+        t_s: row.t_s,
+        err,
+        p: *p,
+        layout: *row.layout,
+        pos_scale: Vec3::new(
+            r.r_m_m + truth.h_m,
+            (r.r_n_m + truth.h_m) * truth.lat_rad.cos(),
+            -1.0,
+        ),
+        nav: ne,
+        c_b_n_true: truth.c_b_n,
+        state: *st,
+        est: *est,
+    }
+}
+
 /// [`fuse_scenario`] reusing a truth from [`scenario_truth`] (`None`: generate it).
 pub fn fuse_scenario_with(
     scn: &Scenario,
@@ -368,481 +487,137 @@ pub fn fuse_scenario_with(
     opts: &FuseOptions,
     run: u64,
     cancel: &CancelToken,
-    observe: impl FnMut(FuseEvent<'_>),
-) -> Result<FuseSummary, FuseError> {
-    match opts.scale_factors {
-        None => fuse_impl::<N_STATES>(scn, cached, gnss, opts, run, cancel, observe),
-        Some(_) => fuse_impl::<N_STATES_SF>(scn, cached, gnss, opts, run, cancel, observe),
-    }
-}
-
-/// The true scale factors of an IMU error model (dimensionless): `s + M_ii` (the
-/// misalignment matrix's diagonal adds to the scale factor, see [`crate::sensors::imu_error`]).
-pub fn true_scale_factors(m: &ImuErrorModel) -> (Vec3, Vec3) {
-    let sf = |s: [f64; 3], mis: [[f64; 3]; 3]| Vec3::from_fn(|i, _| s[i] * 1e-6 + mis[i][i] * 1e-3);
-    (
-        sf(m.accel_scale_ppm, m.accel_misalignment_mrad),
-        sf(m.gyro_scale_ppm, m.gyro_misalignment_mrad),
-    )
-}
-
-fn fuse_impl<const N: usize>(
-    scn: &Scenario,
-    cached: Option<&[TruthSample]>,
-    gnss: &GnssConfig,
-    opts: &FuseOptions,
-    run: u64,
-    cancel: &CancelToken,
     mut observe: impl FnMut(FuseEvent<'_>),
 ) -> Result<FuseSummary, FuseError> {
-    let sf_prior = opts.scale_factors.filter(|_| N > N_STATES);
-    if let Some(sp) = &sf_prior {
-        sp.validate()?;
-    }
-    if scn.mounting.imu.is_some() {
-        return Err(FuseError::Option(
-            "mounting",
-            "the filter's body frame is the IMU and fuse compares with the truth at the vehicle reference point: remove [mounting] imu_lever_arm_m / imu_mount_deg, and give the antenna's lever arm from the IMU".into(),
-        ));
-    }
-    // the antenna lever arm: [gnss] lever_arm_b_m, or [mounting] gnss_lever_arm_m (the IMU
-    // sits at the reference point here, so both are arms from the IMU)
-    let gnss_eff;
-    let gnss = match scn.mounting.gnss_lever_arm_b_m {
-        Some(l) => {
-            let own = Vec3::from(gnss.lever_arm_b_m);
-            if own != Vec3::zeros() && own != l {
-                return Err(FuseError::Option(
-                    "mounting.gnss_lever_arm_m",
-                    format!(
-                        "differs from [gnss] lever_arm_b_m ({:?} m against {:?} m): give one",
-                        [l.x, l.y, l.z],
-                        gnss.lever_arm_b_m
-                    ),
-                ));
+    let setup = scenario_start(scn, cached, gnss, opts, run)?;
+    let earth = setup.cfg.earth;
+    let truths = setup.truths;
+    let mut stream: ScenarioStream<'_> = setup.stream;
+    let n_x = setup.start.layout.n();
+    // the smoothed covariances of the epochs the rows need, packed
+    let mut smoothed_p: Vec<Option<Vec<f64>>> = Vec::new();
+    let mut sink = |ev: EngineEvent<'_>| match ev {
+        EngineEvent::Forward(row) => {
+            if let (Some(tr), Some(p)) = (row.truth, row.p) {
+                let e = epoch_of(row, p, tr, &earth, &truths);
+                observe(FuseEvent::Epoch(&e));
             }
-            gnss_eff = GnssConfig {
-                lever_arm_b_m: [l.x, l.y, l.z],
-                ..gnss.clone()
-            };
-            &gnss_eff
         }
-        None => gnss,
-    };
-    let earth = scn.nav.earth.model();
-    let dt = scn.imu.dt_s();
-    let n = opts.algo.samples.clamp(1, 4);
-    let nav_rate = 1.0 / (dt * n as f64);
-    if !(opts.cov_rate_hz.is_finite() && opts.cov_rate_hz > 0.0 && opts.cov_rate_hz <= nav_rate) {
-        return Err(FuseError::Option(
-            "cov_rate_hz",
-            format!("must be in (0, {nav_rate}] Hz, got {}", opts.cov_rate_hz),
-        ));
-    }
-    let s = &opts.init_sigma;
-    if s.att_rad
-        .iter()
-        .any(|x| !x.is_finite() || *x < 0.0 || *x > 10.0 * DEG)
-        || s.pos_ned_m
-            .iter()
-            .chain(s.vel_ned_mps.iter())
-            .any(|x| !x.is_finite() || *x < 0.0)
-    {
-        return Err(FuseError::Option(
-            "init_sigma",
-            "σ must be finite, ≥ 0, and attitude σ ≤ 10° (the linearised filter's limit)".into(),
-        ));
-    }
-    let cov_updates = (nav_rate / opts.cov_rate_hz).round().max(1.0) as usize;
-    let cfg = scn.truth_config();
-    let generator = TruthGenerator::new(&scn.trajectory, cfg);
-    let init_true = generator.initial_state();
-    let len_samples = generator.len_samples();
-    let mut truth: Box<dyn Iterator<Item = TruthSample> + '_> = match cached {
-        Some(c) => Box::new(c.iter().copied()),
-        None => Box::new(generator),
-    };
-    let mut gsim = GnssSimulator::new(gnss, earth, run)?;
-    let mut sensor = ImuErrorState::new(&scn.imu.model, scn.imu.seed, run)
-        .map_err(|e| FuseError::Imu(e.to_string()))?;
-    let (true_bg, true_ba) = sensor.constant_bias();
-    let (noise, s_ba, s_bg, known_ba, known_bg) = noise_from_model(&scn.imu.model);
-
-    let mut prev_truth = TruthSample::new(
-        0.0,
-        Increment::default(),
-        init_true.lat_rad,
-        init_true.lon_rad,
-        init_true.h_m,
-        init_true.v_n_mps,
-        init_true.c_b_n,
-    );
-    let mut pending: Vec<GnssFix> = Vec::with_capacity(8);
-    // in-motion start: run the sensors and the receiver until the first fix at speed
-    let mut skipped = 0u64;
-    let mut moving_start = None;
-    if let Some(im) = &opts.in_motion {
-        if !(im.min_speed_mps.is_finite()
-            && im.min_speed_mps > 0.0
-            && im.tilt_sigma_rad > 0.0
-            && im.tilt_sigma_rad <= 10.0 * DEG
-            && im.track_sigma_rad > 0.0
-            && im.track_sigma_rad <= 10.0 * DEG)
-        {
-            return Err(FuseError::Option(
-                "in_motion",
-                "min speed must be > 0, tilt and track σ in (0, 10°]".into(),
-            ));
-        }
-        loop {
-            let Some(ts) = truth.next() else {
-                return Err(FuseError::Option(
-                    "in_motion",
-                    format!(
-                        "no GNSS fix with a velocity and a horizontal speed of at least {} m/s in the scenario",
-                        im.min_speed_mps
-                    ),
-                ));
-            };
-            let meas = sensor.apply(&ts.inc, dt);
-            gsim.step(&scn.trajectory, &prev_truth, &ts, &mut pending);
-            prev_truth = ts;
-            skipped += 1;
-            let found = pending.iter().position(|f| {
-                f.vel
-                    .is_some_and(|(v, _)| v.x.hypot(v.y) >= im.min_speed_mps)
-            });
-            match found {
-                Some(i) => {
-                    let f = pending[i];
-                    pending.drain(..=i);
-                    moving_start = Some((f, ts, meas));
-                    break;
+        EngineEvent::Update(u) => observe(FuseEvent::Update(u)),
+        EngineEvent::SmoothedCov { epoch, p, .. } => {
+            if smoothed_p.len() <= epoch {
+                smoothed_p.resize(epoch + 1, None);
+            }
+            let mut v = Vec::with_capacity(n_x * (n_x + 1) / 2);
+            for i in 0..n_x {
+                for j in i..n_x {
+                    v.push(p[(i, j)]);
                 }
-                None => pending.clear(),
             }
+            smoothed_p[epoch] = Some(v);
         }
-    }
-    let t_start = prev_truth.t_s;
-    let init_true = if moving_start.is_some() {
-        InitialState {
-            lat_rad: prev_truth.lat_rad,
-            lon_rad: prev_truth.lon_rad,
-            h_m: prev_truth.h_m,
-            v_n_mps: prev_truth.v_n_mps,
-            c_b_n: prev_truth.c_b_n,
-        }
-    } else {
-        init_true
-    };
-    // initial errors
-    let r0 = earth.radii(init_true.lat_rad);
-    let t0 = Vec3::new(
-        r0.r_m_m + init_true.h_m,
-        (r0.r_n_m + init_true.h_m) * init_true.lat_rad.cos(),
-        -1.0,
-    );
-    let mut w = [0.0; 9];
-    if opts.draw_initial_errors {
-        let mut rng = ChaCha20Rng::seed_from_u64(gnss.seed);
-        rng.set_stream((1u64 << 63) | run.wrapping_mul(16).wrapping_add(10));
-        for wi in &mut w {
-            *wi = StandardNormal.sample(&mut rng);
-        }
-    }
-    let dp = Vec3::from_fn(|i, _| s.pos_ned_m[i] * w[i]);
-    let dv = Vec3::from_fn(|i, _| s.vel_ned_mps[i] * w[3 + i]);
-    let eps = Vec3::from_fn(|i, _| s.att_rad[i] * w[6 + i]);
-    let init = InitialState {
-        lat_rad: init_true.lat_rad + dp.x / t0.x,
-        lon_rad: init_true.lon_rad + dp.y / t0.y,
-        h_m: init_true.h_m - dp.z,
-        v_n_mps: init_true.v_n_mps + dv,
-        c_b_n: Quat::from_rotvec(&eps).to_dcm() * init_true.c_b_n,
-    };
-    let mut init = init;
-    let mut p0 = StateMatN::<N>::zeros();
-    if let Some(sp) = &sf_prior {
-        for i in 0..3 {
-            p0[(I_SA + i, I_SA + i)] = (sp.accel_ppm[i] * 1e-6).powi(2);
-            p0[(I_SG + i, I_SG + i)] = (sp.gyro_ppm[i] * 1e-6).powi(2);
-        }
-    }
-    let true_sf = sf_prior.map(|_| true_scale_factors(&scn.imu.model));
-    for i in 0..3 {
-        p0[(I_POS + i, I_POS + i)] = (s.pos_ned_m[i] / t0[i]).powi(2);
-        p0[(I_VEL + i, I_VEL + i)] = s.vel_ned_mps[i].powi(2);
-        p0[(I_ATT + i, I_ATT + i)] = s.att_rad[i].powi(2);
-        p0[(I_BA + i, I_BA + i)] = s_ba[i].powi(2);
-        p0[(I_BG + i, I_BG + i)] = s_bg[i].powi(2);
-    }
-    if let (Some((f, ts, meas)), Some(im)) = (moving_start, opts.in_motion) {
-        let (v_a, cv) = f.vel.unwrap_or((Vec3::zeros(), Mat3::identity()));
-        let vh = v_a.x.hypot(v_a.y);
-        let w_z = meas.dtheta_b_rad.z / dt;
-        let yaw = v_a.y.atan2(v_a.x) + w_z * (ts.t_s - f.t_s);
-        let pitch = (-v_a.z).atan2(vh);
-        let c = sdins_core::math::c_b_n_from_euler(&sdins_core::math::Euler::new(0.0, pitch, yaw));
-        let l = Vec3::from(gnss.lever_arm_b_m);
-        let w_b = meas.dtheta_b_rad / dt;
-        let v = v_a - c * w_b.cross(&l);
-        let cl = c * l;
-        let r = earth.radii(f.lat_rad);
-        let sc = sdins_core::aiding::error_model::position_scale(
-            r.r_m_m,
-            r.r_n_m,
-            f.lat_rad.cos(),
-            f.h_m,
-        );
-        // the fix is at t_f ≤ t_start: advance by the velocity over the gap
-        let gap = ts.t_s - f.t_s;
-        init = InitialState {
-            lat_rad: f.lat_rad + (v.x * gap - cl.x) / sc.x,
-            lon_rad: f.lon_rad + (v.y * gap - cl.y) / sc.y,
-            h_m: f.h_m - v.z * gap + cl.z,
-            v_n_mps: v,
-            c_b_n: c,
-        };
-        let (sy, cy) = yaw.sin_cos();
-        let s_psi2 =
-            im.track_sigma_rad.powi(2) + (cv[(0, 0)] * sy * sy + cv[(1, 1)] * cy * cy) / (vh * vh);
-        let m = crate::fusion::records::euler_error_matrix(&c);
-        let mi = m.try_inverse().unwrap_or_else(Mat3::identity);
-        let d = Mat3::from_diagonal(&Vec3::new(
-            im.tilt_sigma_rad.powi(2),
-            im.tilt_sigma_rad.powi(2),
-            s_psi2,
-        ));
-        let pa = mi * d * mi.transpose();
-        for i in 0..3 {
-            for j in 0..3 {
-                p0[(I_POS + i, I_POS + j)] = f.pos_cov_ned_m2[(i, j)] / (sc[i] * sc[j]);
-                p0[(I_VEL + i, I_VEL + j)] = cv[(i, j)];
-                p0[(I_ATT + i, I_ATT + j)] = pa[(i, j)];
-            }
-        }
-    }
-    let mech = AnyMechanization::new(&opts.algo, earth, dt, &init);
-    let ekf_cfg = EkfConfig {
-        earth,
-        dt_s: dt,
-        cov_updates,
-        noise,
-        lever_arm_b_m: if opts.model_lever_arm {
-            Vec3::from(gnss.lever_arm_b_m)
-        } else {
-            Vec3::zeros()
-        },
-        gate_chi2: opts.gate_chi2,
-        max_consecutive_rejections: opts.max_consecutive_rejections,
-    };
-    let mut ekf = Ekf::<_, N>::new(mech, ekf_cfg, p0, known_ba, known_bg);
-
-    let mut total = len_samples.saturating_sub(skipped) / n as u64;
-    if let Some(t) = opts.until_s {
-        total = total.min(((t - t_start).max(0.0) * nav_rate).round() as u64);
-    }
-    let latency_fix = if gnss.latency_modelled {
-        gnss.latency_s
-    } else {
-        0.0
-    };
-    let mut incs = [Increment::default(); 4];
-    // forward records for the smoother: the log, and per epoch the forward state, its
-    // bias estimates and the truth
-    let mut smooth = opts.smooth.then(|| {
-        let epochs = (total / cov_updates as u64 + 2) as usize;
-        (
-            SmootherLog::<N>::with_capacity(epochs),
-            Vec::<(NavState, Estimates, TruthSample)>::with_capacity(epochs),
-        )
-    });
-    let truths = Truths {
-        ba: true_ba,
-        bg: true_bg,
-        sf: true_sf,
-    };
-    if let Some((log, fwd)) = smooth.as_mut() {
-        log.push(&ekf.initial_epoch())?;
-        fwd.push((ekf.state(), estimates(&ekf), prev_truth));
-    }
-    let mut fixes = 0u64;
-    let mut last_cur = prev_truth;
-    for k in 0..total {
-        if k % 1024 == 0 {
-            cancel.check()?;
-        }
-        let mut got = 0;
-        for inc in incs.iter_mut().take(n) {
-            let Some(ts) = truth.next() else { break };
-            *inc = sensor.apply(&ts.inc, dt);
-            gsim.step(&scn.trajectory, &prev_truth, &ts, &mut pending);
-            prev_truth = ts;
-            got += 1;
-        }
-        if got < n {
-            break;
-        }
-        let cur = prev_truth;
-        last_cur = cur;
-        ekf.propagate(&incs[..n])?;
-        let t_nav = ekf.state().t_s;
-        // fixes available by now (tag ≤ t_nav), in time order
-        let mut i = 0;
-        while i < pending.len() {
-            if pending[i].t_s <= t_start + t_nav + 1e-9 {
-                let f = pending.remove(i);
-                fixes += 1;
-                let m = GnssMeasurement {
-                    t_s: f.t_s - latency_fix - t_start,
-                    lat_rad: f.lat_rad,
-                    lon_rad: f.lon_rad,
-                    h_m: f.h_m,
-                    pos_cov_ned_m2: f.pos_cov_ned_m2,
-                    vel: f.vel,
-                };
-                let mut rep = ekf.update_gnss(&m)?;
-                rep.t_s += t_start;
-                observe(FuseEvent::Update(&rep));
-            } else {
-                i += 1;
-            }
-        }
-        let epoch_now = (k + 1) % cov_updates as u64 == 0;
-        if epoch_now {
-            let at_rest = opts.zupt.is_some_and(|(_, thr)| cur.v_n_mps.norm() < thr);
-            if let (true, Some((sig, _))) = (at_rest, opts.zupt) {
-                let mut rep = ekf.update_zupt(sig)?;
-                rep.t_s += t_start;
-                observe(FuseEvent::Update(&rep));
-            } else if let Some(sig) = opts.nhc_sigma_mps {
-                let mut rep = ekf.update_nhc(sig)?;
-                rep.t_s += t_start;
-                observe(FuseEvent::Update(&rep));
-            }
-        }
-        if let Some(ep) = ekf.take_epoch() {
-            let mut e = epoch_of(
-                &ekf.state(),
-                &estimates(&ekf),
-                ekf.covariance(),
-                &cur,
-                &earth,
-                &truths,
-            );
-            e.t_s += t_start;
-            observe(FuseEvent::Epoch(&e));
-            if let Some((log, fwd)) = smooth.as_mut() {
-                log.push(&ep)?;
-                fwd.push((ekf.state(), estimates(&ekf), cur));
-            }
-        }
-    }
-    let _ = last_cur;
-    if let Some((log, fwd)) = smooth {
-        let mut out: Vec<Option<FuseEpoch>> = vec![None; fwd.len()];
-        log.smooth(cancel, |k, _, sm| {
-            if let (Some((st, est, tr)), Some(slot)) = (fwd.get(k), out.get_mut(k)) {
-                let s_state = correct_nav_state(st, &sm.dx);
-                let mut est = *est;
-                est.ba += sm.dx.fixed_rows::<3>(I_BA);
-                est.bg += sm.dx.fixed_rows::<3>(I_BG);
-                if N > N_STATES {
-                    est.sa += sm.dx.fixed_rows::<3>(I_SA);
-                    est.sg += sm.dx.fixed_rows::<3>(I_SG);
+        EngineEvent::Smoothed(row) => {
+            let Some(Some(v)) = smoothed_p.get(row.epoch) else {
+                return;
+            };
+            let mut p = Cov::zeros();
+            let mut k = 0;
+            for i in 0..n_x {
+                for j in i..n_x {
+                    p[(i, j)] = v[k];
+                    p[(j, i)] = v[k];
+                    k += 1;
                 }
-                let mut e = epoch_of(&s_state, &est, &sm.p, tr, &earth, &truths);
-                e.t_s += t_start;
-                *slot = Some(e);
             }
-        })?;
-        for e in out.iter().flatten() {
-            observe(FuseEvent::Smoothed(e));
+            if let Some(tr) = row.truth {
+                let e = epoch_of(row, &p, tr, &earth, &truths);
+                observe(FuseEvent::Smoothed(&e));
+            }
         }
-    }
-    let (ba, bg) = ekf.biases();
+    };
+    let s = run_engine(&mut stream, &setup.start, &setup.cfg, cancel, &mut sink)?;
+    let c = s.counts[sdins_core::aiding::meas::MeasKind::Gnss.index()];
+    let late: u64 = s.counts.iter().map(|c| c.late).sum();
+    let est_scale = (
+        vec3_at(&s.est, s.layout.offset(BlockKind::AccelScale)),
+        vec3_at(&s.est, s.layout.offset(BlockKind::GyroScale)),
+    );
     Ok(FuseSummary {
-        fixes,
-        rejected: ekf.rejected_total(),
-        true_bias: (true_ba, true_bg),
-        est_bias: (ba, bg),
-        p_final: ekf
-            .covariance()
-            .fixed_view::<N_STATES, N_STATES>(0, 0)
-            .into_owned(),
-        true_scale: true_sf,
-        est_scale: ekf.scale_factors(),
-        nav_updates: total,
+        fixes: c.applied + c.rejected + c.late,
+        rejected: c.rejected,
+        late,
+        true_bias: (truths.ba, truths.bg),
+        est_bias: (vec3_at(&s.est, Some(9)), vec3_at(&s.est, Some(12))),
+        p_final: s.p.fixed_view::<N_STATES, N_STATES>(0, 0).into_owned(),
+        true_scale: truths.sf,
+        est_scale,
+        nav_updates: s.nav_updates,
+        layout: s.layout,
+        t_start_s: s.t_start_s,
     })
 }
 
-/// The filter's sensor-error estimates at an epoch.
-#[derive(Clone, Copy, Debug)]
-struct Estimates {
-    ba: Vec3,
-    bg: Vec3,
-    sa: Vec3,
-    sg: Vec3,
+fn vec3_at(x: &XVec, o: Option<usize>) -> Vec3 {
+    o.map_or(Vec3::zeros(), |o| Vec3::new(x[o], x[o + 1], x[o + 2]))
 }
 
-fn estimates<M: sdins_core::nav::Mechanization, const N: usize>(ekf: &Ekf<M, N>) -> Estimates {
-    let ((ba, bg), (sa, sg)) = (ekf.biases(), ekf.scale_factors());
-    Estimates { ba, bg, sa, sg }
-}
-
-/// The true sensor errors of the run (scale factors only when estimated).
-struct Truths {
-    ba: Vec3,
-    bg: Vec3,
-    sf: Option<(Vec3, Vec3)>,
-}
-
-fn epoch_of<const N: usize>(
-    st: &NavState,
-    est: &Estimates,
-    p: &StateMatN<N>,
-    truth: &TruthSample,
-    earth: &sdins_core::earth::EarthModel,
-    tr: &Truths,
-) -> FuseEpoch {
-    let (ba, bg, true_ba, true_bg) = (est.ba, est.bg, tr.ba, tr.bg);
-    let ne = nav_error(earth, st, truth);
-    let mut err = StateVec::zeros();
-    err[I_POS] = st.lat_rad - truth.lat_rad;
-    err[I_POS + 1] = lon_diff(st.lon_rad, truth.lon_rad);
-    err[I_POS + 2] = st.h_m - truth.h_m;
-    for i in 0..3 {
-        err[I_VEL + i] = ne.vel_err_ned_mps[i];
-        err[I_ATT + i] = ne.att_err_rad[i];
-        err[I_BA + i] = true_ba[i] - ba[i];
-        err[I_BG + i] = true_bg[i] - bg[i];
+/// The engine configuration shared by the scenario and recorded front ends.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn engine_config(
+    algo: AlgorithmSpec,
+    earth: EarthModel,
+    dt_s: f64,
+    cov_rate_hz: f64,
+    noise: NoiseModel,
+    lever_arm_b_m: Vec3,
+    every_s: Option<f64>,
+    total_updates: u64,
+) -> Result<EngineConfig, FuseError> {
+    let n = algo.samples.clamp(1, 4);
+    let nav_rate = 1.0 / (dt_s * n as f64);
+    if !(cov_rate_hz.is_finite() && cov_rate_hz > 0.0 && cov_rate_hz <= nav_rate) {
+        return Err(FuseError::Option(
+            "cov_rate_hz",
+            format!("must be in (0, {nav_rate}] Hz, got {cov_rate_hz}"),
+        ));
     }
-    let scale_factors = match (tr.sf, N > N_STATES) {
-        (Some((sa, sg)), true) => {
-            let mut e = SVector::<f64, 6>::zeros();
-            for i in 0..3 {
-                e[i] = sa[i] - est.sa[i];
-                e[3 + i] = sg[i] - est.sg[i];
-            }
-            Some(ScaleFactorEpoch {
-                err: e,
-                p: p.fixed_view::<6, 6>(I_SA, I_SA).into_owned(),
-            })
-        }
-        _ => None,
-    };
-    let r = earth.radii(truth.lat_rad);
-    FuseEpoch {
-        t_s: st.t_s,
-        err,
-        p: p.fixed_view::<N_STATES, N_STATES>(0, 0).into_owned(),
-        scale_factors,
-        pos_scale: Vec3::new(
-            r.r_m_m + truth.h_m,
-            (r.r_n_m + truth.h_m) * truth.lat_rad.cos(),
-            -1.0,
-        ),
-        nav: ne,
-        c_b_n_true: truth.c_b_n,
+    let cov_updates = (nav_rate / cov_rate_hz).round().max(1.0) as usize;
+    Ok(EngineConfig {
+        algo,
+        earth,
+        dt_s,
+        cov_updates,
+        noise,
+        gate_chi2: Some(CHI2_999),
+        max_consecutive_rejections: 5,
+        max_latency_s: DEFAULT_MAX_LATENCY_S,
+        lever_arm_b_m,
+        zupt_sigma_mps: None,
+        nhc_sigma_mps: None,
+        smooth: false,
+        every_s: every_s.unwrap_or(cov_updates as f64 * n as f64 * dt_s),
+        total_updates,
+    })
+}
+
+/// The states of a layout in the order the navigation blocks and sensor blocks appear
+/// (helper for callers that print them).
+pub fn layout_names(layout: &StateLayout) -> Vec<&'static str> {
+    layout.blocks().iter().map(|b| b.kind.name()).collect()
+}
+
+/// A navigation state from the start of a scenario (for tests and tools).
+pub fn scenario_initial_state(scn: &Scenario) -> NavState {
+    let s = TruthGenerator::new(&scn.trajectory, scn.truth_config()).initial_state();
+    NavState {
+        t_s: 0.0,
+        lat_rad: s.lat_rad,
+        lon_rad: s.lon_rad,
+        h_m: s.h_m,
+        v_n_mps: s.v_n_mps,
+        c_b_n: s.c_b_n,
     }
 }
+
+/// Units of the initial σ for the in-motion start.
+pub(crate) const IN_MOTION_MAX_SIGMA_RAD: f64 = 10.0 * DEG;

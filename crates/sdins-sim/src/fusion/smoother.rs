@@ -1,5 +1,5 @@
 //! Post-processing with the Rauch–Tung–Striebel smoother (`sdins_core::aiding::rts`):
-//! the forward filter's covariance epochs are logged compactly, walked backwards, and the
+//! the forward filter's covariance epochs are logged compactly at the filter's active dimension, walked backwards, and the
 //! smoothed corrections re-applied to the forward navigation states at full rate.
 //!
 //! ## Storage
@@ -19,29 +19,29 @@
 
 use crate::cancel::{CancelToken, Cancelled};
 use sdins_core::aiding::ekf::{CovEpoch, FilterError};
-use sdins_core::aiding::error_model::{StateMatN, StateVecN, N_STATES};
+use sdins_core::aiding::layout::{Cov, XVec};
 use sdins_core::aiding::rts::{rts_step, Smoothed};
 
-/// Length of the packed upper triangle of a symmetric N × N matrix.
+/// Length of the packed upper triangle of a symmetric n × n matrix.
 const fn packed_len(n: usize) -> usize {
     n * (n + 1) / 2
 }
 
-/// Append the packed upper triangle of `m` to `out`.
-fn pack_into<const N: usize>(m: &StateMatN<N>, out: &mut Vec<f64>) {
-    for i in 0..N {
-        for j in i..N {
+/// Append the packed upper triangle of the leading `n × n` block of `m` to `out`.
+fn pack_into(m: &Cov, n: usize, out: &mut Vec<f64>) {
+    for i in 0..n {
+        for j in i..n {
             out.push(m[(i, j)]);
         }
     }
 }
 
-/// The symmetric matrix of a packed upper triangle (`p.len() ≥ N(N+1)/2`).
-fn unpack<const N: usize>(p: &[f64]) -> StateMatN<N> {
-    let mut m = StateMatN::<N>::zeros();
+/// The symmetric matrix of a packed upper triangle (missing values read as 0).
+fn unpack(p: &[f64], n: usize) -> Cov {
+    let mut m = Cov::zeros();
     let mut k = 0;
-    for i in 0..N {
-        for j in i..N {
+    for i in 0..n {
+        for j in i..n {
             let v = p.get(k).copied().unwrap_or(0.0);
             m[(i, j)] = v;
             m[(j, i)] = v;
@@ -49,13 +49,6 @@ fn unpack<const N: usize>(p: &[f64]) -> StateMatN<N> {
         }
     }
     m
-}
-
-#[derive(Clone, Debug)]
-struct Record<const N: usize> {
-    t_s: f64,
-    phi: StateMatN<N>,
-    dx: StateVecN<N>,
 }
 
 /// Why smoothing stopped.
@@ -73,6 +66,16 @@ pub enum SmootherError {
         /// the previous epoch's time \[s\]
         prev_s: f64,
     },
+    /// An epoch of another dimension than the first.
+    #[error("smoother epoch at t = {t_s} s has {n} states, the log {want}")]
+    Dimension {
+        /// the offending epoch's time \[s\]
+        t_s: f64,
+        /// its dimension
+        n: usize,
+        /// the log's
+        want: usize,
+    },
     /// A backward step failed (names the epoch).
     #[error(transparent)]
     Filter(#[from] FilterError),
@@ -81,84 +84,115 @@ pub enum SmootherError {
     Cancelled(#[from] Cancelled),
 }
 
-/// The forward filter's covariance epochs, in time order (`N` = 15 or 21 states).
-#[derive(Clone, Debug)]
-pub struct SmootherLog<const N: usize = N_STATES> {
-    recs: Vec<Record<N>>,
-    /// per epoch the packed P(k|k−1) then P(k|k)
-    packed: Vec<f64>,
+/// The forward filter's covariance epochs, in time order, at the active dimension n of
+/// the first epoch: per epoch `t`, Φ (n × n), δx̂ (n), packed P(k|k−1) and P(k|k).
+#[derive(Clone, Debug, Default)]
+pub struct SmootherLog {
+    n: usize,
+    data: Vec<f64>,
+    len: usize,
 }
 
-impl<const N: usize> Default for SmootherLog<N> {
-    fn default() -> Self {
-        Self {
-            recs: Vec::new(),
-            packed: Vec::new(),
-        }
-    }
-}
-
-impl<const N: usize> SmootherLog<N> {
-    const PACKED: usize = packed_len(N);
-
+impl SmootherLog {
     /// An empty log.
     pub fn new() -> Self {
         Self::default()
     }
-    /// An empty log with room for `n` epochs.
-    pub fn with_capacity(n: usize) -> Self {
+    /// An empty log with room for `epochs` epochs of `n` states.
+    pub fn with_capacity(epochs: usize, n: usize) -> Self {
         Self {
-            recs: Vec::with_capacity(n),
-            packed: Vec::with_capacity(n * 2 * Self::PACKED),
+            n,
+            data: Vec::with_capacity(epochs * Self::record_len(n)),
+            len: 0,
         }
     }
+    /// f64 values per epoch: t, Φ, δx̂, two packed covariances.
+    const fn record_len(n: usize) -> usize {
+        1 + n * n + n + 2 * packed_len(n)
+    }
     /// Append an epoch (from `Ekf::initial_epoch` first, then `Ekf::take_epoch`).
-    pub fn push(&mut self, e: &CovEpoch<N>) -> Result<(), SmootherError> {
-        if let Some(prev) = self.recs.last() {
-            if e.t_s.partial_cmp(&prev.t_s) != Some(std::cmp::Ordering::Greater) {
+    pub fn push(&mut self, e: &CovEpoch) -> Result<(), SmootherError> {
+        if self.len == 0 {
+            self.n = e.n;
+        } else if e.n != self.n {
+            return Err(SmootherError::Dimension {
+                t_s: e.t_s,
+                n: e.n,
+                want: self.n,
+            });
+        }
+        if let Some(prev) = self.t_s(self.len.wrapping_sub(1)) {
+            if e.t_s.partial_cmp(&prev) != Some(std::cmp::Ordering::Greater) {
                 return Err(SmootherError::Order {
                     t_s: e.t_s,
-                    prev_s: prev.t_s,
+                    prev_s: prev,
                 });
             }
         }
-        self.recs.push(Record {
-            t_s: e.t_s,
-            phi: e.phi,
-            dx: e.dx,
-        });
-        pack_into(&e.p_pred, &mut self.packed);
-        pack_into(&e.p_post, &mut self.packed);
+        let n = self.n;
+        self.data.push(e.t_s);
+        for j in 0..n {
+            for i in 0..n {
+                self.data.push(e.phi[(i, j)]);
+            }
+        }
+        self.data.extend((0..n).map(|i| e.dx[i]));
+        pack_into(&e.p_pred, n, &mut self.data);
+        pack_into(&e.p_post, n, &mut self.data);
+        self.len += 1;
         Ok(())
     }
     /// Number of epochs.
     pub fn len(&self) -> usize {
-        self.recs.len()
+        self.len
     }
     /// No epoch logged.
     pub fn is_empty(&self) -> bool {
-        self.recs.is_empty()
+        self.len == 0
+    }
+    /// Active dimension of the epochs.
+    pub fn dim(&self) -> usize {
+        self.n
     }
     /// Bytes held by the log (its allocation).
     pub fn bytes(&self) -> usize {
-        self.recs.capacity() * std::mem::size_of::<Record<N>>()
-            + self.packed.capacity() * std::mem::size_of::<f64>()
+        self.data.capacity() * std::mem::size_of::<f64>()
+    }
+    fn record(&self, k: usize) -> Option<&[f64]> {
+        let l = Self::record_len(self.n);
+        if k >= self.len {
+            return None;
+        }
+        self.data.get(k * l..(k + 1) * l)
     }
     /// Time of epoch `k` \[s\].
     pub fn t_s(&self, k: usize) -> Option<f64> {
-        self.recs.get(k).map(|r| r.t_s)
+        self.record(k).map(|r| r[0])
     }
     /// The forward record of epoch `k`.
-    pub fn epoch(&self, k: usize) -> Option<CovEpoch<N>> {
-        let r = self.recs.get(k)?;
-        let p = Self::PACKED;
-        let packed = self.packed.get(2 * p * k..2 * p * (k + 1))?;
+    pub fn epoch(&self, k: usize) -> Option<CovEpoch> {
+        let r = self.record(k)?;
+        let n = self.n;
+        let mut phi = Cov::zeros();
+        for j in 0..n {
+            for i in 0..n {
+                phi[(i, j)] = r[1 + j * n + i];
+            }
+        }
+        let o = 1 + n * n;
+        let mut dx = XVec::zeros();
+        for i in 0..n {
+            dx[i] = r[o + i];
+        }
+        let o = o + n;
+        let p = packed_len(n);
         Some(CovEpoch {
-            t_s: r.t_s,
-            phi: r.phi,
-            p_pred: unpack(&packed[..p]),
-            p_post: unpack(&packed[p..]),
-            dx: r.dx,
+            t_s: r[0],
+            n,
+            phi,
+            p_pred: unpack(&r[o..o + p], n),
+            p_post: unpack(&r[o + p..o + 2 * p], n),
+            dx,
         })
     }
 
@@ -168,13 +202,14 @@ impl<const N: usize> SmootherLog<N> {
     pub fn smooth(
         &self,
         cancel: &CancelToken,
-        mut visit: impl FnMut(usize, &CovEpoch<N>, &Smoothed<N>),
-    ) -> Result<SmoothedCorrections<N>, SmootherError> {
-        let n = self.recs.len();
+        mut visit: impl FnMut(usize, &CovEpoch, &Smoothed),
+    ) -> Result<SmoothedCorrections, SmootherError> {
+        let n = self.len;
         let Some(last) = n.checked_sub(1).and_then(|k| self.epoch(k)) else {
             return Err(SmootherError::Empty);
         };
-        let mut dx = vec![StateVecN::<N>::zeros(); n];
+        let d = self.n;
+        let mut dx = vec![0.0; n * d];
         let mut s = Smoothed::last(&last);
         visit(n - 1, &last, &s);
         let mut next = last;
@@ -186,13 +221,24 @@ impl<const N: usize> SmootherLog<N> {
                 return Err(SmootherError::Empty);
             };
             s = rts_step(&rec, &next, &s)?;
-            dx[k] = s.dx;
+            for i in 0..d {
+                dx[k * d + i] = s.dx[i];
+            }
             visit(k, &rec, &s);
             next = rec;
         }
+        let l = Self::record_len(d);
+        let mut applied = Vec::with_capacity(n * d);
+        let mut t_s = Vec::with_capacity(n);
+        for k in 0..n {
+            let r = &self.data[k * l..(k + 1) * l];
+            t_s.push(r[0]);
+            applied.extend_from_slice(&r[1 + d * d..1 + d * d + d]);
+        }
         Ok(SmoothedCorrections {
-            t_s: self.recs.iter().map(|r| r.t_s).collect(),
-            applied: self.recs.iter().map(|r| r.dx).collect(),
+            n: d,
+            t_s,
+            applied,
             dx,
         })
     }
@@ -200,13 +246,14 @@ impl<const N: usize> SmootherLog<N> {
 
 /// The smoothed corrections of every epoch, to be re-applied at full rate.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SmoothedCorrections<const N: usize = N_STATES> {
+pub struct SmoothedCorrections {
+    n: usize,
     t_s: Vec<f64>,
-    applied: Vec<StateVecN<N>>,
-    dx: Vec<StateVecN<N>>,
+    applied: Vec<f64>,
+    dx: Vec<f64>,
 }
 
-impl<const N: usize> SmoothedCorrections<N> {
+impl SmoothedCorrections {
     /// Number of epochs.
     pub fn len(&self) -> usize {
         self.t_s.len()
@@ -215,28 +262,38 @@ impl<const N: usize> SmoothedCorrections<N> {
     pub fn is_empty(&self) -> bool {
         self.t_s.is_empty()
     }
+    fn vec(v: &[f64], k: usize, n: usize) -> XVec {
+        let mut x = XVec::zeros();
+        if let Some(s) = v.get(k * n..(k + 1) * n) {
+            for (i, a) in s.iter().enumerate() {
+                x[i] = *a;
+            }
+        }
+        x
+    }
     /// `ê⁺_k` of epoch `k`.
-    pub fn at_epoch(&self, k: usize) -> Option<&StateVecN<N>> {
-        self.dx.get(k)
+    pub fn at_epoch(&self, k: usize) -> Option<XVec> {
+        (k < self.len()).then(|| Self::vec(&self.dx, k, self.n))
     }
     /// The correction for a forward state at time `t_s` \[s\] (see the module
     /// documentation); `epoch` is the index of the latest epoch at or before `t_s`
     /// (the caller tracks it as it walks forward). Before the first and after the last
     /// epoch the nearest epoch's correction is used.
-    pub fn at(&self, epoch: usize, t_s: f64) -> StateVecN<N> {
+    pub fn at(&self, epoch: usize, t_s: f64) -> XVec {
         let n = self.t_s.len();
         if n == 0 {
-            return StateVecN::<N>::zeros();
+            return XVec::zeros();
         }
         let k = epoch.min(n - 1);
         let tk = self.t_s[k];
+        let dk = Self::vec(&self.dx, k, self.n);
         if k + 1 >= n || t_s <= tk {
-            return self.dx[k];
+            return dk;
         }
         let t1 = self.t_s[k + 1];
         let w = ((t_s - tk) / (t1 - tk)).clamp(0.0, 1.0);
-        let pre_next = self.dx[k + 1] + self.applied[k + 1];
-        self.dx[k] + (pre_next - self.dx[k]) * w
+        let pre_next = Self::vec(&self.dx, k + 1, self.n) + Self::vec(&self.applied, k + 1, self.n);
+        dk + (pre_next - dk) * w
     }
     /// Index of the latest epoch with time ≤ `t_s` (binary search).
     pub fn epoch_index(&self, t_s: f64) -> usize {
@@ -248,57 +305,78 @@ impl<const N: usize> SmoothedCorrections<N> {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
-    use sdins_core::aiding::error_model::{StateMat, StateVec, N_STATES_SF};
 
-    fn roundtrip<const N: usize>() -> usize {
-        let mut m = StateMatN::<N>::zeros();
-        for i in 0..N {
-            for j in 0..N {
+    fn roundtrip(n: usize) -> usize {
+        let mut m = Cov::zeros();
+        for i in 0..n {
+            for j in 0..n {
                 m[(i, j)] = (i.min(j) * 100 + i.max(j)) as f64;
             }
         }
         let mut v = Vec::new();
-        pack_into(&m, &mut v);
-        assert_eq!(v.len(), packed_len(N));
-        assert_eq!(unpack::<N>(&v), m);
-        std::mem::size_of::<Record<N>>() + 2 * 8 * packed_len(N)
+        pack_into(&m, n, &mut v);
+        assert_eq!(v.len(), packed_len(n));
+        assert_eq!(unpack(&v, n), m);
+        8 * SmootherLog::record_len(n)
     }
 
     #[test]
     fn pack_roundtrip_and_size() {
-        assert_eq!(roundtrip::<N_STATES>(), 3848);
-        assert_eq!(roundtrip::<N_STATES_SF>(), 7400);
+        // the bytes per epoch of the fixed-size logs of earlier versions
+        assert_eq!(roundtrip(15), 3848);
+        assert_eq!(roundtrip(21), 7400);
+    }
+
+    fn epoch(t: f64, n: usize) -> CovEpoch {
+        CovEpoch {
+            t_s: t,
+            n,
+            phi: Cov::identity(),
+            p_pred: Cov::identity(),
+            p_post: Cov::identity(),
+            dx: XVec::zeros(),
+        }
     }
 
     #[test]
-    fn log_refuses_epochs_out_of_order_and_empty_smoothing() {
-        let e = CovEpoch {
-            t_s: 1.0,
-            phi: StateMat::identity(),
-            p_pred: StateMat::identity(),
-            p_post: StateMat::identity(),
-            dx: StateVec::zeros(),
-        };
-        let mut log = SmootherLog::<N_STATES>::new();
+    fn log_refuses_epochs_out_of_order_other_dimensions_and_empty_smoothing() {
+        let mut log = SmootherLog::new();
         assert!(matches!(
             log.smooth(&CancelToken::new(), |_, _, _| {}),
             Err(SmootherError::Empty)
         ));
+        log.push(&epoch(1.0, 15)).unwrap();
+        assert!(matches!(
+            log.push(&epoch(1.0, 15)),
+            Err(SmootherError::Order { .. })
+        ));
+        assert!(matches!(
+            log.push(&epoch(2.0, 21)),
+            Err(SmootherError::Dimension { .. })
+        ));
+        let mut e = epoch(2.0, 15);
+        e.phi[(3, 4)] = 0.5;
+        e.dx[14] = 2.0;
+        e.p_post[(1, 2)] = 0.25;
+        e.p_post[(2, 1)] = 0.25;
         log.push(&e).unwrap();
-        assert!(matches!(log.push(&e), Err(SmootherError::Order { .. })));
+        assert_eq!(log.epoch(1).unwrap(), e);
+        assert!(log.bytes() >= 2 * 3848);
     }
 
     #[test]
     fn interpolation_runs_from_post_to_pre_correction() {
         let c = SmoothedCorrections {
+            n: 15,
             t_s: vec![0.0, 1.0],
-            applied: vec![StateVec::zeros(), StateVec::repeat(2.0)],
-            dx: vec![StateVec::repeat(1.0), StateVec::repeat(-1.0)],
+            applied: [vec![0.0; 15], vec![2.0; 15]].concat(),
+            dx: [vec![1.0; 15], vec![-1.0; 15]].concat(),
         };
         assert_eq!(c.at(0, 0.0)[0], 1.0);
         // pre-correction at t1: −1 + 2 = 1 → constant 1 in between
         assert!((c.at(0, 0.5)[3] - 1.0).abs() < 1e-15);
         assert_eq!(c.at(1, 1.0)[0], -1.0);
+        assert_eq!(c.at(1, 1.0)[15], 0.0);
         assert_eq!(c.epoch_index(0.5), 0);
         assert_eq!(c.epoch_index(1.0), 1);
     }

@@ -340,7 +340,8 @@ mod tests {
     fn seconds_of_week_roll_over_and_weeks_count() {
         let spec = TimeSpec {
             kind: TimeKind::GpsSow,
-            gps_week: Some(2000), week_column: false,
+            gps_week: Some(2000),
+            week_column: false,
             offset_s: 0.0,
         };
         let mut c = TimeConverter::new(&spec, None).unwrap();

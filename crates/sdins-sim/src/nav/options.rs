@@ -70,6 +70,15 @@ pub fn algorithms(c: &AlgoChoice, nav: &NavConfig) -> Result<Vec<AlgorithmSpec>,
             .collect(),
         None => nav.algos.clone(),
     };
+    // each algorithm once: its outputs (nav_ALGO.csv, err_ALGO.csv) are named after it
+    for (i, a) in names.iter().enumerate() {
+        if names[..i].contains(a) {
+            return Err(bad(format!(
+                "--algo {}: {a} is named twice (each algorithm runs once)",
+                names.join(",")
+            )));
+        }
+    }
     let coning_name = c.coning.clone().or_else(|| nav.coning.clone());
     let coning = match &coning_name {
         None => ConingSet::recommended_for(n),

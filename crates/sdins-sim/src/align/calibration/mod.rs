@@ -3,6 +3,7 @@
 //! Carlo ([`run`]). Theory and conventions: docs/theory/calibration.md.
 
 pub mod estimate;
+pub mod request;
 pub mod run;
 pub mod table;
 

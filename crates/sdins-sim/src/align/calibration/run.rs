@@ -36,16 +36,38 @@ impl DrawSpec {
         misalignment_mrad: (0.1, 1.0),
     };
 
-    /// Check both ranges: finite, `0 ≤ lo ≤ hi`.
+    /// Largest drawn scale factor \[ppm\]: the estimator's small-error model.
+    pub const MAX_SCALE_PPM: f64 = 1e5;
+    /// Largest drawn misalignment \[mrad\]: the estimator's small-angle model.
+    pub const MAX_MISALIGNMENT_MRAD: f64 = 100.0;
+
+    /// Check both ranges: finite, `0 ≤ lo ≤ hi`, within the estimator's small-error model
+    /// ([`Self::MAX_SCALE_PPM`], [`Self::MAX_MISALIGNMENT_MRAD`]).
     pub fn validate(&self) -> Result<(), CalibrationError> {
-        for (key, (lo, hi)) in [
-            ("scale_ppm", self.scale_ppm),
-            ("misalignment_mrad", self.misalignment_mrad),
+        for (key, (lo, hi), max, what) in [
+            (
+                "scale_ppm",
+                self.scale_ppm,
+                Self::MAX_SCALE_PPM,
+                "small-error",
+            ),
+            (
+                "misalignment_mrad",
+                self.misalignment_mrad,
+                Self::MAX_MISALIGNMENT_MRAD,
+                "small-angle",
+            ),
         ] {
             if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo <= hi) {
                 return Err(CalibrationError::Draw {
                     key,
                     what: format!("range [{lo}, {hi}] must be finite with 0 ≤ lo ≤ hi"),
+                });
+            }
+            if hi > max {
+                return Err(CalibrationError::Draw {
+                    key,
+                    what: format!("{hi} is beyond the {what} model (at most {max})"),
                 });
             }
         }
@@ -113,6 +135,15 @@ pub enum CalibrationError {
     /// A recorded IMU file does not fit the schedule.
     #[error("the IMU record does not fit the schedule: {0}")]
     Mismatch(String),
+    /// An option is not usable (the message names it).
+    #[error("{0}")]
+    Option(String),
+    /// The IMU file cannot be read as an IMU record (the reader's located message).
+    #[error("{0}")]
+    ImuFile(String),
+    /// The IMU file cannot be read at all (an I/O failure).
+    #[error("{0}")]
+    ImuIo(String),
     /// Stopped through the cancel token.
     #[error(transparent)]
     Cancelled(#[from] Cancelled),

@@ -55,6 +55,13 @@ pub fn mc_options(scn: &Scenario, c: &McChoice) -> Result<McOptions, OptionError
             return Err(bad(format!("--until-s {u}: expected > 0")));
         }
     }
+    if let Some(e) = c.every_s {
+        if !(e.is_finite() && e > 0.0) {
+            return Err(bad(format!(
+                "--every-s {e}: expected a positive number of seconds"
+            )));
+        }
+    }
     Ok(McOptions {
         runs: c.runs,
         seed: c.seed.unwrap_or(scn.imu.seed),
