@@ -1,6 +1,8 @@
 //! `sdins fuse` on one's own files through column maps (docs/own-data.md): the worked
-//! example of the docs, run on a logger layout written from an `sdins truth` record,
-//! equals the run on sdins's own files to round-off; bad maps exit 2 naming the option.
+//! example of the docs (increments), run on a logger layout written from an `sdins truth`
+//! record, equals the run on sdins's own files to round-off; a rate logger (deg/s, g, RFU
+//! axes, GPS seconds of week) equals it within the trapezoid rule's error; bad maps, units
+//! and gaps exit 2 naming the option or the file and line.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::{Path, PathBuf};
@@ -110,7 +112,7 @@ fn fuse(f: &Files, imu: &Path, gnss: &Path, out: &str, extra: &[&str]) -> Output
 fn rmse(o: &Output) -> Vec<f64> {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    ["roll", "pitch", "yaw", "vN", "vE", "vD", "N", "E", "D"]
+    ["roll", "pitch", "yaw", "v_N", "v_E", "v_D", "N", "E", "D"]
         .iter()
         .map(|k| {
             j["forward_vs_truth"]
@@ -240,7 +242,7 @@ fn bad_maps_exit_2_naming_the_option() {
         "reflection",
         "undulation",
         "--gnss-sigma",
-        "missing",
+        "no column `nope`",
         "3 or 6",
         "column map",
     ];
@@ -285,6 +287,176 @@ fn bad_maps_exit_2_naming_the_option() {
     assert!(
         err.contains("bad.txt:10: accel_x_mps_inc: `oops` is not a number"),
         "{err}"
+    );
+    std::fs::remove_dir_all(&f.dir).ok();
+}
+
+/// GPS seconds of week of the record's t = 0 (a whole second: the run clock's origin is
+/// then t = 0 and the times match the native files exactly).
+const SOW0: f64 = 345_600.0;
+
+/// The rate logger's files: `time,gx,gy,gz,ax,ay,az` in GPS seconds of week, deg/s and g
+/// on right-forward-up axes, one row per sample t_k = kδt, k = 0..N (a rate sensor's
+/// samples include t = 0); the rate at t_k is the native increment of the interval ending
+/// at t_k divided by δt (at t_0 that of the first interval). GNSS `time,lat,lon,alt` in
+/// seconds of week with ellipsoidal heights and no σ. Returns the paths and, from the
+/// native increments, the bounds of the trapezoid rule's error (below).
+fn rate_files(f: &Files) -> (PathBuf, PathBuf, [f64; 2]) {
+    let text = std::fs::read_to_string(&f.imu).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let dt = rows[0][0];
+    let g0 = 9.80665;
+    let mut out = String::from("time,gx,gy,gz,ax,ay,az\n");
+    let mut line = |t: f64, v: &[f64]| {
+        // FRD body → RFU sensor: s = (b_y, b_x, −b_z)
+        let w = [v[2], v[1], -v[3]].map(|x| (x / dt).to_degrees());
+        let a = [v[5], v[4], -v[6]].map(|x| x / dt / g0);
+        out.push_str(&format!(
+            "{},{},{},{},{},{},{}\n",
+            SOW0 + t,
+            w[0],
+            w[1],
+            w[2],
+            a[0],
+            a[1],
+            a[2]
+        ));
+    };
+    line(0.0, &rows[0]);
+    for r in &rows {
+        line(r[0], r);
+    }
+    // Trapezoid error: with ω_k = Δθ_k/δt (ω_0 = ω_1), Δθ'_k = ½(Δθ_{k−1} + Δθ_k), so
+    // Σ_{j≤k} Δθ'_j − Δθ_j = ½(Δθ_1 − Δθ_k): the attitude the mapped record integrates
+    // differs by at most ½ max_k |Δθ_k − Δθ_1| [rad], the velocity by ½ max_k |Δv_k − Δv_1|
+    // [m/s] (the same telescoping sum).
+    let mut bound = [0.0f64; 2];
+    for r in &rows {
+        for i in 0..3 {
+            bound[0] = bound[0].max(0.5 * (r[1 + i] - rows[0][1 + i]).abs());
+            bound[1] = bound[1].max(0.5 * (r[4 + i] - rows[0][4 + i]).abs());
+        }
+    }
+    let imu = f.dir.join("rates.csv");
+    std::fs::write(&imu, out).unwrap();
+    let g = std::fs::read_to_string(&f.gnss).unwrap();
+    let mut own = String::from("time,lat,lon,alt\n");
+    for l in g.lines().skip(1) {
+        let v: Vec<&str> = l.split(',').collect();
+        let t: f64 = v[0].parse().unwrap();
+        own.push_str(&format!("{},{},{},{}\n", SOW0 + t, v[1], v[2], v[3]));
+    }
+    let gnss = f.dir.join("fixes.csv");
+    std::fs::write(&gnss, own).unwrap();
+    (imu, gnss, bound)
+}
+
+const RATE_MAP: &str = "t_s=time,gyro_x_dps=gx,gyro_y_dps=gy,gyro_z_dps=gz,accel_x_g=ax,accel_y_g=ay,accel_z_g=az,axes=x:+y,y:+x,z:-z,time=gps-sow";
+const FIX_MAP: &str = "t_s=time,lat_deg=lat,lon_deg=lon,h_m=alt,time=gps-sow";
+
+#[test]
+fn rate_logger_matches_sdins_files_within_the_trapezoid_error() {
+    let f = files("rates");
+    let (imu, gnss, bound) = rate_files(&f);
+    let want = rmse(&fuse(&f, &f.imu, &f.gnss, "canonical", &[]));
+    let args = [
+        "--imu-columns",
+        RATE_MAP,
+        "--gnss-columns",
+        FIX_MAP,
+        "--gnss-sigma",
+        "1,1,2",
+    ];
+    let o = fuse(&f, &imu, &gnss, "rates", &args);
+    let got = rmse(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("imu: 3001 rows, time gps-sow"), "{err}");
+    let run = std::fs::read_to_string(f.dir.join("rates/run.toml")).unwrap();
+    assert!(
+        run.contains("[inputs.imu]") && run.contains("time_base = \"gps-sow\""),
+        "{run}"
+    );
+    // |RMSE_a − RMSE_b| ≤ RMS(a − b) ≤ max |a − b|. Attitude: the integrated angle bound
+    // ε [rad] (plus the round-off of the decimal deg/s and g text, 1e-12 rad); velocity:
+    // the Δv bound plus the tilt it causes, ε g T; position: the velocity bound times T.
+    let t_end = 30.0;
+    let eps = bound[0] + 1e-12;
+    let v_tol = bound[1] + eps * 9.81 * t_end + 1e-12;
+    let tol = [
+        eps.to_degrees(),
+        eps.to_degrees(),
+        eps.to_degrees(),
+        v_tol,
+        v_tol,
+        v_tol,
+        v_tol * t_end,
+        v_tol * t_end,
+        v_tol * t_end,
+    ];
+    println!("trapezoid bound: {} rad, {} m/s", bound[0], bound[1]);
+    for i in 0..9 {
+        println!("{i}: {} {} (tol {})", want[i], got[i], tol[i]);
+        assert!(
+            (got[i] - want[i]).abs() <= tol[i],
+            "{i}: {} vs {} (tol {})",
+            got[i],
+            want[i],
+            tol[i]
+        );
+    }
+    std::fs::remove_dir_all(&f.dir).ok();
+}
+
+#[test]
+fn rate_logger_errors_exit_2_located() {
+    let f = files("rate-err");
+    let (imu, gnss, _) = rate_files(&f);
+    let run = |imu_map: &str, imu: &Path| {
+        let o = fuse(
+            &f,
+            imu,
+            &gnss,
+            "err",
+            &[
+                "--imu-columns",
+                imu_map,
+                "--gnss-columns",
+                FIX_MAP,
+                "--gnss-sigma",
+                "1,1,2",
+            ],
+        );
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+        err
+    };
+    // a reflection (z not flipped with x↔y swapped)
+    let e = run(&RATE_MAP.replace("z:-z", "z:+z"), &imu);
+    assert!(
+        e.contains("--imu-columns") && e.contains("reflection"),
+        "{e}"
+    );
+    // an unknown unit
+    let e = run(&RATE_MAP.replace("gyro_x_dps", "gyro_x_rpm"), &imu);
+    assert!(
+        e.contains("--imu-columns") && e.contains("gyro_x_rpm"),
+        "{e}"
+    );
+    // a gap: lines 102..=104 (samples 100..=102) removed
+    let text = std::fs::read_to_string(&imu).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines.drain(101..104);
+    let gap = f.dir.join("gap.csv");
+    std::fs::write(&gap, lines.join("\n") + "\n").unwrap();
+    let e = run(RATE_MAP, &gap);
+    assert!(
+        e.contains("gap.csv:102: t_s: sample interval") && e.contains("a gap"),
+        "{e}"
     );
     std::fs::remove_dir_all(&f.dir).ok();
 }
