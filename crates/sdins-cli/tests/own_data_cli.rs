@@ -221,7 +221,7 @@ fn bad_maps_exit_2_naming_the_option() {
                 "--gnss-columns",
                 gnss_ok,
             ],
-            "--imu-columns",
+            "imu.txt:2: gyro_x_dps",
         ),
         (
             vec![
