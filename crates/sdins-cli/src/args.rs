@@ -65,7 +65,8 @@ pub fn warn_deprecated(args: &[std::ffi::OsString]) {
 }
 
 /// The column maps of one's own files (docs/own-data.md): `--imu-columns`,
-/// `--gnss-columns`, an input profile and the settings a file cannot carry.
+/// `--gnss-columns`, `--truth-columns`, an input profile and the settings a file cannot
+/// carry.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct ColumnsArgs {
     /// read the IMU file through a column map `quantity_unit=COLUMN,…` with settings
@@ -77,7 +78,12 @@ pub struct ColumnsArgs {
     /// `alt_msl_m=…`, optional σ and velocity columns; docs/own-data.md)
     #[arg(long, value_name = "MAP")]
     pub gnss_columns: Option<String>,
-    /// input profile: a TOML file with `[imu]` and `[gnss]` maps (docs/own-data.md)
+    /// read the --truth file through a column map (time, position, attitude and velocity
+    /// columns; `yaw=ned|enu|enu-east`; docs/own-data.md)
+    #[arg(long, value_name = "MAP")]
+    pub truth_columns: Option<String>,
+    /// input profile: a TOML file with `[imu]`, `[gnss]` and `[reference]` maps
+    /// (docs/own-data.md)
     #[arg(long, value_name = "FILE")]
     pub profile: Option<PathBuf>,
     /// GPS week of `time=gps-sow` files without a week column
@@ -86,83 +92,36 @@ pub struct ColumnsArgs {
     /// σ of fixes whose file has no σ columns: N,E,D[,vN,vE,vD] [m, m/s]
     #[arg(long, value_name = "N,E,D[,vN,vE,vD]")]
     pub gnss_sigma: Option<String>,
-    /// geoid undulation N [m] for a GNSS map with `alt_msl_m` (h = H + N)
+    /// geoid undulation N [m] for a map with `alt_msl_m` (h = H + N)
     #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub undulation_m: Option<f64>,
 }
 
+/// An option name as the command line spells it (`imu_columns` → `--imu-columns`).
+pub fn flag_name(name: &str) -> String {
+    format!("--{}", name.replace('_', "-"))
+}
+
 impl ColumnsArgs {
-    /// The IMU and GNSS maps from the options and the profile (a map given both ways is
-    /// refused); every error names its option or `profile:line`.
+    /// The library's options.
+    pub fn options(&self) -> sdins_sim::fusion::files::ColumnOptions {
+        sdins_sim::fusion::files::ColumnOptions {
+            imu_columns: self.imu_columns.clone(),
+            gnss_columns: self.gnss_columns.clone(),
+            truth_columns: self.truth_columns.clone(),
+            profile: self.profile.clone(),
+            gps_week: self.gps_week,
+            gnss_sigma: self.gnss_sigma.clone(),
+            undulation_m: self.undulation_m,
+        }
+    }
+    /// The IMU, GNSS and reference maps from the options and the profile (a map given
+    /// both ways is refused); every error names its option or `profile:line` (exit 2).
     pub fn resolve(
         &self,
-    ) -> Result<
-        (
-            Option<sdins_sim::io::imu_columns::ImuColumns>,
-            Option<sdins_sim::io::gnss_columns::GnssColumns>,
-        ),
-        crate::error::CliError,
-    > {
-        use crate::error::CliError;
-        use sdins_sim::io::columns::MapOrigin;
-        use sdins_sim::io::gnss_columns::{GnssColumns, GnssSigma};
-        use sdins_sim::io::imu_columns::ImuColumns;
-        let bad = |e: sdins_sim::io::columns::ColumnsError| CliError::bad(e.to_string());
-        let (mut imu, mut gnss) = match &self.profile {
-            Some(p) => {
-                let pr = sdins_sim::io::profile::Profile::read(p).map_err(bad)?;
-                (pr.imu, pr.gnss)
-            }
-            None => (None, None),
-        };
-        if let Some(text) = &self.imu_columns {
-            if imu.is_some() {
-                return Err(CliError::bad(
-                    "--imu-columns: the profile has an [imu] map too: give one",
-                ));
-            }
-            imu = Some(
-                ImuColumns::parse(text, MapOrigin::Option("--imu-columns".into())).map_err(bad)?,
-            );
-        }
-        if let Some(text) = &self.gnss_columns {
-            if gnss.is_some() {
-                return Err(CliError::bad(
-                    "--gnss-columns: the profile has a [gnss] map too: give one",
-                ));
-            }
-            gnss = Some(
-                GnssColumns::parse(text, MapOrigin::Option("--gnss-columns".into()))
-                    .map_err(bad)?,
-            );
-        }
-        if let Some(w) = self.gps_week {
-            if imu.is_none() && gnss.is_none() {
-                return Err(CliError::bad(
-                    "--gps-week applies to files read through a column map (--imu-columns, --gnss-columns or --profile)",
-                ));
-            }
-            if let Some(c) = imu.as_mut() {
-                c.gps_week = Some(w);
-            }
-            if let Some(c) = gnss.as_mut() {
-                c.gps_week = Some(w);
-            }
-        }
-        let need_gnss = |opt: &str| {
-            CliError::bad(format!(
-                "{opt} applies to a GNSS file read through a column map (--gnss-columns or a profile's [gnss])"
-            ))
-        };
-        if let Some(s) = &self.gnss_sigma {
-            let c = gnss.as_mut().ok_or_else(|| need_gnss("--gnss-sigma"))?;
-            c.sigma =
-                Some(GnssSigma::parse(s).map_err(|e| CliError::bad(format!("--gnss-sigma: {e}")))?);
-        }
-        if let Some(n) = self.undulation_m {
-            let c = gnss.as_mut().ok_or_else(|| need_gnss("--undulation-m"))?;
-            c.undulation_m = Some(n);
-        }
-        Ok((imu, gnss))
+    ) -> Result<sdins_sim::fusion::files::InputColumns, crate::error::CliError> {
+        self.options()
+            .resolve(&flag_name)
+            .map_err(|e| crate::error::CliError::bad(e.to_string()))
     }
 }

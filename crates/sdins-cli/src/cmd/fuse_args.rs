@@ -4,7 +4,6 @@
 //! (`sdins_sim::fusion::request::FuseRequest`).
 
 use crate::error::CliError;
-use sdins_sim::fusion::files::InputColumns;
 use sdins_sim::fusion::request::{FilesData, FuseData, FuseRequest, FuseRunError, ScenarioData};
 use sdins_sim::scenario::Scenario;
 use std::path::PathBuf;
@@ -196,7 +195,6 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
                 .gnss
                 .clone()
                 .ok_or_else(|| CliError::bad("--imu needs --gnss FILE"))?;
-            let (imu_map, gnss_map) = a.columns.resolve()?;
             FuseData::Files(FilesData {
                 imu: (imu.clone(), a.imu_format.parse().map_err(CliError::bad)?),
                 gnss: (gnss, a.gnss_format.parse().map_err(CliError::bad)?),
@@ -208,10 +206,7 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
                 static_s: a.static_s,
                 lever_arm_m: opt_triple("--lever-arm-m", &a.lever_arm_m)?,
                 truth: a.truth.clone(),
-                columns: InputColumns {
-                    imu: imu_map,
-                    gnss: gnss_map,
-                },
+                columns: a.columns.resolve()?,
             })
         }
         (None, Some(name)) => {
@@ -222,10 +217,10 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
                 ("--static-s", a.static_s.is_some()),
                 ("--truth", a.truth.is_some()),
                 ("--lever-arm-m", a.lever_arm_m.is_some()),
-                ("--imu-columns", a.columns.imu_columns.is_some()),
-                ("--gnss-columns", a.columns.gnss_columns.is_some()),
-                ("--profile", a.columns.profile.is_some()),
-                ("--gnss-sigma", a.columns.gnss_sigma.is_some()),
+                (
+                    "--imu-columns, --gnss-columns, --profile, …",
+                    a.columns.options().any(),
+                ),
             ] {
                 if given {
                     return Err(CliError::bad(format!(

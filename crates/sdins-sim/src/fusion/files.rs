@@ -10,8 +10,8 @@ use crate::fusion::records::{
     TruthComparison,
 };
 use crate::fusion::simulated::{FuseError, InitSigma};
-use crate::io::columns::ColumnsError;
-use crate::io::gnss_columns::{read_gnss_columns, GnssColumns};
+use crate::io::columns::{ColumnsError, InputKind, MapOrigin};
+use crate::io::gnss_columns::{read_gnss_columns, GnssColumns, GnssSigma};
 use crate::io::gnss_file::TimeBase;
 use crate::io::gnss_file::{
     clip_to_imu_span, imu_span_s, read_gnss_file, to_imu_time, GnssFileError, GnssFormat,
@@ -20,6 +20,9 @@ use crate::io::gnss_file::{
 use crate::io::imu_columns::{read_imu_columns, ImuColumns, InputReport};
 use crate::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use crate::io::navego_params::{read_navego_imu_params, NavegoImuParams, ParamsError};
+use crate::io::reference_file::{
+    parse_generic_on, ColumnMap as ReferenceColumns, ReferenceFileError,
+};
 use crate::io::time::{ClockScale, RunClock};
 use crate::io::truth_file::{read_truth, TruthFileError};
 use crate::sensors::imu_error::ImuErrorModel;
@@ -141,6 +144,122 @@ pub struct InputColumns {
     pub imu: Option<ImuColumns>,
     /// the GNSS file's map (its format is then ignored)
     pub gnss: Option<GnssColumns>,
+    /// the reference trajectory's map (it needs the velocity columns)
+    pub truth: Option<ReferenceColumns>,
+}
+
+/// The column-map options as the user gives them (CLI `--imu-columns`, …; Python
+/// `imu_columns=`, …): maps as text, a profile, and the values a file cannot carry.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ColumnOptions {
+    /// IMU map text
+    pub imu_columns: Option<String>,
+    /// GNSS map text
+    pub gnss_columns: Option<String>,
+    /// reference map text
+    pub truth_columns: Option<String>,
+    /// TOML input profile with `[imu]`, `[gnss]`, `[reference]` maps
+    pub profile: Option<PathBuf>,
+    /// GPS week of `time=gps-sow` files without a week column
+    pub gps_week: Option<u32>,
+    /// σ of fixes without σ columns: `N,E,D[,vN,vE,vD]` \[m, m/s\]
+    pub gnss_sigma: Option<String>,
+    /// geoid undulation \[m\] for `alt_msl_m` maps
+    pub undulation_m: Option<f64>,
+}
+
+impl ColumnOptions {
+    /// Whether any option is given.
+    pub fn any(&self) -> bool {
+        *self != Self::default()
+    }
+    /// The maps of the options and the profile (a map given both ways is refused). `name`
+    /// spells an option for messages (`imu_columns` → `--imu-columns` on the CLI).
+    pub fn resolve(&self, name: &dyn Fn(&str) -> String) -> Result<InputColumns, ColumnsError> {
+        let opt = |o: &str, m: String| ColumnsError::map(&MapOrigin::Option(name(o)), m);
+        let mut c = match &self.profile {
+            Some(p) => {
+                let pr = crate::io::profile::Profile::read(p)?;
+                InputColumns {
+                    imu: pr.imu,
+                    gnss: pr.gnss,
+                    truth: pr.reference,
+                }
+            }
+            None => InputColumns::default(),
+        };
+        let both = |o: &str, t: &str| opt(o, format!("the profile has a [{t}] map too: give one"));
+        if let Some(text) = &self.imu_columns {
+            if c.imu.is_some() {
+                return Err(both("imu_columns", "imu"));
+            }
+            c.imu = Some(ImuColumns::parse(
+                text,
+                MapOrigin::Option(name("imu_columns")),
+            )?);
+        }
+        if let Some(text) = &self.gnss_columns {
+            if c.gnss.is_some() {
+                return Err(both("gnss_columns", "gnss"));
+            }
+            c.gnss = Some(GnssColumns::parse(
+                text,
+                MapOrigin::Option(name("gnss_columns")),
+            )?);
+        }
+        if let Some(text) = &self.truth_columns {
+            if c.truth.is_some() {
+                return Err(both("truth_columns", "reference"));
+            }
+            c.truth = Some(ReferenceColumns::new(crate::io::columns::ColumnMap::parse(
+                InputKind::Reference,
+                text,
+                MapOrigin::Option(name("truth_columns")),
+            )?));
+        }
+        if let Some(w) = self.gps_week {
+            if c.imu.is_none() && c.gnss.is_none() && c.truth.is_none() {
+                return Err(opt(
+                    "gps_week",
+                    "applies to files read through a column map".into(),
+                ));
+            }
+            if let Some(m) = c.imu.as_mut() {
+                m.gps_week = Some(w);
+            }
+            if let Some(m) = c.gnss.as_mut() {
+                m.gps_week = Some(w);
+            }
+            if let Some(m) = c.truth.as_mut() {
+                m.gps_week = Some(w);
+            }
+        }
+        let need_gnss = |o: &str| {
+            opt(
+                o,
+                format!(
+                    "applies to a GNSS file read through a column map ({} or a profile's [gnss])",
+                    name("gnss_columns")
+                ),
+            )
+        };
+        if let Some(s) = &self.gnss_sigma {
+            let m = c.gnss.as_mut().ok_or_else(|| need_gnss("gnss_sigma"))?;
+            m.sigma = Some(GnssSigma::parse(s).map_err(|e| opt("gnss_sigma", e))?);
+        }
+        if let Some(n) = self.undulation_m {
+            if c.gnss.is_none() && c.truth.is_none() {
+                return Err(need_gnss("undulation_m"));
+            }
+            if let Some(m) = c.gnss.as_mut() {
+                m.undulation_m = Some(n);
+            }
+            if let Some(m) = c.truth.as_mut() {
+                m.undulation_m = Some(n);
+            }
+        }
+        Ok(c)
+    }
 }
 
 /// Why a fused run on files failed.
@@ -162,6 +281,9 @@ pub enum FilesError {
     /// a column map or a file read through one
     #[error(transparent)]
     Columns(#[from] ColumnsError),
+    /// a reference trajectory read through a column map
+    #[error(transparent)]
+    Reference(#[from] ReferenceFileError),
     /// the filter or an option
     #[error(transparent)]
     Fuse(#[from] FuseError),
@@ -290,9 +412,21 @@ pub fn fuse_files(
         }
         InitSource::StaticCoarse(w) => RecordInit::StaticCoarse { window_s: w },
     };
-    let truth = match &input.truth {
-        Some(p) => Some(read_truth(p)?),
-        None => None,
+    let truth = match (&input.truth, &input.columns.truth) {
+        (Some(p), Some(m)) => {
+            let (t, rep) = read_truth_columns(p, m, inputs.first().map(|r| r.clock))?;
+            inputs.push(rep);
+            Some(t)
+        }
+        (Some(p), None) => Some(read_truth(p)?),
+        (None, Some(m)) => {
+            return Err(ColumnsError::map(
+                &m.map.origin,
+                "a reference map needs a reference file (--truth FILE / truth=)",
+            )
+            .into())
+        }
+        (None, None) => None,
     };
     // the comparison starts counting ±3σ after the navigation start + check_after_s;
     // the start is known only inside fuse_records: use the later of the first fix and
@@ -332,4 +466,40 @@ pub fn fuse_files(
         smoothed: smo,
         inputs,
     })
+}
+
+/// A reference trajectory read through a map, as truth samples on the run's clock (the
+/// IMU map's, else the file's own). The comparison needs the velocity: a map without
+/// `v_n`/`v_e` columns is refused.
+fn read_truth_columns(
+    path: &Path,
+    m: &ReferenceColumns,
+    clock: Option<RunClock>,
+) -> Result<(Vec<crate::truth::TruthSample>, InputReport), FilesError> {
+    let bytes = crate::input::read_capped(path).map_err(|source| TruthFileError::Io {
+        file: path.into(),
+        source,
+    })?;
+    let text = crate::input::text_lossy(bytes);
+    let (rows, rep) = parse_generic_on(path, &text, m, clock.as_ref())?;
+    let mut out = Vec::with_capacity(rows.len());
+    for r in rows {
+        let Some(v) = r.v_n_mps else {
+            return Err(ColumnsError::map(
+                &m.map.origin,
+                "the comparison with the reference needs its velocity: map v_n, v_e and v_d (or v_u)",
+            )
+            .into());
+        };
+        out.push(crate::truth::TruthSample::new(
+            r.t_s,
+            Default::default(),
+            r.lat_rad,
+            r.lon_rad,
+            r.h_m,
+            v,
+            sdins_core::math::c_b_n_from_euler(&r.euler),
+        ));
+    }
+    Ok((out, rep))
 }
