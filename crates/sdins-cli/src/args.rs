@@ -14,6 +14,60 @@ pub struct ImuFormatArg {
     /// navego (docs/imu-files.md); `--format` is a deprecated alias
     #[arg(long = "imu-format", alias = "format", value_name = "FORMAT", default_value = "auto", value_parser = parse_imu_format)]
     pub imu_format: ImuFormat,
+    /// read the IMU file through a column map `quantity_unit=COLUMN,…` with settings
+    /// (`axes=`, `mount_deg=`, `time=`, `delim=`, `header=`, `rates=`; docs/own-data.md);
+    /// replaces --imu-format
+    #[arg(long, value_name = "MAP")]
+    pub imu_columns: Option<String>,
+    /// input profile: a TOML file whose `[imu]` map reads the IMU file (docs/own-data.md)
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
+}
+
+impl ImuFormatArg {
+    /// `--imu-format auto` and no map.
+    #[cfg(test)]
+    pub fn auto() -> Self {
+        Self {
+            imu_format: ImuFormat::Auto,
+            imu_columns: None,
+            profile: None,
+        }
+    }
+    /// The IMU map of `--imu-columns` or the profile's `[imu]` (errors name the option or
+    /// `profile:line`; exit 2).
+    pub fn columns(
+        &self,
+    ) -> Result<Option<sdins_sim::io::imu_columns::ImuColumns>, crate::error::CliError> {
+        let o = sdins_sim::fusion::files::ColumnOptions {
+            imu_columns: self.imu_columns.clone(),
+            profile: self.profile.clone(),
+            ..Default::default()
+        };
+        let c = o
+            .resolve(&flag_name)
+            .map_err(|e| crate::error::CliError::bad(e.to_string()))?;
+        if self.profile.is_some() && c.imu.is_none() {
+            return Err(crate::error::CliError::bad(
+                "--profile: the profile has no [imu] map",
+            ));
+        }
+        Ok(c.imu)
+    }
+    /// Read the IMU file in the format or through the map; the map's summary goes to stderr.
+    pub fn read(
+        &self,
+        path: &std::path::Path,
+    ) -> Result<sdins_sim::io::imu_file::ImuData, crate::error::CliError> {
+        let cols = self.columns()?;
+        let (d, rep) =
+            sdins_sim::io::imu_columns::read_imu_any(path, self.imu_format, cols.as_ref())
+                .map_err(crate::error::CliError::bad)?;
+        if let Some(r) = rep {
+            eprintln!("{}", r.summary());
+        }
+        Ok(d)
+    }
 }
 
 fn parse_imu_format(s: &str) -> Result<ImuFormat, String> {

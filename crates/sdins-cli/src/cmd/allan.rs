@@ -54,7 +54,11 @@ fn file_error(e: ImuFileError) -> CliError {
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let data = read_imu_file(&args.imu, args.imu_format.imu_format).map_err(file_error)?;
+    let data = if args.imu_format.imu_columns.is_some() || args.imu_format.profile.is_some() {
+        args.imu_format.read(&args.imu)?
+    } else {
+        read_imu_file(&args.imu, args.imu_format.imu_format).map_err(file_error)?
+    };
     let n = data.increments.len();
     if n < 20 {
         return Err(CliError::bad(format!(
@@ -382,9 +386,7 @@ mod tests {
         let out = dir.join("out");
         crate::output::finish(run(Args {
             imu: file.clone(),
-            imu_format: crate::args::ImuFormatArg {
-                imu_format: ImuFormat::Auto,
-            },
+            imu_format: crate::args::ImuFormatArg::auto(),
             out: out.clone(),
             json: true,
         }))
@@ -417,9 +419,7 @@ mod tests {
         .unwrap();
         let e = crate::output::finish(run(Args {
             imu: dir.join("bad.csv"),
-            imu_format: crate::args::ImuFormatArg {
-                imu_format: ImuFormat::Auto,
-            },
+            imu_format: crate::args::ImuFormatArg::auto(),
             out: out.clone(),
             json: false,
         }))

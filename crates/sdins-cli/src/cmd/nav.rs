@@ -51,8 +51,8 @@ pub struct Args {
 }
 
 /// The run as the library takes it.
-fn request(args: &Args) -> NavFileRequest {
-    NavFileRequest {
+fn request(args: &Args) -> Result<NavFileRequest, CliError> {
+    Ok(NavFileRequest {
         imu: args.imu.clone(),
         imu_format: args.imu_format.imu_format,
         init: args.init.clone(),
@@ -61,12 +61,14 @@ fn request(args: &Args) -> NavFileRequest {
         coning: args.coning.clone(),
         earth: args.earth.clone(),
         truth: args.truth.clone(),
-    }
+        imu_columns: args.imu_format.columns()?,
+    })
 }
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let plan = recorded::prepare(&request(&args)).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let plan =
+        recorded::prepare(&request(&args)?).map_err(|e| CliError::BadInput(e.to_string()))?;
     let spec = plan.spec;
     let out = args
         .out

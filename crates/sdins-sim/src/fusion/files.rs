@@ -17,7 +17,7 @@ use crate::io::gnss_file::{
     clip_to_imu_span, imu_span_s, read_gnss_file, to_imu_time, GnssFileError, GnssFormat,
     GnssReadOptions, GnssReadReport, ImuClock,
 };
-use crate::io::imu_columns::{read_imu_columns, ImuColumns, InputReport};
+use crate::io::imu_columns::{read_imu_record, ImuColumns, InputReport};
 use crate::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use crate::io::navego_params::{read_navego_imu_params, NavegoImuParams, ParamsError};
 use crate::io::reference_file::{
@@ -331,21 +331,9 @@ pub fn fuse_files(
     let mut inputs = Vec::new();
     let imu = match &input.columns.imu {
         Some(c) => {
-            let d = read_imu_columns(&input.imu.0, c, None)?;
-            if d.segments.len() > 1 {
-                return Err(ColumnsError::Data {
-                    file: input.imu.0.clone(),
-                    line: 1,
-                    field: "(time)".into(),
-                    message: format!(
-                        "the record has {} segments split at gaps: fuse runs on one continuous record (cut the file at the gap)",
-                        d.segments.len()
-                    ),
-                }
-                .into());
-            }
-            inputs.push(d.report);
-            d.data
+            let (d, rep) = read_imu_record(&input.imu.0, c, None)?;
+            inputs.push(rep);
+            d
         }
         None => read_imu_file(&input.imu.0, input.imu.1)?,
     };

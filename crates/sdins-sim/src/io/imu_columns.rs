@@ -172,6 +172,52 @@ pub fn read_imu_columns(
     parse_imu_columns(path, &text, cols, clock)
 }
 
+/// Read `path` through `cols` as one continuous record (a record split at gaps by
+/// `allow_gaps` is refused: cut the file at the gap), with its report.
+pub fn read_imu_record(
+    path: &Path,
+    cols: &ImuColumns,
+    clock: Option<&RunClock>,
+) -> Result<(ImuData, InputReport), ColumnsError> {
+    let d = read_imu_columns(path, cols, clock)?;
+    if d.segments.len() > 1 {
+        return Err(ColumnsError::Data {
+            file: path.to_path_buf(),
+            line: 1,
+            field: "(time)".into(),
+            message: format!(
+                "the record has {} segments split at gaps: this runs on one continuous record (cut the file at the gap)",
+                d.segments.len()
+            ),
+        });
+    }
+    Ok((d.data, d.report))
+}
+
+/// An IMU file read through `cols` when given, else in its format; with the map's report.
+pub fn read_imu_any(
+    path: &Path,
+    format: crate::io::imu_file::ImuFormat,
+    cols: Option<&ImuColumns>,
+) -> Result<(ImuData, Option<InputReport>), String> {
+    match cols {
+        Some(c) => {
+            if format != crate::io::imu_file::ImuFormat::Auto {
+                return Err(format!(
+                    "{}: the IMU file is read through a column map: give either it or an IMU format",
+                    c.map.origin
+                ));
+            }
+            read_imu_record(path, c, None)
+                .map(|(d, r)| (d, Some(r)))
+                .map_err(|e| e.to_string())
+        }
+        None => crate::io::imu_file::read_imu_file(path, format)
+            .map(|d| (d, None))
+            .map_err(|e| e.to_string()),
+    }
+}
+
 /// A triad: its three columns' indices, SI factors and whether they are increments.
 struct Triad {
     idx: [usize; 3],
