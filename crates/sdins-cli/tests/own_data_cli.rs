@@ -506,3 +506,77 @@ fn rate_logger_errors_exit_2_located() {
     );
     std::fs::remove_dir_all(&f.dir).ok();
 }
+
+/// `nav` and `allan` read the same logger through `--imu-columns` (the IMU-file options
+/// every command shares).
+#[test]
+fn nav_and_allan_read_the_rate_logger() {
+    let f = files("nav");
+    let (imu, _, bound) = rate_files(&f);
+    let nav = |imu: &Path, extra: &[&str], out: &str| {
+        let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
+            .args(["nav", "--imu"])
+            .arg(imu)
+            .arg("--truth")
+            .arg(&f.truth)
+            .args(["--init", INIT, "--json", "--out"])
+            .arg(f.dir.join(out))
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let p: Vec<f64> = j["final"]["pos_err_ned_m"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        (p, String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    let (want, _) = nav(&f.imu, &[], "nav-native");
+    let (got, err) = nav(&imu, &["--imu-columns", RATE_MAP], "nav-map");
+    assert!(err.contains("imu: 3001 rows, time gps-sow"), "{err}");
+    // free inertial over T = 30 s: the attitude bound ε tilts g into a velocity error
+    // ε g T, which integrates to ½ ε g T² in position; plus the Δv bound times T
+    let t = 30.0;
+    let tol = 0.5 * bound[0] * 9.81 * t * t + bound[1] * t + 1e-9;
+    for i in 0..3 {
+        println!("nav {i}: {} {} (tol {tol})", want[i], got[i]);
+        assert!(
+            (got[i] - want[i]).abs() <= tol,
+            "{i}: {} vs {}",
+            got[i],
+            want[i]
+        );
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args(["allan", "--imu"])
+        .arg(&imu)
+        .args(["--imu-columns", RATE_MAP, "--json", "--out"])
+        .arg(f.dir.join("allan"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("imu: 3001 rows"), "{err}");
+    // a reflection is refused on nav as on fuse
+    let o = Command::new(env!("CARGO_BIN_EXE_sdins"))
+        .args(["nav", "--imu"])
+        .arg(&imu)
+        .args([
+            "--init",
+            INIT,
+            "--imu-columns",
+            &RATE_MAP.replace("z:-z", "z:+z"),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--imu-columns") && err.contains("reflection"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&f.dir).ok();
+}

@@ -87,6 +87,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (mut write_err, mut final_state) = (None, None);
     // what was used, so that nobody has to guess a default
     eprintln!("{}", used(&args, &plan));
+    if let Some(r) = &plan.imu_report {
+        eprintln!("{}", r.summary());
+    }
     let rec = recorded::run_plan(&plan, &crate::progress::token(), |t, st| {
         final_state = Some((t, *st));
         if let Err(err) = nav_csv.row(&nav_row(t, st)) {
@@ -119,7 +122,9 @@ fn used(args: &Args, plan: &recorded::NavFilePlan) -> String {
     format!(
         "sdins nav: {} format {}, algorithm {}, N = {}, coning {}, earth {}",
         args.imu.display(),
-        if args.imu_format.imu_format == ImuFormat::Auto {
+        if plan.imu_report.is_some() {
+            "read through the column map".to_string()
+        } else if args.imu_format.imu_format == ImuFormat::Auto {
             format!("{} (detected)", data.format.name())
         } else {
             data.format.name().to_string()

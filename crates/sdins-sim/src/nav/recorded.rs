@@ -255,6 +255,8 @@ pub struct NavFilePlan {
     pub t0_s: f64,
     /// navigation updates the run will make
     pub updates: usize,
+    /// what the column map did (time base, clock, offsets), when one was given
+    pub imu_report: Option<crate::io::imu_columns::InputReport>,
 }
 
 /// Read and check the inputs of `sdins nav` (messages name the file, line and option).
@@ -273,7 +275,7 @@ pub fn prepare(req: &NavFileRequest) -> Result<NavFilePlan, NavInputError> {
         [] => return Err(bad("--algo: no algorithm given".into())),
         _ => return Err(bad("--algo: `nav` runs one algorithm".into())),
     };
-    let (data, _) =
+    let (data, imu_report) =
         crate::io::imu_columns::read_imu_any(&req.imu, req.imu_format, req.imu_columns.as_ref())
             .map_err(bad)?;
     let truth = match &req.truth {
@@ -311,6 +313,7 @@ pub fn prepare(req: &NavFileRequest) -> Result<NavFilePlan, NavInputError> {
         earth,
         t0_s,
         updates,
+        imu_report,
     })
 }
 
