@@ -1,7 +1,7 @@
 //! One column-map mechanism for every tabular input (IMU, GNSS, reference/truth, and the
 //! aiding sensors' files to come): the text form `quantity_unit=COLUMN,…` of `--columns`,
 //! the unit suffixes, the axis map and the settings a map may carry, parsed in one place
-//! (docs/imu-files.md §"Column maps").
+//! (docs/own-data.md §"The map").
 //!
 //! * A **column key** is a quantity and a unit suffix, `gyro_x_dps`, `t_ms`, `lat_deg`,
 //!   `accel_z_mps_inc` (a velocity increment); `COLUMN` is the file's column name or its

@@ -1,5 +1,5 @@
 //! Input profiles: a small TOML file that keeps a logger's column maps for reuse
-//! (`--profile FILE`; docs/imu-files.md §"Input profiles"). One table per input kind:
+//! (`--profile FILE`; docs/own-data.md §"Input profiles"). One table per input kind:
 //!
 //! ```toml
 //! [imu]
