@@ -570,7 +570,9 @@ def fuse_files(
     prior σ); ``innovations`` (t_s, t_valid_s, kind, dof, nis, accepted, forced, late,
     innovation (m, 12)); ``fixes_used``, ``rejected``, ``late``, ``fixes_outside`` (before, after),
     ``imu_samples``; with ``truth``: ``forward_rmse`` / ``smoothed_rmse`` (roll, pitch,
-    yaw [rad], v N, E, D [m/s], N, E, D [m]) and their ``*_inside_3sigma`` fractions.
+    yaw [rad], v N, E, D [m/s], N, E, D [m]) and their ``*_inside_3sigma`` fractions;
+    ``health``: the verdict (``{"ok": bool, "checks": [...]}``; never raised: check
+    ``result["health"]["ok"]``).
     """
     return _sdins.fuse_files(
         imu, gnss, imu_format, gnss_format, grade, navego_params, init,

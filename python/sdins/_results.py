@@ -364,7 +364,9 @@ class FuseResult:
     ``nis``, ``accepted``, ``forced``, ``late``, ``innovation`` (m, 12; first ``dof`` used).
     Summary: ``fixes``, ``rejected``, ``late``, ``nav_updates``, ``accel_bias_est_mps2``,
     ``accel_bias_true_mps2``, ``gyro_bias_est_rps``, ``gyro_bias_true_rps``, ``samples``,
-    ``run``. With ``scale_factors_ppm`` (the 21-state filter) also
+    ``run``; ``health``: the verdict (``{"ok": bool, "checks": [{"name", "passed",
+    "detail"}]}``, docs/user-guide.md "Health verdict"; never raised). With
+    ``scale_factors_ppm`` (the 21-state filter) also
     ``scale_factor_error`` / ``scale_factor_sigma`` (n, 6; true error ``s − ŝ`` and 1σ,
     dimensionless, accelerometer x y z then gyro x y z) and ``accel_scale_est``,
     ``accel_scale_true``, ``gyro_scale_est``, ``gyro_scale_true``; otherwise those are
@@ -400,6 +402,7 @@ class FuseResult:
             "gyro_bias_est_rps", "gyro_bias_true_rps", "samples", "run",
         ):
             setattr(self, k, d[k])
+        self.health: Dict[str, Any] = d["health"]
 
     def rms(self) -> Dict[str, List[float]]:
         """RMS over the epochs of the position [m], velocity [m/s] and attitude [rad]

@@ -111,6 +111,10 @@ def test_fuse_equals_cli_json(cli, tmp_path):
         assert row[0] == r.t_s[k]
         assert row[1:4] == list(r.pos_error_ned_m[k])
         assert row[4:7] == list(r.sigma[k, 0:3])
+    # the health verdict: the same checks and words as the CLI's
+    assert r.health == js["health"] and r.health["ok"]
+    assert [c["name"] for c in r.health["checks"]] == [
+        "nis_windows", "rejected_share", "forced_updates", "sigma_h", "bias"]
     inn = r.innovations
     assert (inn["kind"] == "gnss").sum() == js["fixes"]
     assert (~inn["accepted"]).sum() == js["rejected"]
@@ -157,6 +161,7 @@ def test_fuse_files_navego_equals_cli(cli, tmp_path):
     js = json.loads(out)
     r = sdins.fuse_files(**args)
     assert r["fixes_used"] == js["fixes_used"] and r["rejected"] == js["rejected"]
+    assert r["health"] == js["health"] and r["health"]["ok"]
     names = ["roll", "pitch", "yaw", "v_N", "v_E", "v_D", "N", "E", "D"]
     for i, n in enumerate(names):
         want = js["smoothed_vs_truth"][n]["rmse"]
@@ -288,7 +293,8 @@ def test_fuse_files_column_maps_equal_cli(cli, tmp_path):
     code, out, err = cli(
         "fuse", "--imu", str(imu), "--gnss", str(gnss), "--imu-columns", RATE_MAP,
         "--gnss-columns", FIX_MAP, "--gnss-sigma", "1,1,2", "--grade", "tactical",
-        "--init", init, "--truth", str(truth), "--json", "--out", str(tmp_path / "o"),
+        "--init", init, "--truth", str(truth), "--json", "--health", "warn",
+        "--out", str(tmp_path / "o"),
     )
     assert code == 0, err
     js = json.loads(out)

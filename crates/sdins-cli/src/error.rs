@@ -23,6 +23,10 @@ pub enum CliError {
     /// Stopped by SIGINT/SIGTERM through the cancellation token. Exit code 130 or 143.
     #[error("interrupted: no output written")]
     Interrupted,
+    /// The inputs were valid but the result failed its own checks (the fusion health
+    /// verdict); the outputs are written. Exit code 3.
+    #[error("{0}")]
+    ResultFailedChecks(String),
 }
 
 impl CliError {
@@ -33,6 +37,7 @@ impl CliError {
             CliError::Io { source, .. } if user_io_cause(source).is_some() => 2,
             CliError::Io { .. } | CliError::Other(_) => 1,
             CliError::Interrupted => crate::progress::cancel_exit_code(),
+            CliError::ResultFailedChecks(_) => 3,
         }
     }
     /// Shorthand for a bad-input error.

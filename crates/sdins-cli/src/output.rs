@@ -506,6 +506,11 @@ pub fn abort_all() {
 pub fn finish(result: Result<(), CliError>) -> Result<(), CliError> {
     match result {
         Ok(()) => commit_all(),
+        // the result failed its own checks: its outputs are kept (exit 3)
+        Err(e @ CliError::ResultFailedChecks(_)) => {
+            commit_all()?;
+            Err(e)
+        }
         Err(e) => {
             abort_all();
             Err(e)

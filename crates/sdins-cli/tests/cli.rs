@@ -820,3 +820,86 @@ fn allan_of_a_moving_record_warns() {
         assert_eq!(stderr.contains("does not look static"), warns, "{stderr}");
     }
 }
+
+/// The health verdict (bring-your-own-data issue, part 4): NaveGo's ADIS16488 record
+/// (static biases 720 °/h and 16 mg) fused with the tactical preset diverges; the outputs
+/// are written, every failed check is named on stderr, and the exit code is 3; `--health
+/// warn` turns it into a warning and exit 0. The same record with NaveGo's own parameters
+/// passes (exit 0).
+#[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data")]
+fn fuse_health_verdict_exit_3_on_a_diverged_filter() {
+    let base = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/csv/navego/"
+    );
+    if !std::path::Path::new(base).exists() {
+        eprintln!("skipped: ../shared/data not present");
+        return;
+    }
+    let f = |n: &str| format!("{base}{n}");
+    let d = tmp("health");
+    let (imu, gnss, truth) = (f("imu2.csv"), f("gnss.csv"), f("ref.csv"));
+    let common = [
+        "fuse",
+        "--imu",
+        &imu,
+        "--imu-format",
+        "navego",
+        "--gnss",
+        &gnss,
+        "--truth",
+        &truth,
+    ];
+    let out = d.join("tactical");
+    let mut args = common.to_vec();
+    args.extend([
+        "--grade",
+        "tactical",
+        "--attitude-deg",
+        "0,0,-15",
+        "--json",
+        "--out",
+    ]);
+    args.push(out.to_str().unwrap());
+    let (code, stdout, stderr) = sdins(&args);
+    assert_eq!(code, 3, "{stderr}");
+    for check in ["nis_windows", "rejected_share", "forced_updates", "bias"] {
+        assert!(stderr.contains(&format!("health: {check}:")), "{stderr}");
+    }
+    let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(j["health"]["ok"], false, "{j}");
+    for file in ["nav.csv", "innovations.csv", "report.html", "run.toml"] {
+        assert!(out.join(file).exists(), "{file}");
+    }
+    let run = std::fs::read_to_string(out.join("run.toml")).unwrap();
+    assert!(run.contains("health_ok = false"), "{run}");
+
+    let warn = d.join("warn");
+    let mut args = common.to_vec();
+    args.extend([
+        "--grade",
+        "tactical",
+        "--attitude-deg",
+        "0,0,-15",
+        "--health",
+        "warn",
+        "--out",
+    ]);
+    args.push(warn.to_str().unwrap());
+    let (code, _, stderr) = sdins(&args);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("warning: health: rejected_share"),
+        "{stderr}"
+    );
+
+    let good = d.join("good");
+    let params = f("imu2_params.txt");
+    let mut args = common.to_vec();
+    args.extend(["--navego-params", &params, "--samples", "1", "--out"]);
+    args.push(good.to_str().unwrap());
+    let (code, _, stderr) = sdins(&args);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("health"), "{stderr}");
+}

@@ -188,11 +188,28 @@ pub struct Compensated {
 /// Combine the samples of one update with the coefficient set (docs/theory/coning-sculling.md
 /// §"Coning and sculling"). `prev` is the previous update's summed increment (used by `1prev`
 /// only).
-#[inline]
+#[inline(always)]
 pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Compensated {
-    if let (ConingSet::ThreePoly | ConingSet::ThreeOpt, [s1, s2, s3]) = (set, samples) {
-        return compensate_three(set, s1, s2, s3);
+    // the common shapes without loops: N = 3 with a three-sample set, N = 1 (the default
+    // of `sdins nav`) with 1prev or none
+    match (set, samples) {
+        (ConingSet::ThreePoly | ConingSet::ThreeOpt, [s1, s2, s3]) => {
+            compensate_three(set, s1, s2, s3)
+        }
+        (ConingSet::OnePrev, [s]) => one_prev(s.dtheta_b_rad, s.dv_b_mps, prev),
+        (ConingSet::None, [s]) => Compensated {
+            dtheta_b_rad: s.dtheta_b_rad,
+            dv_b_mps: s.dv_b_mps,
+            dphi_b_rad: s.dtheta_b_rad,
+            dv_scul_b_mps: Vec3::zeros(),
+        },
+        _ => compensate_general(set, samples, prev),
     }
+}
+
+/// [`compensate`] for any N and set: sums, then the pairs of the coefficient table.
+#[inline(never)]
+fn compensate_general(set: ConingSet, samples: &[Increment], prev: &Increment) -> Compensated {
     let mut dth = Vec3::zeros();
     let mut dv = Vec3::zeros();
     for s in samples {
@@ -203,10 +220,7 @@ pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Co
     let mut scul = Vec3::zeros();
     match set {
         ConingSet::None => {}
-        ConingSet::OnePrev => {
-            cone = prev.dtheta_b_rad.cross(&dth) / 12.0;
-            scul = (prev.dtheta_b_rad.cross(&dv) + prev.dv_b_mps.cross(&dth)) / 12.0;
-        }
+        ConingSet::OnePrev => return one_prev(dth, dv, prev),
         _ => {
             for &(i, j, k) in set.coefficients() {
                 if let (Some(a), Some(b)) = (samples.get(i), samples.get(j)) {
@@ -217,6 +231,32 @@ pub fn compensate(set: ConingSet, samples: &[Increment], prev: &Increment) -> Co
             }
         }
     }
+    Compensated {
+        dtheta_b_rad: dth,
+        dv_b_mps: dv,
+        dphi_b_rad: dth + cone,
+        dv_scul_b_mps: scul,
+    }
+}
+
+/// The one-plus-previous correction of the summed increments `Δθ`, `Δv` with the previous
+/// update's (Savage *Strapdown Analytics* §7.1.1.1, Groves eq. 5.97):
+/// `Δφ = Δθ + (1/12) Δθ_{k−1} × Δθ`, `ΔV_scul = (1/12)(Δθ_{k−1} × Δv + Δv_{k−1} × Δθ)`.
+#[inline(always)]
+fn one_prev(dth: Vec3, dv: Vec3, prev: &Increment) -> Compensated {
+    // written out per component (what `cross` computes), which compiles to fewer
+    // instructions than the vector expression on x86-64's two-wide SSE2
+    let (a, b) = (&prev.dtheta_b_rad, &prev.dv_b_mps);
+    let cone = Vec3::new(
+        (a.y * dth.z - a.z * dth.y) / 12.0,
+        (a.z * dth.x - a.x * dth.z) / 12.0,
+        (a.x * dth.y - a.y * dth.x) / 12.0,
+    );
+    let scul = Vec3::new(
+        ((a.y * dv.z - a.z * dv.y) + (b.y * dth.z - b.z * dth.y)) / 12.0,
+        ((a.z * dv.x - a.x * dv.z) + (b.z * dth.x - b.x * dth.z)) / 12.0,
+        ((a.x * dv.y - a.y * dv.x) + (b.x * dth.y - b.y * dth.x)) / 12.0,
+    );
     Compensated {
         dtheta_b_rad: dth,
         dv_b_mps: dv,

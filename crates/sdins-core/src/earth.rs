@@ -105,16 +105,207 @@ pub fn sin_cos_shift(s: f64, c: f64, d: f64) -> (f64, f64) {
     (s + (s * cdm1 + c * sd), c + (c * cdm1 - s * sd))
 }
 
-impl EarthModel {
-    /// Radii from `sin L` (no trigonometry): see [`EarthModel::radii`].
+/// `sin(a + d)`, `cos(a + d)` from `sin a`, `cos a` for the small steps of one navigation
+/// update: |d| < 1e-4 rad by the series `sin d = d − d³/6`, `cos d − 1 = −d²/2 + d⁴/24`
+/// (first omitted terms d⁵/120 < 8.4e-23 and d⁶/720 < 1.4e-27, far below the rounding of
+/// the sums, 1.1e-16), larger steps by [`sin_cos_shift`].
+///
+/// Below |d| = 1e-6 rad (the latitude steps of one update: 1e-7 rad at Mach 1 and 6 ms)
+/// the series stop at `sin d = d`, `cos d − 1 = −d²/2` (omitted d³/6 < 1.7e-19, 1/600 of
+/// the rounding of a sine near 1, and d⁴/24 < 4.2e-26).
+#[inline(always)]
+pub fn sin_cos_step(s: f64, c: f64, d: f64) -> (f64, f64) {
+    let ad = libm::fabs(d);
+    if ad < 1e-6 {
+        let half_d2 = 0.5 * d * d;
+        (s + (c * d - s * half_d2), c - (s * d + c * half_d2))
+    } else if ad < 1e-4 {
+        sin_cos_series4(s, c, d)
+    } else {
+        sin_cos_shift(s, c, d)
+    }
+}
+
+/// The series of [`sin_cos_step`] (|d| < 1e-4 rad).
+#[inline(always)]
+fn sin_cos_series4(s: f64, c: f64, d: f64) -> (f64, f64) {
+    let d2 = d * d;
+    let sd = d - d * d2 * (1.0 / 6.0);
+    let cdm1 = d2 * (d2 * (1.0 / 24.0) - 0.5); // cos d − 1
+    (s + (s * cdm1 + c * sd), c + (c * cdm1 - s * sd))
+}
+
+/// `sin`/`cos` of a slowly varying angle `base + x` without a libm call per evaluation:
+/// libm evaluates a reference angle `base + x_ref` once, and every later `x` within
+/// 1e-4 rad of it is one angle addition from the reference, with the series of
+/// [`sin_cos_step`] for the difference (truncation below 1e-22).
+///
+/// Every value is one shift away from a libm value, so the rounding does not accumulate
+/// along a trajectory (as it would if each value were shifted from the previous one):
+/// the error is that of libm plus the final additions of the shift, ≈ 1 ulp. When `x`
+/// leaves the window, the reference moves to `x` (one `sincos`). The local-level
+/// mechanization tracks half the latitude and half the transport angle of S1 eq. (32); at
+/// Mach 1 each needs a new reference about once a second.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SinCosTrack {
+    base: f64,
+    x_ref: f64,
+    s_ref: f64,
+    c_ref: f64,
+}
+
+impl SinCosTrack {
+    /// Half-width of the window around the reference \[rad\].
+    pub const WINDOW_RAD: f64 = 1e-4;
+
+    /// Track `base + x`, with the reference at `x`.
+    pub fn new(base: f64, x: f64) -> Self {
+        let (s_ref, c_ref) = libm::sincos(base + x);
+        Self {
+            base,
+            x_ref: x,
+            s_ref,
+            c_ref,
+        }
+    }
+
+    /// `(sin, cos)` of the reference angle (libm's values).
     #[inline]
+    pub fn sin_cos_ref(&self) -> (f64, f64) {
+        (self.s_ref, self.c_ref)
+    }
+
+    /// `(sin, cos)` of `base + x`; moves the reference to `x` (one `sincos`) when
+    /// `|x − x_ref| ≥ 1e-4` rad (or `x` is not finite).
+    #[inline]
+    pub fn sin_cos(&mut self, x: f64) -> (f64, f64) {
+        let d = x - self.x_ref;
+        if libm::fabs(d) < Self::WINDOW_RAD {
+            sin_cos_series4(self.s_ref, self.c_ref, d)
+        } else {
+            *self = Self::new(self.base, x);
+            (self.s_ref, self.c_ref)
+        }
+    }
+}
+
+/// The latitude-independent factors of [`EarthModel::local_sc`] and
+/// [`EarthModel::radii_sin`] (`1 − e²`, `2/a`, `1 + f + m`, `2f`, `3/a²`), computed once:
+/// the mechanizations keep one and evaluate the earth terms of every update without
+/// recomputing them. Each factor is the same expression as in the formula, so the results
+/// are the same bits as [`EarthModel::local_sc`]'s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthCoeffs {
+    a_m: f64,
+    e2: f64,
+    one_minus_e2: f64,
+    gravity: GravityCoeffs,
+}
+
+/// [`Gravity`] with its constant factors evaluated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum GravityCoeffs {
+    /// `γ_e (1 + k s²)/w · (1 − (2/a)(1 + f + m − 2f s²) h + (3/a²) h²)`
+    Somigliana {
+        gamma_e: f64,
+        k: f64,
+        two_over_a: f64,
+        one_f_m: f64,
+        two_f: f64,
+        three_over_a2: f64,
+    },
+    /// `γ_e (1 + k s²)/w · (1 − 2h/a)`
+    SomiglianaLinear { gamma_e: f64, k: f64 },
+    /// `g0 (1 + c2 s² + c4 s⁴) − dh h`
+    Psins { g0: f64, c2: f64, c4: f64, dh: f64 },
+    /// constant
+    Constant { g_mps2: f64 },
+}
+
+impl EarthCoeffs {
+    /// Radii from `sin L` (no trigonometry): see [`EarthModel::radii`].
+    #[inline(always)]
     pub fn radii_sin(&self, sin_lat: f64) -> Radii {
         let w2 = 1.0 - self.e2 * sin_lat * sin_lat;
         let r_n_m = self.a_m / libm::sqrt(w2);
         Radii {
-            r_m_m: r_n_m * (1.0 - self.e2) / w2,
+            r_m_m: r_n_m * self.one_minus_e2 / w2,
             r_n_m,
         }
+    }
+
+    /// [`LocalEarth`] from `sin L`, `cos L` and the height.
+    #[inline(always)]
+    pub fn local_sc(&self, sin_lat: f64, cos_lat: f64, h_m: f64) -> LocalEarth {
+        let s2 = sin_lat * sin_lat;
+        let w2 = 1.0 - self.e2 * s2;
+        let w = libm::sqrt(w2);
+        let r_n_m = self.a_m / w;
+        // the WGS-84 default first (one test and branch, not a jump table)
+        let g_mps2 = if let GravityCoeffs::Somigliana {
+            gamma_e,
+            k,
+            two_over_a,
+            one_f_m,
+            two_f,
+            three_over_a2,
+        } = self.gravity
+        {
+            let gamma = gamma_e * (1.0 + k * s2) / w;
+            gamma * (1.0 - two_over_a * (one_f_m - two_f * s2) * h_m + three_over_a2 * h_m * h_m)
+        } else {
+            match self.gravity {
+                GravityCoeffs::SomiglianaLinear { gamma_e, k } => {
+                    gamma_e * (1.0 + k * s2) / w * (1.0 - 2.0 * h_m / self.a_m)
+                }
+                GravityCoeffs::Psins { g0, c2, c4, dh } => {
+                    g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h_m
+                }
+                GravityCoeffs::Constant { g_mps2 } => g_mps2,
+                GravityCoeffs::Somigliana { .. } => f64::NAN, // handled above
+            }
+        };
+        LocalEarth {
+            sin_lat,
+            cos_lat,
+            r_m_m: r_n_m * self.one_minus_e2 / w2,
+            r_n_m,
+            g_mps2,
+        }
+    }
+}
+
+impl EarthModel {
+    /// The constant factors of the latitude-dependent terms ([`EarthCoeffs`]).
+    #[inline(always)]
+    pub fn coeffs(&self) -> EarthCoeffs {
+        let a = self.a_m;
+        EarthCoeffs {
+            a_m: a,
+            e2: self.e2,
+            one_minus_e2: 1.0 - self.e2,
+            gravity: match self.gravity {
+                Gravity::Somigliana { gamma_e, k, m } => GravityCoeffs::Somigliana {
+                    gamma_e,
+                    k,
+                    two_over_a: 2.0 / a,
+                    one_f_m: 1.0 + self.f + m,
+                    two_f: 2.0 * self.f,
+                    three_over_a2: 3.0 / (a * a),
+                },
+                Gravity::SomiglianaLinear { gamma_e, k } => {
+                    GravityCoeffs::SomiglianaLinear { gamma_e, k }
+                }
+                Gravity::Psins { g0, c2, c4, dh } => GravityCoeffs::Psins { g0, c2, c4, dh },
+                Gravity::Constant { g_mps2 } => GravityCoeffs::Constant { g_mps2 },
+            },
+        }
+    }
+
+    /// Radii from `sin L` (no trigonometry): see [`EarthModel::radii`].
+    #[inline]
+    pub fn radii_sin(&self, sin_lat: f64) -> Radii {
+        self.coeffs().radii_sin(sin_lat)
     }
 
     /// [`LocalEarth`] at latitude `lat_rad` and height `h_m`.
@@ -128,31 +319,7 @@ impl EarthModel {
     /// [`LocalEarth`] from precomputed `sin L`, `cos L`.
     #[inline]
     pub fn local_sc(&self, sin_lat: f64, cos_lat: f64, h_m: f64) -> LocalEarth {
-        let s2 = sin_lat * sin_lat;
-        let w2 = 1.0 - self.e2 * s2;
-        let w = libm::sqrt(w2);
-        let r_n_m = self.a_m / w;
-        let g_mps2 = match self.gravity {
-            Gravity::Somigliana { gamma_e, k, m } => {
-                let gamma = gamma_e * (1.0 + k * s2) / w;
-                let a = self.a_m;
-                gamma
-                    * (1.0 - (2.0 / a) * (1.0 + self.f + m - 2.0 * self.f * s2) * h_m
-                        + (3.0 / (a * a)) * h_m * h_m)
-            }
-            Gravity::SomiglianaLinear { gamma_e, k } => {
-                gamma_e * (1.0 + k * s2) / w * (1.0 - 2.0 * h_m / self.a_m)
-            }
-            Gravity::Psins { g0, c2, c4, dh } => g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h_m,
-            Gravity::Constant { g_mps2 } => g_mps2,
-        };
-        LocalEarth {
-            sin_lat,
-            cos_lat,
-            r_m_m: r_n_m * (1.0 - self.e2) / w2,
-            r_n_m,
-            g_mps2,
-        }
+        self.coeffs().local_sc(sin_lat, cos_lat, h_m)
     }
 
     /// Earth rate in NED from a [`LocalEarth`].
@@ -460,6 +627,66 @@ mod tests {
         let e = EarthModel::WGS84;
         let w = c * Vec3::new(0.0, 0.0, e.omega_ie_rps);
         assert!((w - e.omega_ie_n(lat)).norm() < 1e-20);
+    }
+
+    #[test]
+    fn hoisted_coefficients_give_the_same_bits() {
+        // EarthCoeffs::local_sc against the formula written out with the factors inline
+        for e in [
+            EarthModel::WGS84,
+            EarthModel::PSINS,
+            EarthModel::WGS84_LINEAR_G,
+            EarthModel::flat(9.80665),
+        ] {
+            for &(lat, h) in &[(0.3_f64, 100.0), (-1.2, 5000.0), (1.55, -300.0)] {
+                let (s, c) = (libm::sin(lat), libm::cos(lat));
+                let le = e.coeffs().local_sc(s, c, h);
+                let s2 = s * s;
+                let w2 = 1.0 - e.e2 * s2;
+                let w = libm::sqrt(w2);
+                let r_n = e.a_m / w;
+                let g = match e.gravity {
+                    Gravity::Somigliana { gamma_e, k, m } => {
+                        let a = e.a_m;
+                        gamma_e * (1.0 + k * s2) / w
+                            * (1.0 - (2.0 / a) * (1.0 + e.f + m - 2.0 * e.f * s2) * h
+                                + (3.0 / (a * a)) * h * h)
+                    }
+                    Gravity::SomiglianaLinear { gamma_e, k } => {
+                        gamma_e * (1.0 + k * s2) / w * (1.0 - 2.0 * h / e.a_m)
+                    }
+                    Gravity::Psins { g0, c2, c4, dh } => {
+                        g0 * (1.0 + c2 * s2 + c4 * s2 * s2) - dh * h
+                    }
+                    Gravity::Constant { g_mps2 } => g_mps2,
+                };
+                assert_eq!(le.g_mps2, g);
+                assert_eq!(le.r_n_m, r_n);
+                assert_eq!(le.r_m_m, r_n * (1.0 - e.e2) / w2);
+            }
+        }
+    }
+
+    #[test]
+    fn sin_cos_step_and_track_agree_with_libm() {
+        let a = 0.7_f64;
+        let (s, c) = (a.sin(), a.cos());
+        for d in [0.0, 3e-9, -4e-7, 9.9e-7, 1.0e-6, -5e-5, 9.9e-5, 2e-4, -3e-3] {
+            let (ss, cc) = sin_cos_step(s, c, d);
+            assert!(
+                (ss - (a + d).sin()).abs() < 3e-16 && (cc - (a + d).cos()).abs() < 3e-16,
+                "{d}"
+            );
+        }
+        // a track along a trajectory: every value within a few ulp of libm, no drift
+        let mut tr = SinCosTrack::new(0.3, 0.0);
+        let mut worst: f64 = 0.0;
+        for k in 0..200_000 {
+            let x = 3.7e-7 * k as f64 - 1e-13 * (k as f64).powi(2);
+            let (s, c) = tr.sin_cos(x);
+            worst = worst.max((s - (0.3 + x).sin()).abs().max((c - (0.3 + x).cos()).abs()));
+        }
+        assert!(worst < 3e-16, "{worst:e}");
     }
 
     #[test]

@@ -192,6 +192,7 @@ pub fn fuse<'py>(
         out.set_item("smoothed", acc.smoothed.dict(py)?)?;
     }
     let v3 = |v: &sdins_core::math::Vec3| vec![v.x, v.y, v.z];
+    out.set_item("health", health_dict(py, &o.health)?)?;
     out.set_item("fixes", s.fixes)?;
     out.set_item("rejected", s.rejected)?;
     out.set_item("late", s.late)?;
@@ -409,6 +410,7 @@ pub fn fuse_files<'py>(
         out.set_item("smoothed", acc.smo.dict(py)?)?;
     }
     out.set_item("innovations", acc.inn.dict(py)?)?;
+    out.set_item("health", health_dict(py, &o.health)?)?;
     out.set_item("fixes_used", o.fixes)?;
     out.set_item("rejected", o.rejected)?;
     out.set_item("late", o.late)?;
@@ -650,4 +652,24 @@ pub fn fuse_merge(
         )));
     }
     Ok(FuseMcState { state: merged })
+}
+
+/// The health verdict as a dict: `ok` and `checks` (name, passed, detail); Python never
+/// raises for it.
+fn health_dict<'py>(
+    py: Python<'py>,
+    h: &sdins_sim::fusion::health::HealthVerdict,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("ok", h.ok())?;
+    let checks = pyo3::types::PyList::empty(py);
+    for c in &h.checks {
+        let cd = PyDict::new(py);
+        cd.set_item("name", c.name)?;
+        cd.set_item("passed", c.passed)?;
+        cd.set_item("detail", &c.detail)?;
+        checks.append(cd)?;
+    }
+    d.set_item("checks", checks)?;
+    Ok(d)
 }

@@ -1,15 +1,30 @@
-//! Profiling driver for the end-to-end loop of `benches/end_to_end.rs` (navigation +
-//! `nav_error` after every update, increments from memory), for callgrind:
+//! Profiling driver for the navigation loops, for callgrind (docs/performance.md §5):
+//!
+//! * `e2e` (default): the end-to-end loop of `benches/end_to_end.rs` (navigation +
+//!   `nav_error` after every update, increments from memory), collected as `full_run`;
+//! * `nav`: what `sdins nav` times, i.e. [`recorded::navigate`] without a reference —
+//!   every update followed by the state hand-off (`state()` pushed into the block
+//!   buffer), collected as `nav_handoff`;
+//! * `update`: the updates alone, no state taken (`nav_only`).
 //!
 //! ```text
 //! cargo build --release -p sdins-sim --example profile_e2e
+//! # the default `sdins nav` configuration (songlee-complete, N = 1, 1prev) and N = 3:
+//! valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*nav_handoff*' \
+//!     target/release/examples/profile_e2e songlee-complete 60 mach1-east 1 nav
+//! valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*nav_handoff*' \
+//!     target/release/examples/profile_e2e songlee-complete 60 mach1-east 3 nav
+//! # end to end with errors:
 //! valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*full_run*' \
 //!     target/release/examples/profile_e2e savage 60
 //! ```
 //!
-//! Arguments: algorithm (default `savage`), seconds of `mach1-east` (default 60),
-//! scenario (default `mach1-east`). Prints the errors and the wall time. With
-//! `SDINS_NAV_ONLY=1` it times the navigation updates alone (no `nav_error`).
+//! Arguments: algorithm (default `savage`), seconds of the scenario (default 60),
+//! scenario (default `mach1-east`), samples per update N (default the scenario's), mode
+//! (`e2e`, `nav`, `update`; default `e2e`). The coning set is the one a user gets when
+//! naming none ([`ConingSet::recommended_for`]: `1prev` for N = 1, the polynomial set
+//! otherwise), as in `sdins nav` and `sdins run`. Prints the samples, the instructions
+//! divisor and the wall time. `SDINS_NAV_ONLY=1` is the old spelling of mode `update`.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -17,7 +32,11 @@
 mod common;
 
 use common::{full_run, record, scenario, Recorded};
+use sdins_core::coning::ConingSet;
 use sdins_core::nav::{AlgorithmSpec, AnyMechanization, Mechanization};
+use sdins_sim::cancel::CancelToken;
+use sdins_sim::nav::recorded;
+use std::hint::black_box;
 use std::time::Instant;
 
 /// The navigation loop alone (same buffer), for the split between update and errors.
@@ -29,6 +48,27 @@ fn nav_only(rec: &Recorded, spec: &AlgorithmSpec) -> f64 {
         m.update(chunk);
     }
     m.state().h_m
+}
+
+/// `sdins nav`'s loop: [`recorded::navigate`] without a reference, with an observer that
+/// only keeps the last height (the CSV formatting of `sdins nav` is outside its `wall_s`
+/// and outside this count).
+#[inline(never)]
+fn nav_handoff(rec: &Recorded, spec: &AlgorithmSpec) -> (f64, f64) {
+    let mut h = 0.0;
+    let run = recorded::navigate(
+        spec,
+        rec.earth,
+        rec.dt_s,
+        0.0,
+        &rec.init,
+        &rec.incs,
+        None,
+        &CancelToken::new(),
+        |_, s| h = s.h_m,
+    )
+    .expect("not cancelled");
+    (h, run.wall_s)
 }
 
 /// CPU time of this thread \[s\] from /proc (10 ms resolution; None off Linux): on a
@@ -48,31 +88,57 @@ fn main() {
     let secs: f64 = args.get(2).map_or(60.0, |s| s.parse().expect("seconds"));
     let name = args.get(3).map_or("mach1-east", String::as_str);
     let scn = scenario(name);
-    let n = scn.nav.samples;
+    let n: usize = args
+        .get(4)
+        .map_or(scn.nav.samples, |s| s.parse().expect("samples per update"));
+    let mode = match args.get(5).map(String::as_str) {
+        Some(m) => m.to_string(),
+        None if std::env::var_os("SDINS_NAV_ONLY").is_some() => "update".to_string(),
+        None => "e2e".to_string(),
+    };
     let max = (secs * scn.imu.rate_hz).round() as usize;
     let rec = record(&scn, n, Some(max));
-    let spec = AlgorithmSpec::from_name(algo, n).expect("algorithm name");
-    if std::env::var_os("SDINS_NAV_ONLY").is_some() {
-        let t0 = Instant::now();
-        let h = nav_only(&rec, &spec);
-        let wall = t0.elapsed().as_secs_f64();
-        println!(
-            "{algo} N={n} navigation only: wall {wall:.4} s = {:.3} M samples/s (h {h:.3} m)",
-            rec.incs.len() as f64 / 1e6 / wall
-        );
-        return;
-    }
-    let c0 = thread_cpu_s();
-    let t0 = Instant::now();
-    let e = full_run(&rec, &spec);
-    let wall = t0.elapsed().as_secs_f64();
-    let cpu = c0.and_then(|c0| thread_cpu_s().map(|c1| c1 - c0));
+    let mut spec = AlgorithmSpec::from_name(algo, n).expect("algorithm name");
+    spec.coning = ConingSet::recommended_for(n);
     let m = rec.incs.len() as f64 / 1e6;
-    println!(
-        "{algo} N={n} {} samples: wall {wall:.4} s = {:.3} M samples/s; cpu {} ; max |pos err| {:?} m",
+    let head = format!(
+        "{algo} N={n} coning {} {name}: {} samples, {} updates",
+        spec.coning.name(),
         rec.incs.len(),
-        m / wall,
-        cpu.map_or("n/a".to_string(), |c| format!("{c:.2} s = {:.2} M samples/s", m / c)),
-        e.pos_err_ned_m
+        rec.incs.len() / n
     );
+    match mode.as_str() {
+        "update" => {
+            let t0 = Instant::now();
+            let h = black_box(nav_only(&rec, &spec));
+            let wall = t0.elapsed().as_secs_f64();
+            println!(
+                "{head}; updates only: wall {wall:.4} s = {:.3} M samples/s (h {h:.3} m)",
+                m / wall
+            );
+        }
+        "nav" => {
+            let t0 = Instant::now();
+            let (h, wall_s) = black_box(nav_handoff(&rec, &spec));
+            let wall = t0.elapsed().as_secs_f64();
+            println!(
+                "{head}; updates + state hand-off (sdins nav): wall {wall:.4} s = {:.3} M samples/s, its wall_s {wall_s:.4} s (h {h:.3} m)",
+                m / wall
+            );
+        }
+        "e2e" => {
+            let c0 = thread_cpu_s();
+            let t0 = Instant::now();
+            let e = full_run(&rec, &spec);
+            let wall = t0.elapsed().as_secs_f64();
+            let cpu = c0.and_then(|c0| thread_cpu_s().map(|c1| c1 - c0));
+            println!(
+                "{head}; end to end: wall {wall:.4} s = {:.3} M samples/s; cpu {} ; max |pos err| {:?} m",
+                m / wall,
+                cpu.map_or("n/a".to_string(), |c| format!("{c:.2} s = {:.2} M samples/s", m / c)),
+                e.pos_err_ned_m
+            );
+        }
+        o => panic!("mode {o}: expected e2e, nav or update"),
+    }
 }

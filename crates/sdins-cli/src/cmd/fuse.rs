@@ -118,8 +118,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(run_err)
     })?;
     report(&out, &args, &req, &outcome, &plot)?;
-    crate::report::write_run_toml(&out, run_toml(&args, &outcome))?;
-    let s = summary(&args, &outcome);
+    let mut toml = run_toml(&args, &outcome);
+    super::fuse_args::health_toml(&mut toml, &outcome.health);
+    crate::report::write_run_toml(&out, toml)?;
+    let mut s = summary(&args, &outcome);
+    s["health"] = super::fuse_args::health_json(&outcome.health);
     if args.json {
         outln!("{s:#}");
     } else {
@@ -130,7 +133,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             out.display()
         );
     }
-    Ok(())
+    super::fuse_args::health_end(&args, &outcome.health, &out)
 }
 
 fn report(

@@ -4,6 +4,7 @@
 //! (`sdins_sim::fusion::request::FuseRequest`).
 
 use crate::error::CliError;
+use sdins_sim::fusion::health::HealthVerdict;
 use sdins_sim::fusion::request::{FilesData, FuseData, FuseRequest, FuseRunError, ScenarioData};
 use sdins_sim::scenario::Scenario;
 use std::path::PathBuf;
@@ -105,6 +106,14 @@ pub struct Args {
     /// largest age of a measurement at its arrival [s] (older ones are refused and counted)
     #[arg(long)]
     pub max_latency_s: Option<f64>,
+    /// a result that fails its health checks (NIS windows, rejected share, resets,
+    /// horizontal σ, bias estimates; docs/user-guide.md "Health verdict"): `fail` writes
+    /// the outputs and exits 3, `warn` only warns
+    #[arg(long, value_enum, default_value_t = HealthMode::Fail)]
+    pub health: HealthMode,
+    /// the health verdict's largest horizontal σ [m] (default 100)
+    #[arg(long, value_name = "M")]
+    pub health_max_sigma: Option<f64>,
     /// scenario: a Monte Carlo of N runs (NEES per state block and NIS per measurement
     /// kind per output epoch; fuse_mc_stats.csv, fuse_mc_state.json)
     #[arg(long)]
@@ -256,6 +265,7 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
     req.every_s = a.every_s;
     req.until_s = a.until_s;
     req.max_latency_s = a.max_latency_s;
+    req.health_max_sigma_m = a.health_max_sigma;
     req.check().map_err(run_err)?;
     Ok(req)
 }
@@ -276,6 +286,54 @@ pub fn scale_factor_prior(
         Some(p) if p.validate().is_ok() => Ok(p),
         _ => Err(CliError::bad(format!(
             "--scale-factors-ppm: expected ACCEL_PPM,GYRO_PPM, two numbers in (0, 100000], got `{s}`"
+        ))),
+    }
+}
+
+/// What an unhealthy result does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum HealthMode {
+    /// write the outputs, then exit 3
+    Fail,
+    /// write the outputs and warn (exit 0)
+    Warn,
+}
+
+/// The verdict in run.toml: `health_ok` and the failed checks.
+pub fn health_toml(f: &mut toml::Table, h: &HealthVerdict) {
+    f.insert("health_ok".into(), h.ok().into());
+    let failed: Vec<toml::Value> = h.failures().into_iter().map(Into::into).collect();
+    f.insert("health_failures".into(), failed.into());
+}
+
+/// The verdict in the `--json` summary.
+pub fn health_json(h: &HealthVerdict) -> serde_json::Value {
+    serde_json::json!({
+        "ok": h.ok(),
+        "checks": h.checks.iter().map(|c| serde_json::json!({
+            "name": c.name, "passed": c.passed, "detail": c.detail,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// The end of a run whose outputs are written: each failed check on stderr, then exit 3
+/// (`--health fail`) or a warning (`--health warn`).
+pub fn health_end(args: &Args, h: &HealthVerdict, out: &std::path::Path) -> Result<(), CliError> {
+    if h.ok() {
+        return Ok(());
+    }
+    let what = match args.health {
+        HealthMode::Fail => "health",
+        HealthMode::Warn => "warning: health",
+    };
+    for f in h.failures() {
+        eprintln!("{what}: {f}");
+    }
+    match args.health {
+        HealthMode::Warn => Ok(()),
+        HealthMode::Fail => Err(CliError::ResultFailedChecks(format!(
+            "the solution failed its health checks (above); the outputs are written in {} (exit 3; --health warn accepts the result)",
+            out.display()
         ))),
     }
 }

@@ -140,7 +140,9 @@ pub fn run(args: &Args, req: &FuseRequest) -> Result<(), CliError> {
     if !plot.forward.pts.is_empty() || !plot.gnss.is_empty() {
         report(&out, args, d, &o, r, &plot)?;
     }
-    crate::report::write_run_toml(&out, run_toml(args, d, r))?;
+    let mut toml = run_toml(args, d, r);
+    super::fuse_args::health_toml(&mut toml, &o.health);
+    crate::report::write_run_toml(&out, toml)?;
     for rep in &r.inputs {
         eprintln!("{}", rep.summary());
     }
@@ -151,11 +153,13 @@ pub fn run(args: &Args, req: &FuseRequest) -> Result<(), CliError> {
         eprintln!("warning: {}: {w}", d.gnss.0.display());
     }
     if args.json {
-        outln!("{:#}", summary(args, d, &o, r, last.as_ref()));
+        let mut s = summary(args, d, &o, r, last.as_ref());
+        s["health"] = super::fuse_args::health_json(&o.health);
+        outln!("{s:#}");
     } else {
         print(d, r, &out);
     }
-    Ok(())
+    super::fuse_args::health_end(args, &o.health, &out)
 }
 
 fn report(

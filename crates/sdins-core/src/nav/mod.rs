@@ -16,7 +16,7 @@ mod transport;
 pub use dual::DualQuat;
 pub use dualquat::DualQuatNav;
 pub use local_level::{AttitudeMode, LocalLevel, LocalLevelConfig, RotVector, VelocityMode};
-pub use transport::{transport_matrix, transport_matrix_sc};
+pub use transport::{transport_matrix, transport_matrix_sc, transport_matrix_trig};
 
 use crate::coning::{ConingSet, Increment};
 use crate::earth::EarthModel;
@@ -84,6 +84,28 @@ pub trait Mechanization {
     fn update(&mut self, samples: &[Increment]);
     /// Current navigation state.
     fn state(&self) -> NavState;
+    /// Write the current state into `out`: `*out = self.state()`, for loops that hand
+    /// every state over into a buffer (implementations may write it without the
+    /// intermediate copy).
+    #[inline]
+    fn state_into(&self, out: &mut NavState) {
+        *out = self.state();
+    }
+    /// Run one update per N samples of `samples` (a trailing partial update is ignored)
+    /// and write the state after each into the next slot of `states`; stops when either
+    /// runs out and returns the number of updates done. The same states as
+    /// [`Mechanization::update`] followed by [`Mechanization::state`], for loops that keep
+    /// every state (implementations may dispatch on their options once per call).
+    fn update_many(&mut self, samples: &[Increment], states: &mut [NavState]) -> usize {
+        let n = self.samples_per_update().max(1);
+        let mut k = 0;
+        for (chunk, slot) in samples.chunks_exact(n).zip(states.iter_mut()) {
+            self.update(chunk);
+            self.state_into(slot);
+            k += 1;
+        }
+        k
+    }
     /// Replace height and down velocity by a reference (vertical channel `hold`).
     fn hold_vertical(&mut self, h_m: f64, v_d_mps: f64);
     /// Replace position, velocity and attitude by `s` (its `t_s` is ignored), keeping the
@@ -249,6 +271,20 @@ impl Mechanization for AnyMechanization {
         match self {
             AnyMechanization::LocalLevel(m) => m.state(),
             AnyMechanization::DualQuat(m) => m.state(),
+        }
+    }
+    #[inline]
+    fn state_into(&self, out: &mut NavState) {
+        match self {
+            AnyMechanization::LocalLevel(m) => m.state_into(out),
+            AnyMechanization::DualQuat(m) => m.state_into(out),
+        }
+    }
+    #[inline]
+    fn update_many(&mut self, samples: &[Increment], states: &mut [NavState]) -> usize {
+        match self {
+            AnyMechanization::LocalLevel(m) => m.update_many(samples, states),
+            AnyMechanization::DualQuat(m) => m.update_many(samples, states),
         }
     }
     #[inline]

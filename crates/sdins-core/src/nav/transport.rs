@@ -22,6 +22,13 @@ pub fn transport_matrix(lat_rad: f64, s_l0: f64, c_l0: f64, delta_rad: f64) -> M
 #[inline]
 pub fn transport_matrix_sc(sl: f64, cl: f64, s_l0: f64, c_l0: f64, delta_rad: f64) -> Mat3 {
     let (sd, cd) = (libm::sin(delta_rad), libm::cos(delta_rad));
+    transport_matrix_trig(sl, cl, s_l0, c_l0, sd, cd)
+}
+
+/// [`transport_matrix`] from precomputed `sin L`, `cos L`, `sin Δ`, `cos Δ` (no
+/// trigonometry: the mechanizations carry these along the trajectory).
+#[inline]
+pub fn transport_matrix_trig(sl: f64, cl: f64, s_l0: f64, c_l0: f64, sd: f64, cd: f64) -> Mat3 {
     Mat3::new(
         sl * s_l0 * cd + cl * c_l0,
         -sl * sd,

@@ -6,6 +6,7 @@
 
 pub mod engine;
 pub mod files;
+pub mod health;
 pub mod records;
 pub mod request;
 pub mod scenario_stream;

@@ -11,6 +11,7 @@
 //!
 //! Option errors name the option in both spellings (`cov_rate_hz` / `--cov-rate-hz`).
 
+use super::health::{HealthMonitor, HealthVerdict, DEFAULT_MAX_SIGMA_H_M};
 use crate::cancel::CancelToken;
 use crate::fusion::files::{fuse_files, FilesError, FilesInput, FilesResult};
 use crate::fusion::files::{InitSource, InputColumns, SensorModelSource};
@@ -111,6 +112,9 @@ pub struct FuseRequest {
     pub until_s: Option<f64>,
     /// largest latency of a measurement \[s\]
     pub max_latency_s: Option<f64>,
+    /// the health verdict's largest horizontal σ \[m\] (default
+    /// [`health::DEFAULT_MAX_SIGMA_H_M`](super::health::DEFAULT_MAX_SIGMA_H_M))
+    pub health_max_sigma_m: Option<f64>,
 }
 
 impl FuseRequest {
@@ -130,6 +134,7 @@ impl FuseRequest {
             every_s: None,
             until_s: None,
             max_latency_s: None,
+            health_max_sigma_m: None,
         }
     }
 }
@@ -240,6 +245,8 @@ pub struct FuseOutcome {
     pub rms_smoothed: Option<[f64; 9]>,
     /// the mode-specific part
     pub details: FuseDetails,
+    /// can the solution be trusted? ([`super::health`])
+    pub health: HealthVerdict,
 }
 
 fn bad(name: &str, flag: &str, msg: impl std::fmt::Display) -> FuseRunError {
@@ -302,10 +309,22 @@ pub fn fuse(
     cancel: &CancelToken,
     observe: &mut dyn FnMut(FuseOutput<'_>),
 ) -> Result<FuseOutcome, FuseRunError> {
-    match &req.data {
-        FuseData::Scenario(d) => fuse_scenario_request(req, d, cancel, observe),
-        FuseData::Files(d) => fuse_files_request(req, d, cancel, observe),
-    }
+    positive(
+        "health_max_sigma_m",
+        "--health-max-sigma",
+        req.health_max_sigma_m,
+    )?;
+    let mut monitor = HealthMonitor::new(req.health_max_sigma_m.unwrap_or(DEFAULT_MAX_SIGMA_H_M));
+    let mut watch = |ev: FuseOutput<'_>| {
+        monitor.observe(&ev);
+        observe(ev);
+    };
+    let mut o = match &req.data {
+        FuseData::Scenario(d) => fuse_scenario_request(req, d, cancel, &mut watch),
+        FuseData::Files(d) => fuse_files_request(req, d, cancel, &mut watch),
+    }?;
+    o.health = monitor.verdict();
+    Ok(o)
 }
 
 /// Sums of squares of 9 channels, in row order.
@@ -409,6 +428,7 @@ fn fuse_scenario_request(
             summary: s,
             gnss_rate_hz: gnss.rate_hz,
         },
+        health: HealthVerdict::default(),
     })
 }
 
@@ -515,5 +535,6 @@ fn fuse_files_request(
         rms_forward: rms(&r.forward),
         rms_smoothed: rms(&r.smoothed),
         details: FuseDetails::Files(r),
+        health: HealthVerdict::default(),
     })
 }

@@ -327,13 +327,19 @@ mod tests {
         assert_eq!(roundtrip(21), 7400);
     }
 
+    /// Identity blocks of dimension `n` (only the leading `n × n` blocks are meaningful:
+    /// the log keeps those and gives zeros outside).
     fn epoch(t: f64, n: usize) -> CovEpoch {
+        let mut eye = Cov::zeros();
+        for i in 0..n {
+            eye[(i, i)] = 1.0;
+        }
         CovEpoch {
             t_s: t,
             n,
-            phi: Cov::identity(),
-            p_pred: Cov::identity(),
-            p_post: Cov::identity(),
+            phi: eye,
+            p_pred: eye,
+            p_post: eye,
             dx: XVec::zeros(),
         }
     }

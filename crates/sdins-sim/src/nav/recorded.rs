@@ -174,22 +174,21 @@ pub fn navigate(
     const BLOCK: usize = 4096;
     let mut m = AnyMechanization::new(spec, earth, dt_s, init);
     let n = spec.samples.max(1);
-    let mut states = Vec::with_capacity(BLOCK);
+    // the block buffer is allocated once at its full length; `update_many` writes each
+    // state into its slot (`Vec::push(m.state())` copied the 128-byte state twice, and one
+    // call per block leaves the dispatch on the algorithm's options out of the loop)
+    let mut states = vec![m.state(); BLOCK];
     let mut wall = 0.0;
     let mut errors = Vec::new();
     let mut ti = 0usize;
     let mut updates = 0usize;
     for block in incs.chunks(BLOCK * n) {
         cancel.check()?;
-        states.clear();
         let t0 = Instant::now();
-        for chunk in block.chunks_exact(n) {
-            m.update(chunk);
-            states.push(m.state());
-        }
+        let k = m.update_many(block, &mut states);
         wall += t0.elapsed().as_secs_f64();
-        updates += states.len();
-        for st in &states {
+        updates += k;
+        for st in &states[..k] {
             let t = t0_s + st.t_s;
             observe(t, st);
             if let Some(tr) = truth {

@@ -321,7 +321,7 @@ duration_s = 60.0
         assert_eq!(a.to_csv(), b.to_csv());
         assert!(a.complete);
         assert_eq!(a.runs, 61);
-        assert_eq!(a.times_s.len(), 6);
+        assert_eq!(a.times_s, [0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0]);
         // bit equality of every number
         for (ra, rb) in a.cells.iter().zip(&b.cells) {
             for (x, y) in ra.iter().zip(rb) {
@@ -379,7 +379,7 @@ duration_s = 60.0
             for r in [0, 5] {
                 let a = run_one(&s, &o, r).unwrap();
                 let c = cache.run(&s.imu.model, s.imu.seed, r, &o.algo, hold);
-                assert_eq!(a.len(), 5);
+                assert_eq!(a.len(), 6); // 0, 10, 20, 30, 40 and the last update, 41 s
                 assert_eq!(a, c);
             }
         }
