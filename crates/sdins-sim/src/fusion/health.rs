@@ -40,6 +40,7 @@ use sdins_core::aiding::layout::BlockKind;
 use sdins_core::aiding::meas::MeasKind;
 use sdins_core::aiding::stationarity::chi2::chi2_quantile;
 use serde::Serialize;
+use std::cmp::Ordering::{Equal, Less};
 
 /// Fixes per NIS window.
 pub const W_FIXES: usize = 60;
@@ -176,7 +177,7 @@ impl HealthMonitor {
                     }
                 };
                 let h = sigma_ne[0].hypot(sigma_ne[1]);
-                if !(h <= self.sigma_h.0) {
+                if !matches!(h.partial_cmp(&self.sigma_h.0), Some(Less | Equal)) {
                     self.sigma_h = (h, t);
                 }
                 self.prior.get_or_insert((bias, sigma_bias));
@@ -258,7 +259,7 @@ impl HealthMonitor {
             for i in 0..6 {
                 if prior[i] > 0.0 {
                     let r = (self.last_bias[i] - b0[i]).abs() / prior[i];
-                    if !(r <= worst.0) {
+                    if !matches!(r.partial_cmp(&worst.0), Some(Less | Equal)) {
                         worst = (r, i);
                     }
                 }

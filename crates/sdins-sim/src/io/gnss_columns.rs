@@ -242,12 +242,15 @@ pub(crate) fn wrap_lon_rad(lon: f64) -> f64 {
     l
 }
 
+/// Three columns' indices and keys.
+type ThreeCols = ([usize; 3], [String; 3]);
+
 /// Three σ columns (`sigma_{n,e,d|u}` or `sigma_{vn,ve,vd|vu}`), all or none.
 fn sigma_cols(
     t: &Table<'_>,
     m: &ColumnMap,
     names: [&str; 4],
-) -> Result<Option<([usize; 3], [String; 3])>, ColumnsError> {
+) -> Result<Option<ThreeCols>, ColumnsError> {
     let z = match (m.get(names[2]), m.get(names[3])) {
         (Some(_), Some(_)) => {
             return Err(ColumnsError::map(
@@ -481,7 +484,7 @@ mod tests {
         assert_eq!(d.fixes[1].h_m, 90.0);
         for (map, what) in [
             (format!("{base},alt_msl_m=alt"), "give the geoid undulation"),
-            (format!("{base}"), "state its datum"),
+            (base.to_string(), "state its datum"),
             (format!("{base},h_m=alt,alt_msl_m=alt"), "not both"),
             (format!("{base},h_m=alt,v_d_mps=vu"), "not both"),
             (

@@ -347,8 +347,8 @@ pub fn parse_imu_columns(
             .map_err(|e| t.err(line, &tcol.key, e))?;
         let vec = |tr: &Triad| -> Result<Vec3, ColumnsError> {
             let mut v = [0.0; 3];
-            for i in 0..3 {
-                v[i] = t.num(line, &f, tr.idx[i], &tr.keys[i])? * tr.scale[i];
+            for (i, vi) in v.iter_mut().enumerate() {
+                *vi = t.num(line, &f, tr.idx[i], &tr.keys[i])? * tr.scale[i];
             }
             Ok(c_s_b * Vec3::from(v))
         };
@@ -522,12 +522,12 @@ fn segment(
         }
     };
     let mut incs = Vec::with_capacity(n - first);
-    for k in first..n {
+    for (k, &line_k) in lines.iter().enumerate().take(n).skip(first) {
         let inc = Increment::new(one(gv, g.inc, k), one(av, a.inc, k));
         let dth = inc.dtheta_b_rad.norm();
         if dth > MAX_DTHETA_RAD {
             return Err(t.err(
-                lines[k],
+                line_k,
                 &g.keys.join("/"),
                 format!("|Δθ| = {dth:e} rad per sample, expected at most π"),
             ));
@@ -536,7 +536,7 @@ fn segment(
         let lim = MAX_SPECIFIC_FORCE_G * crate::io::columns::G0;
         if f > lim {
             return Err(t.err(
-                lines[k],
+                line_k,
                 &a.keys.join("/"),
                 format!("|f| = {f:e} m/s², expected at most {lim:e}"),
             ));

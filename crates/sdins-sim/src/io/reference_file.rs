@@ -214,8 +214,8 @@ pub fn parse_generic_on(
         let v_n_mps = match &vel {
             Some(vc) => {
                 let mut v = [0.0; 3];
-                for i in 0..3 {
-                    v[i] = t.num(line, &f, vc.idx[i], &vc.keys[i])?;
+                for (i, vi) in v.iter_mut().enumerate() {
+                    *vi = t.num(line, &f, vc.idx[i], &vc.keys[i])?;
                 }
                 if vc.up {
                     v[2] = -v[2];
