@@ -379,7 +379,6 @@ fn nav_imu_file_classes_exit_2_with_file_line_column() {
     let cases: Vec<(&str, String, &str)> = vec![
         ("empty.csv", String::new(), "empty.csv: empty file, expected an IMU record"),
         ("header.csv", IMU_H.into(), "header.csv:1: header only, expected data rows after it"),
-        ("truncated.csv", format!("{IMU_H}{r3}0.04,0,0"), "truncated.csv:5: truncated last line: 3 of 7 fields and no final newline"),
         ("columns.csv", format!("{IMU_H}0.01,0,0,0,0,-0.098\n{r3}"), "columns.csv:2: expected 7 fields, found 6"),
         ("text.csv", format!("{IMU_H}{r3}0.04,0,x1,0,0,0,-0.098\n"), "text.csv:5: column 3 (dtheta_y_rad): expected a number, found `x1`"),
         ("nan.csv", format!("{IMU_H}{r3}0.04,0,0,0,NaN,0,-0.098\n"), "nan.csv:5: column 5 (dv_x_mps): expected a finite number, found `NaN`"),
@@ -407,6 +406,7 @@ fn nav_imu_file_classes_exit_2_with_file_line_column() {
         assert!(err.contains(want), "{name}: want `{want}` in `{err}`");
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
+    // (a cut last line is dropped with a warning: `cut_last_line_is_dropped_with_a_warning`)
     // nothing was written for any of them
     assert!(!d.join("o").exists() || std::fs::read_dir(d.join("o")).unwrap().count() == 0);
 }
@@ -902,4 +902,42 @@ fn fuse_health_verdict_exit_3_on_a_diverged_filter() {
     let (code, _, stderr) = sdins(&args);
     assert_eq!(code, 0, "{stderr}");
     assert!(!stderr.contains("health"), "{stderr}");
+}
+
+/// Reliability class 10: a logger killed mid-write cuts its last line; `nav` and `allan`
+/// drop it with a warning on stderr (not stdout) that names the line, recorded in
+/// run.toml.
+#[test]
+fn cut_last_line_is_dropped_with_a_warning() {
+    let d = tmp("cutline");
+    truth_and_imu(&d);
+    let full = std::fs::read_to_string(d.join("imu.csv")).unwrap();
+    let rows = full.lines().count();
+    let cut = format!("{full}0.5,1e-4,2e-4");
+    let f = input(&d, "cut.csv");
+    std::fs::write(&f, &cut).unwrap();
+    let truth = d.join("truth.csv");
+    for cmd in ["nav", "allan"] {
+        let out = d.with_extension(format!("out-{cmd}"));
+        let mut args = vec![
+            cmd,
+            "--imu",
+            f.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if cmd == "nav" {
+            args.extend(["--truth", truth.to_str().unwrap()]);
+        }
+        let (code, stdout, stderr) = sdins(&args);
+        assert_eq!(code, 0, "{cmd}: {stderr}");
+        let line = format!("line {}", rows + 1);
+        assert!(
+            stderr.contains("warning:") && stderr.contains(&line) && stderr.contains("dropped"),
+            "{cmd}: {stderr}"
+        );
+        assert!(!stdout.contains("dropped"), "{cmd}: {stdout}");
+        let run = std::fs::read_to_string(out.join("run.toml")).unwrap();
+        assert!(run.contains("dropped"), "{cmd}: {run}");
+    }
 }

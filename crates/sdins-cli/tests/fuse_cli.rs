@@ -133,11 +133,21 @@ fn fuse_on_recorded_files_and_bad_gnss_files() {
             "--truth",
             rec.join("truth.csv").to_str().unwrap(),
             "--smooth",
+            "--health",
+            "warn",
         ],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // the fixes are the exact truth with a stated σ of 1, 1, 2 m: the innovations are far
+    // smaller than the filter expects, and the health verdict says so (a warning here)
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("warning: health: nis_windows") && err.contains("mean NIS per fix 0.00"),
+        "{err}"
+    );
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["fixes_used"], 60);
+    assert_eq!(j["health"]["ok"], false);
     assert_eq!(j["rejected"], 0);
     for f in [
         "nav.csv",

@@ -72,11 +72,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let svg = plot_svg(&report)?;
     write_string(&args.out.join("allan.svg"), &svg)?;
     plot_png(&report, &args.out.join("allan.png"))?;
-    for w in report.warnings() {
+    // the file's warnings (a cut last line dropped, …) and the result's (a moving record)
+    let warnings: Vec<String> = data
+        .warnings
+        .iter()
+        .cloned()
+        .chain(report.warnings())
+        .collect();
+    for w in &warnings {
         eprintln!("warning: {}: {w}", args.imu.display());
     }
+    let mut toml = toml::Table::new();
+    toml.insert("imu".into(), args.imu.display().to_string().into());
+    toml.insert("imu_format".into(), data.format.name().into());
+    let list: Vec<toml::Value> = warnings.iter().map(|w| w.as_str().into()).collect();
+    toml.insert("warnings".into(), list.into());
+    crate::report::write_run_toml(&args.out, toml)?;
     if args.json {
-        outln!("{}", json(&report));
+        outln!("{}", json(&report, &warnings));
     } else {
         outln!(
             "{}: format {}, {n} samples, dt {} s, {:.1} s",
@@ -184,7 +197,7 @@ pub fn table(r: &AllanReport) -> String {
 }
 
 /// The JSON summary (`null` where a term could not be fitted).
-pub fn json(r: &AllanReport) -> String {
+pub fn json(r: &AllanReport, warnings: &[String]) -> String {
     let ch: Vec<serde_json::Value> = (0..6)
         .map(|c| {
             let f = &r.fits[c];
@@ -208,7 +221,7 @@ pub fn json(r: &AllanReport) -> String {
             }
         })
         .collect();
-    serde_json::json!({ "channels": ch, "warnings": r.warnings() }).to_string()
+    serde_json::json!({ "channels": ch, "warnings": warnings }).to_string()
 }
 
 /// `allan.csv`: τ and the six deviations (gyro °/h, accelerometer μg).
@@ -408,7 +421,7 @@ mod tests {
             let vrw = r.fits[ch + 3].white.unwrap() / UG_PER_SQRT_HZ;
             assert!((vrw / 100.0 - 1.0).abs() < 0.10, "{vrw}");
         }
-        let j: serde_json::Value = serde_json::from_str(&json(&r)).unwrap();
+        let j: serde_json::Value = serde_json::from_str(&json(&r, &[])).unwrap();
         assert_eq!(j["channels"][0]["name"], "gyro_x");
         assert!(j["channels"][0]["arw_dpsh"].as_f64().is_some());
         // a bad file is BadInput (exit code 2) naming file and line
@@ -447,7 +460,7 @@ mod tests {
         assert!((data.dt_s - 0.01).abs() < 1e-15);
         let r = analyse(&data.increments, data.dt_s);
         outln!("{}", table(&r));
-        outln!("{}", json(&r));
+        outln!("{}", json(&r, &[]));
         // parked: the mean specific force is gravity (header g = 9.780327) along −z FRD
         let n = data.increments.len() as f64;
         let fz: f64 = data.increments.iter().map(|i| i.dv_b_mps[2]).sum::<f64>() / (n * data.dt_s);

@@ -104,6 +104,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if plan.truth.is_some() {
         write_errors(&out, spec.kind.name(), &rec.errors)?;
     }
+    // warnings (a cut last line dropped, …) on stderr and in run.toml
+    for w in &plan.data.warnings {
+        eprintln!("warning: {}: {w}", args.imu.display());
+    }
+    let mut toml = toml::Table::new();
+    toml.insert("imu".into(), args.imu.display().to_string().into());
+    toml.insert("imu_format".into(), plan.data.format.name().into());
+    toml.insert("algo".into(), spec.kind.name().into());
+    toml.insert("samples".into(), (spec.samples as i64).into());
+    let warnings: Vec<toml::Value> = plan
+        .data
+        .warnings
+        .iter()
+        .map(|w| w.as_str().into())
+        .collect();
+    toml.insert("warnings".into(), warnings.into());
+    crate::report::write_run_toml(&out, toml)?;
     if args.json {
         let v = summary_json(&args, &plan, rec.wall_s, rec.errors.last(), final_state);
         outln!(
@@ -184,9 +201,6 @@ fn print_summary(
     let (data, spec) = (&plan.data, &plan.spec);
     if let Some(why) = &data.detection {
         outln!("{}: {why}", args.imu.display());
-    }
-    for w in &data.warnings {
-        outln!("{}: warning: {w}", args.imu.display());
     }
     outln!(
         "{}: {} samples at {} s, {} updates in {:.3} s (navigation only)",

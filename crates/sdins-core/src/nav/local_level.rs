@@ -77,7 +77,7 @@ pub struct LocalLevelConfig {
 
 /// Local-level NED strapdown mechanization (SAV, SL, SLC).
 ///
-/// Cost notes (docs/performance.md §"Navigation near its floor"): the update calls no libm
+/// Cost notes (docs/performance.md §"The navigation update near its instruction floor"): the update calls no libm
 /// function and builds no matrix product.
 /// * The transport matrix of S1 eq. (32) factors into elementary rotations,
 ///   `T = R_y(L) R_x(−Δ) R_y(−L0)` with `Δ = Δλ + Ω_e t` (so `T(0) = I`), and the

@@ -18,7 +18,8 @@
 //! * **Rejected share.** The gate rejects a consistent fix with probability
 //!   [`GATE_FALSE_REJECTION`] (χ²_{0.999}); more than `max(5 %, 10 × 0.1 %)` of the fixes
 //!   rejected fails. With n fixes the count is Binomial(n, 1e-3): above 5 % it has
-//!   probability below 1e-9 for n ≥ 100.
+//!   probability below 1e-9 for n ≥ 100. A run where no fix reached the filter fails
+//!   here (a free-inertial solution is not an INS/GNSS one).
 //! * **Forced updates.** The filter's reset policy applies a fix after a run of rejections
 //!   (`forced`); more than one such reset fails (a consistent run of an hour at 1 Hz has
 //!   one with probability ~ 3600 × (1e-3)^k, k the policy's run length).
@@ -220,20 +221,24 @@ impl HealthMonitor {
             },
         });
         let share = if self.fixes == 0 {
-            0.0
+            1.0
         } else {
             self.rejected as f64 / self.fixes as f64
         };
         checks.push(HealthCheck {
             name: "rejected_share",
             passed: share <= MAX_REJECTED_SHARE,
-            detail: format!(
-                "{} of {} fixes rejected by the gate ({:.1} %, limit {:.0} %)",
-                self.rejected,
-                self.fixes,
-                100.0 * share,
-                100.0 * MAX_REJECTED_SHARE
-            ),
+            detail: if self.fixes == 0 {
+                "no GNSS fix reached the filter: the solution is free inertial".to_string()
+            } else {
+                format!(
+                    "{} of {} fixes rejected by the gate ({:.1} %, limit {:.0} %)",
+                    self.rejected,
+                    self.fixes,
+                    100.0 * share,
+                    100.0 * MAX_REJECTED_SHARE
+                )
+            },
         });
         checks.push(HealthCheck {
             name: "forced_updates",
@@ -281,6 +286,60 @@ impl HealthMonitor {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+
+    fn update(nis: f64, accepted: bool, forced: bool) -> sdins_core::aiding::ekf::UpdateReport {
+        sdins_core::aiding::ekf::UpdateReport {
+            t_s: 0.0,
+            t_valid_s: 0.0,
+            kind: MeasKind::Gnss,
+            dof: 6,
+            innovation: [0.0; sdins_core::aiding::linalg::MAX_ROWS],
+            sigma: [1.0; sdins_core::aiding::linalg::MAX_ROWS],
+            nis,
+            accepted,
+            forced,
+            late: false,
+        }
+    }
+
+    /// No fix at all fails; 60 fixes of NIS 6 (the mean) pass every GNSS check; a burst
+    /// of far-off fixes (NIS 100, rejected, then forced) fails the window, the rejected
+    /// share and the forced updates.
+    #[test]
+    fn verdicts_on_constructed_streams() {
+        let m = HealthMonitor::new(DEFAULT_MAX_SIGMA_H_M);
+        let v = m.verdict();
+        assert!(!v.ok());
+        assert!(
+            v.failures()[0].contains("no GNSS fix"),
+            "{:?}",
+            v.failures()
+        );
+
+        let mut m = HealthMonitor::new(DEFAULT_MAX_SIGMA_H_M);
+        for _ in 0..60 {
+            m.observe(&FuseOutput::Update(&update(6.0, true, false)));
+        }
+        assert!(m.verdict().ok(), "{:?}", m.verdict().failures());
+
+        let mut m = HealthMonitor::new(DEFAULT_MAX_SIGMA_H_M);
+        for k in 0..60 {
+            let far = (20..30).contains(&k);
+            m.observe(&FuseOutput::Update(&update(
+                if far { 100.0 } else { 6.0 },
+                !far || k % 5 == 4,
+                far && k % 5 == 4,
+            )));
+        }
+        let names: Vec<&str> = m
+            .verdict()
+            .checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| c.name)
+            .collect();
+        assert_eq!(names, ["nis_windows", "rejected_share", "forced_updates"]);
+    }
 
     /// The band of the module docs: W = 60, d = 6, K = 60 (an hour of 1 Hz fixes).
     #[test]

@@ -444,6 +444,10 @@ pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuDa
         ImuFormat::Psins if first.trim_start().starts_with("t_s,") => ImuFormat::PsinsCsv,
         f => f,
     };
+    // a logger killed mid-write cuts its last line: dropped with a warning (reliability
+    // issue, class 10)
+    let mut p = p;
+    let cut = p.drop_cut_last_line(format == ImuFormat::KfGins);
     let mut data = match format {
         ImuFormat::Psins => p.psins()?,
         ImuFormat::KfGins => p.kfgins()?,
@@ -494,7 +498,9 @@ pub fn parse_imu_str(file: &Path, text: &str, format: ImuFormat) -> Result<ImuDa
         };
         data.detection = Some(format!("read as `{}`: {why}", data.format));
     }
-    if !p.ends_with_newline {
+    if let Some(w) = cut {
+        data.warnings.push(w);
+    } else if !p.ends_with_newline {
         data.warnings.push(
             "the file does not end with a newline: its last line may have been cut inside its last number".into(),
         );
@@ -619,6 +625,46 @@ impl Parser<'_> {
             }
         }
         Ok(out)
+    }
+
+    /// A last line without final newline that is cut (fewer fields than the line before;
+    /// with `fixed_decimals`, a number with fewer decimals than the same column on the
+    /// line before) is removed; the warning that says so, or None.
+    fn drop_cut_last_line(&mut self, fixed_decimals: bool) -> Option<String> {
+        let n = self.lines.len();
+        if self.ends_with_newline || n < 2 {
+            return None;
+        }
+        let (line, last) = self.lines[n - 1];
+        let (fl, fp) = (split_fields(last), split_fields(self.lines[n - 2].1));
+        let dec = |s: &str| {
+            if s.contains(['e', 'E']) {
+                None
+            } else {
+                Some(s.find('.').map_or(0, |k| s.len() - k - 1))
+            }
+        };
+        let why = if fl.len() < fp.len() {
+            format!("{} of {} fields", fl.len(), fp.len())
+        } else if let Some(b) = fixed_decimals
+            .then(|| {
+                fp.iter()
+                    .zip(&fl)
+                    .find_map(|(a, b)| match (dec(a), dec(b)) {
+                        (Some(da), Some(db)) if db < da => Some(*b),
+                        _ => None,
+                    })
+            })
+            .flatten()
+        {
+            format!("`{b}` has fewer decimals than the line before")
+        } else {
+            return None;
+        };
+        self.lines.pop();
+        Some(format!(
+            "line {line}: the last line is cut ({why}) and the file does not end with a newline (a logger stopped mid-write): dropped"
+        ))
     }
 
     /// Fixed-decimal text (KF-GINS prints every column with the same decimals): a last line
@@ -1081,21 +1127,17 @@ mod tests {
             err(&one, ImuFormat::Auto),
             ImuFileError::TooFewRows { rows: 1, .. }
         ));
-        // truncated last line (no final newline)
+        // truncated last line (no final newline): dropped with a warning that names it
         let mut t = format!("{INC_H}{}", good_rows(3));
         t.push_str("0.04,1e-4,2e-4");
-        let e = err(&t, ImuFormat::Auto);
+        let d = parse(&t, ImuFormat::Auto).unwrap();
+        assert_eq!(d.increments.len(), 3);
         assert!(
-            matches!(
-                e,
-                ImuFileError::Truncated {
-                    line: 5,
-                    expected: 7,
-                    found: 3,
-                    ..
-                }
-            ),
-            "{e}"
+            d.warnings.iter().any(|w| w.contains("line 5")
+                && w.contains("3 of 7 fields")
+                && w.contains("dropped")),
+            "{:?}",
+            d.warnings
         );
         // wrong column count in the middle
         let t = format!("{INC_H}0.01,1,2,3,4,5\n{}", good_rows(3));
@@ -1222,11 +1264,13 @@ mod tests {
             ImuFormat::Psins,
         );
         assert!(matches!(e, ImuFileError::NoData { line: 4, .. }), "{e}");
-        let e = err(
-            "% x\n0 0 0 0 0 0\n34 108 380 0 10 9.78\n0.1 0.1 0.1 125 125 125\n1 2 3 4 5 6\n1 2",
+        let d = parse(
+            "% x\n0 0 0 0 0 0\n34 108 380 0 10 9.78\n0.1 0.1 0.1 125 125 125\n1 2 3 4 5 6\n1 2 3 4 5 6\n1 2",
             ImuFormat::Psins,
-        );
-        assert!(matches!(e, ImuFileError::Truncated { line: 6, .. }), "{e}");
+        )
+        .unwrap();
+        assert_eq!(d.increments.len(), 2);
+        assert!(d.warnings[0].contains("line 7"), "{:?}", d.warnings);
         // I/O error names the file
         let e = read_imu_file(Path::new("/nonexistent/x.imu"), ImuFormat::Auto).unwrap_err();
         assert!(
@@ -1266,35 +1310,29 @@ mod tests {
         let d = parse(&format!("\u{feff}{INC_H}{}", good_rows(3)), ImuFormat::Auto).unwrap();
         assert_eq!(d.increments.len(), 3);
         // last line cut inside its last number, no final newline: KF-GINS (fixed decimals)
-        let kf = "100.000 1.0e-5 2e-5 3e-5 0.00100 0.00200 -0.04900\n100.005 1e-5 2e-5 3e-5 0.00100 0.00200 -0.049";
-        let e = err(kf, ImuFormat::Auto);
+        let row = |t: f64| format!("{t:.3} 1.0e-5 2e-5 3e-5 0.00100 0.00200 -0.04900\n");
+        let kf = format!(
+            "{}{}{}100.015 1e-5 2e-5 3e-5 0.00100 0.00200 -0.049",
+            row(100.0),
+            row(100.005),
+            row(100.01)
+        );
+        let d = parse(&kf, ImuFormat::Auto).unwrap();
+        assert_eq!(d.increments.len(), 3);
         assert!(
-            matches!(
-                e,
-                ImuFileError::CutNumber {
-                    line: 2,
-                    column: 7,
-                    ..
-                }
-            ),
-            "{e}"
+            d.warnings[0].contains("line 4")
+                && d.warnings[0].contains("`-0.049` has fewer decimals"),
+            "{:?}",
+            d.warnings
         );
         // ... and in the middle of the line: too few fields
-        let e = err(
+        let d = parse(
             &format!("{INC_H}{}0.04,1e-4,2e", good_rows(3)),
             ImuFormat::Auto,
-        );
-        assert!(
-            matches!(
-                e,
-                ImuFileError::Truncated {
-                    line: 5,
-                    found: 3,
-                    ..
-                }
-            ),
-            "{e}"
-        );
+        )
+        .unwrap();
+        assert_eq!(d.increments.len(), 3);
+        assert!(d.warnings[0].contains("line 5"), "{:?}", d.warnings);
         // a complete last line without newline: read, with a warning
         let t = format!("{INC_H}{}", good_rows(3));
         let d = parse(t.trim_end(), ImuFormat::Auto).unwrap();
