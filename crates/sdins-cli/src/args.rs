@@ -54,19 +54,35 @@ impl ImuFormatArg {
         }
         Ok(c.imu)
     }
-    /// Read the IMU file in the format or through the map; the map's summary goes to stderr.
+    /// Read the IMU file in the format or through the map; the map's summary goes to
+    /// stderr and is returned for run.toml.
     pub fn read(
         &self,
         path: &std::path::Path,
-    ) -> Result<sdins_sim::io::imu_file::ImuData, crate::error::CliError> {
+    ) -> Result<
+        (
+            sdins_sim::io::imu_file::ImuData,
+            Option<sdins_sim::io::imu_columns::InputReport>,
+        ),
+        crate::error::CliError,
+    > {
         let cols = self.columns()?;
         let (d, rep) =
             sdins_sim::io::imu_columns::read_imu_any(path, self.imu_format, cols.as_ref())
                 .map_err(crate::error::CliError::bad)?;
-        if let Some(r) = rep {
+        if let Some(r) = &rep {
             eprintln!("{}", r.summary());
         }
-        Ok(d)
+        Ok((d, rep))
+    }
+}
+
+/// `[inputs.imu]` of run.toml: what the IMU column map did (time base, clock, offsets).
+pub fn inputs_toml(toml: &mut toml::Table, rep: Option<&sdins_sim::io::imu_columns::InputReport>) {
+    if let Some(r) = rep {
+        let mut t = toml::Table::new();
+        t.insert(r.kind.to_string(), r.to_toml().into());
+        toml.insert("inputs".into(), t.into());
     }
 }
 

@@ -543,6 +543,11 @@ fn nav_and_allan_read_the_rate_logger() {
     let (want, _) = nav(&f.imu, &[], "nav-native");
     let (got, err) = nav(&imu, &["--imu-columns", RATE_MAP], "nav-map");
     assert!(err.contains("imu: 3001 rows, time gps-sow"), "{err}");
+    let run = std::fs::read_to_string(f.dir.join("nav-map/run.toml")).unwrap();
+    assert!(
+        run.contains("[inputs.imu]") && run.contains("gps-sow"),
+        "{run}"
+    );
     // free inertial over T = 30 s: the attitude bound ε tilts g into a velocity error
     // ε g T, which integrates to ½ ε g T² in position; plus the Δv bound times T
     let t = 30.0;

@@ -188,7 +188,7 @@ fn load(args: &Args) -> Result<AlignInput, CliError> {
         (None, Some(path)) => {
             let data = if args.imu_format.imu_columns.is_some() || args.imu_format.profile.is_some()
             {
-                args.imu_format.read(path)?
+                args.imu_format.read(path)?.0
             } else {
                 read_imu_file(path, args.imu_format.imu_format).map_err(file_error)?
             };

@@ -120,6 +120,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map(|w| w.as_str().into())
         .collect();
     toml.insert("warnings".into(), warnings.into());
+    crate::args::inputs_toml(&mut toml, plan.imu_report.as_ref());
     crate::report::write_run_toml(&out, toml)?;
     if args.json {
         let v = summary_json(&args, &plan, rec.wall_s, rec.errors.last(), final_state);
