@@ -491,3 +491,92 @@ fn read_truth_columns(
     }
     Ok((out, rep))
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    const IMU: &str =
+        "t_s=time,gyro_x_dps=gx,gyro_y_dps=gy,gyro_z_dps=gz,accel_x_g=ax,accel_y_g=ay,accel_z_g=az";
+    const GNSS: &str = "t_s=time,lat_deg=lat,lon_deg=lon,alt_msl_m=alt";
+
+    fn cli(n: &str) -> String {
+        format!("--{}", n.replace('_', "-"))
+    }
+
+    #[test]
+    fn column_options_resolve_and_name_the_caller_s_option() {
+        let o = ColumnOptions {
+            imu_columns: Some(IMU.into()),
+            gnss_columns: Some(GNSS.into()),
+            gnss_sigma: Some("1,1,2".into()),
+            undulation_m: Some(30.0),
+            gps_week: Some(2300),
+            ..Default::default()
+        };
+        let c = o.resolve(&cli).unwrap();
+        let g = c.gnss.unwrap();
+        assert_eq!(g.undulation_m, Some(30.0));
+        assert_eq!(g.gps_week, Some(2300));
+        assert!(g.sigma.is_some());
+        assert_eq!(c.imu.unwrap().gps_week, Some(2300));
+        assert!(!ColumnOptions::default().any() && o.any());
+        // σ without a GNSS map; a bad σ; a reflection: each names the option as spelled
+        let e = ColumnOptions {
+            gnss_sigma: Some("1,1,2".into()),
+            ..Default::default()
+        }
+        .resolve(&|n: &str| n.to_string())
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("gnss_sigma: ") && e.contains("gnss_columns"),
+            "{e}"
+        );
+        let e = ColumnOptions {
+            gnss_sigma: Some("1,1".into()),
+            ..o.clone()
+        }
+        .resolve(&cli)
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("--gnss-sigma: "), "{e}");
+        let e = ColumnOptions {
+            imu_columns: Some(format!("{IMU},axes=x:+y,y:+x,z:+z")),
+            ..Default::default()
+        }
+        .resolve(&cli)
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("--imu-columns: ") && e.contains("reflection"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_map_in_the_profile_and_an_option_is_refused() {
+        let dir = std::env::temp_dir().join(format!("sdins-colopt-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("p.toml");
+        std::fs::write(&p, format!("[imu]\ncolumns = \"{IMU}\"\n")).unwrap();
+        let from_profile = ColumnOptions {
+            profile: Some(p.clone()),
+            ..Default::default()
+        };
+        assert!(from_profile.resolve(&cli).unwrap().imu.is_some());
+        let e = ColumnOptions {
+            imu_columns: Some(IMU.into()),
+            ..from_profile
+        }
+        .resolve(&cli)
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("--imu-columns: the profile has a [imu] map"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
