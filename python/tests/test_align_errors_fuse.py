@@ -138,8 +138,10 @@ def test_fuse_smooth_equals_cli_smoothed_csv(cli, tmp_path):
     # the CSV prints shortest round-trip decimals ({:e}): equal to the last bit
     assert np.array_equal(s["pos_error_ned_m"][:, 0], rows[:, 1])
     assert np.array_equal(s["sigma"][:, 0], rows[:, 4])
+    # smoothed rows at the forward rows' epochs (the epoch rule, initial row included);
     # the smoother never has a larger σ than the forward filter at the same epoch
-    assert np.all(s["sigma"][1:, :9] <= r.sigma[:, :9] * (1 + 1e-12))
+    assert np.array_equal(s["t_s"], r.t_s)
+    assert np.all(s["sigma"][:, :9] <= r.sigma[:, :9] * (1 + 1e-12))
 
 
 def test_fuse_files_navego_equals_cli(cli, tmp_path):

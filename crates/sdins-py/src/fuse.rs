@@ -526,6 +526,9 @@ impl FuseMcState {
         d.set_item("in95", c.in95)?;
         d.set_item("in99", c.in99)?;
         d.set_item("max", c.max)?;
+        d.set_item("epochs_eff", c.epochs_eff)?;
+        d.set_item("need95", c.need95)?;
+        d.set_item("need99", c.need99)?;
         d.set_item("pass", c.pass)?;
         Ok(d)
     }
