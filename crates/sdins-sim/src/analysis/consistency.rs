@@ -218,7 +218,7 @@ pub fn effective_epochs(means: &[f64]) -> f64 {
             / nf
     };
     let c0 = c(0);
-    if !(c0 > 0.0) {
+    if !matches!(c0.partial_cmp(&0.0), Some(std::cmp::Ordering::Greater)) {
         return nf;
     }
     let mut tau = -1.0; // 1 + 2 Σ_{k≥1} ρ_k = −1 + 2 Σ_{m≥0} (ρ_{2m} + ρ_{2m+1})
