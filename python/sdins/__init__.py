@@ -251,12 +251,24 @@ def _imu_format(imu_format: Optional[str], format: Optional[str]) -> Optional[st
     return imu_format
 
 
-def read_imu(path: Any, imu_format: Optional[str] = "auto", format: Optional[str] = None) -> ImuRecord:
+def read_imu(
+    path: Any,
+    imu_format: Optional[str] = "auto",
+    format: Optional[str] = None,
+    columns: Optional[str] = None,
+    profile: Optional[Any] = None,
+) -> ImuRecord:
     """Read an IMU file: sdins CSV, PSINS ``.imu`` (psins) or trj CSV (psins-csv),
     KF-GINS text (kfgins), NaveGo CSV (navego); ``imu_format="auto"`` detects it
-    (docs/imu-files.md; ``format=`` is a deprecated alias). Increments are converted to
-    body FRD."""
-    return ImuRecord(_sdins.read_imu(str(path), _imu_format(imu_format, format)))
+    (docs/imu-files.md; ``format=`` is a deprecated alias). Any other delimited text is
+    read through ``columns``, a column map (the CLI's ``--imu-columns``, docs/own-data.md),
+    or a TOML ``profile``'s ``[imu]`` map; rates become increments by the trapezoid rule.
+    Increments are converted to body FRD."""
+    return ImuRecord(
+        _sdins.read_imu(
+            str(path), _imu_format(imu_format, format), columns, None if profile is None else str(profile)
+        )
+    )
 
 
 def allan(dtheta: Any, dv: Any, dt: float) -> AllanResult:
@@ -525,8 +537,22 @@ def fuse_files(
     scale_factors_ppm: Optional[Tuple[float, float]] = None,
     every_s: Optional[float] = None,
     max_latency_s: Optional[float] = None,
+    imu_columns: Optional[str] = None,
+    gnss_columns: Optional[str] = None,
+    truth_columns: Optional[str] = None,
+    profile: Optional[str] = None,
+    gps_week: Optional[int] = None,
+    gnss_sigma: Optional[str] = None,
+    undulation_m: Optional[float] = None,
 ) -> Dict[str, Any]:
     """INS/GNSS filter (and smoother) on recorded files (``sdins fuse --imu --gnss``).
+
+    One's own files are read through column maps (docs/own-data.md), the strings of the
+    CLI's ``--imu-columns``/``--gnss-columns``/``--truth-columns`` (e.g. ``imu_columns=
+    "t_s=time,gyro_x_dps=gx,...,accel_z_g=az,axes=x:+y,y:+x,z:-z,time=gps-sow"``), or a
+    TOML ``profile``; ``gps_week``, ``gnss_sigma`` (``"N,E,D[,vN,vE,vD]"``) and
+    ``undulation_m`` supply what such files lack. The result's ``inputs`` maps ``imu``,
+    ``gnss``, ``reference`` to what each map did (time base, clock origin, offset).
 
     The IMU's error model comes from ``grade`` (a preset) or ``navego_params`` (a NaveGo
     ``imuN_params.txt``); the initial state from ``init`` (``"lat_deg,lon_deg,h_m,v_n,v_e,
@@ -555,5 +581,6 @@ def fuse_files(
         static_s,
         None if lever_arm_m is None else [float(x) for x in lever_arm_m],
         truth, smooth, algo, samples, cov_rate_hz, gate, nhc_sigma_mps, gnss_offset_s,
-        scale_factors_ppm, every_s, max_latency_s,
+        scale_factors_ppm, every_s, max_latency_s, imu_columns, gnss_columns, truth_columns,
+        None if profile is None else str(profile), gps_week, gnss_sigma, undulation_m,
     )

@@ -232,7 +232,8 @@ class ImuRecord:
     """An IMU file (``sdins.read_imu``): ``t_s`` (n,) sample time stamps [s] (t0_s + k δt);
     ``dtheta_rad``, ``dv_mps`` (n, 3) body FRD increments; ``dt_s``; ``t0_s``; ``format``
     (the format read); ``psins_header`` (dict or None: lat_deg, lon_deg, h_m,
-    vel0_enu_mps, att0_deg)."""
+    vel0_enu_mps, att0_deg); ``input`` (str or None: what a column map did, its time base,
+    clock origin and offset)."""
 
     def __init__(self, d: Dict[str, Any]):
         self.format: str = d["format"]
@@ -242,6 +243,7 @@ class ImuRecord:
         self.dtheta_rad: np.ndarray = d["dtheta_rad"]
         self.dv_mps: np.ndarray = d["dv_mps"]
         self.psins_header: Optional[Dict[str, Any]] = d.get("psins_header")
+        self.input: Optional[str] = d.get("input")
 
     def __len__(self) -> int:
         return len(self.t_s)

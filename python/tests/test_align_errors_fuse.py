@@ -251,3 +251,65 @@ def test_fuse_montecarlo_equals_cli(cli, tmp_path):
     assert c["epochs"] > 0 and c["dof"] == 3
     with pytest.raises(sdins.SdinsError, match="missing"):
         sdins.fuse_merge(py[:1])
+
+
+def _rate_logger(cli, tmp_path):
+    """A rate logger's files (deg/s and g on right-forward-up axes, GPS seconds of week;
+    fixes without σ) written from an `sdins truth` record, as in own_data_cli.rs."""
+    scn = tmp_path / "s.toml"
+    scn.write_text(
+        'name = "own-data"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nspeed_mps = 10.0\n'
+        '[imu]\nrate_hz = 100.0\ngrade = "tactical"\n[nav]\nsamples = 2\n'
+        '[[segment]]\ntype = "turn"\nrate_dps = 3.0\nduration_s = 30.0\n'
+    )
+    code, _, err = cli("truth", str(scn), "--out", str(tmp_path / "rec"))
+    assert code == 0, err
+    rows = [list(map(float, l.split(","))) for l in (tmp_path / "rec" / "imu.csv").read_text().splitlines()[1:]]
+    dt, sow0, g0 = rows[0][0], 345600.0, 9.80665
+    out = ["time,gx,gy,gz,ax,ay,az"]
+    for t, r in [(0.0, rows[0])] + [(r[0], r) for r in rows]:
+        w = [np.degrees(x / dt) for x in (r[2], r[1], -r[3])]
+        a = [x / dt / g0 for x in (r[5], r[4], -r[6])]
+        out.append(",".join(repr(float(x)) for x in [sow0 + t] + w + a))
+    imu = tmp_path / "rates.csv"
+    imu.write_text("\n".join(out) + "\n")
+    fixes = ["time,lat,lon,alt"]
+    for l in (tmp_path / "rec" / "truth.csv").read_text().splitlines()[1:]:
+        v = l.split(",")
+        t = float(v[0])
+        if t > 0 and abs(t * 2 - round(t * 2)) < 1e-9:
+            fixes.append(f"{sow0 + t!r},{v[1]},{v[2]},{v[3]}")
+    gnss = tmp_path / "fixes.csv"
+    gnss.write_text("\n".join(fixes) + "\n")
+    return imu, gnss, tmp_path / "rec" / "truth.csv"
+
+
+RATE_MAP = ("t_s=time,gyro_x_dps=gx,gyro_y_dps=gy,gyro_z_dps=gz,accel_x_g=ax,accel_y_g=ay,"
+            "accel_z_g=az,axes=x:+y,y:+x,z:-z,time=gps-sow")
+FIX_MAP = "t_s=time,lat_deg=lat,lon_deg=lon,h_m=alt,time=gps-sow"
+
+
+def test_fuse_files_column_maps_equal_cli(cli, tmp_path):
+    imu, gnss, truth = _rate_logger(cli, tmp_path)
+    init = "37.5,127,0,10,0,0,0,0,0"
+    code, out, err = cli(
+        "fuse", "--imu", str(imu), "--gnss", str(gnss), "--imu-columns", RATE_MAP,
+        "--gnss-columns", FIX_MAP, "--gnss-sigma", "1,1,2", "--grade", "tactical",
+        "--init", init, "--truth", str(truth), "--json", "--health", "warn",
+        "--out", str(tmp_path / "o"),
+    )
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.fuse_files(str(imu), str(gnss), imu_columns=RATE_MAP, gnss_columns=FIX_MAP,
+                         gnss_sigma="1,1,2", grade="tactical", init=init, truth=str(truth))
+    assert r["fixes_used"] == js["fixes_used"]
+    assert r["inputs"]["imu"].startswith("imu: 3001 rows, time gps-sow")
+    names = ["roll", "pitch", "yaw", "v_N", "v_E", "v_D", "N", "E", "D"]
+    for i, n in enumerate(names):
+        got = r["forward_rmse"][i]
+        assert (np.degrees(got) if i < 3 else got) == js["forward_vs_truth"][n]["rmse"], n
+    rec = sdins.read_imu(str(imu), columns=RATE_MAP)
+    assert len(rec) == 3000 and rec.input is not None
+    with pytest.raises(sdins.SdinsError, match="imu_columns.*reflection"):
+        sdins.fuse_files(str(imu), str(gnss), imu_columns=RATE_MAP.replace("z:-z", "z:+z"),
+                         gnss_columns=FIX_MAP, gnss_sigma="1,1,2", grade="tactical", init=init)

@@ -160,9 +160,9 @@ def test_scenario_from_reference(tmp_path):
     assert np.array_equal(u.dv_mps, t.dv_mps)
     rows[6] = rows[5]
     f.write_text("\n".join(rows) + "\n")
-    with pytest.raises(sdins.SdinsError, match=r"log\.csv:7: time: .* does not increase"):
+    with pytest.raises(sdins.SdinsError, match=r"log\.csv:7: t_s: .* does not increase"):
         sdins.Scenario.from_reference(f, columns=cols)
-    with pytest.raises(sdins.SdinsError, match="--columns: missing `lat_deg"):
+    with pytest.raises(sdins.SdinsError, match="--columns: missing `lat_UNIT=COLUMN`"):
         sdins.Scenario.from_reference(f, columns="t_s=time")
     with pytest.raises(sdins.SdinsError, match="earth: `flat`"):
         sdins.Scenario.from_reference(f, columns=cols, earth="flat")

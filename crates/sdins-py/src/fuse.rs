@@ -311,7 +311,8 @@ impl Track {
     navego_params=None, init=None, attitude_deg=None, attitude_sigma_deg=None, static_s=None,
     lever_arm_m=None, truth=None, smooth=None, algo=None, samples=None, cov_rate_hz=None,
     gate=None, nhc_sigma_mps=None, gnss_offset_s=None, scale_factors_ppm=None, every_s=None,
-    max_latency_s=None))]
+    max_latency_s=None, imu_columns=None, gnss_columns=None, truth_columns=None, profile=None,
+    gps_week=None, gnss_sigma=None, undulation_m=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse_files<'py>(
     py: Python<'py>,
@@ -337,7 +338,26 @@ pub fn fuse_files<'py>(
     scale_factors_ppm: Option<(f64, f64)>,
     every_s: Option<f64>,
     max_latency_s: Option<f64>,
+    imu_columns: Option<String>,
+    gnss_columns: Option<String>,
+    truth_columns: Option<String>,
+    profile: Option<std::path::PathBuf>,
+    gps_week: Option<u32>,
+    gnss_sigma: Option<String>,
+    undulation_m: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    // the same maps as the CLI's --imu-columns, …; messages name the Python arguments
+    let columns = sdins_sim::fusion::files::ColumnOptions {
+        imu_columns,
+        gnss_columns,
+        truth_columns,
+        profile,
+        gps_week,
+        gnss_sigma,
+        undulation_m,
+    }
+    .resolve(&|n: &str| n.to_string())
+    .map_err(err)?;
     let mut req = FuseRequest::new(FuseData::Files(FilesData {
         imu: (imu, imu_format.unwrap_or("auto").parse().map_err(err)?),
         gnss: (gnss, gnss_format.unwrap_or("auto").parse().map_err(err)?),
@@ -349,6 +369,7 @@ pub fn fuse_files<'py>(
         static_s,
         lever_arm_m,
         truth,
+        columns,
     }));
     if let Some(a) = algo {
         req.algo = a.to_string();
@@ -395,6 +416,11 @@ pub fn fuse_files<'py>(
     out.set_item("late", o.late)?;
     out.set_item("fixes_outside", (r.fixes_outside.0, r.fixes_outside.1))?;
     out.set_item("imu_samples", r.imu_samples)?;
+    let inputs = PyDict::new(py);
+    for rep in &r.inputs {
+        inputs.set_item(rep.kind, rep.summary())?;
+    }
+    out.set_item("inputs", inputs)?;
     for (name, c) in [("forward_rmse", &r.forward), ("smoothed_rmse", &r.smoothed)] {
         if let Some(c) = c {
             out.set_item(name, c.rmse().to_vec())?;

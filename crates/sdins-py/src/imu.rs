@@ -7,7 +7,7 @@ use crate::interrupt;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use sdins_sim::io::imu_file::{read_imu_file, ImuFormat};
+use sdins_sim::io::imu_file::ImuFormat;
 use sdins_sim::sensors::imu_error::ImuErrorModel;
 use std::path::PathBuf;
 
@@ -92,15 +92,42 @@ pub fn corrupt<'py>(
 
 /// Read an IMU file (sdins CSV, PSINS .imu / trj CSV, KF-GINS, NaveGo) into FRD arrays.
 #[pyfunction]
-#[pyo3(signature = (path, format=None))]
+#[pyo3(signature = (path, format=None, columns=None, profile=None))]
 pub fn read_imu<'py>(
     py: Python<'py>,
     path: PathBuf,
     format: Option<&str>,
+    columns: Option<String>,
+    profile: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let fmt: ImuFormat = format.unwrap_or("auto").parse().map_err(err)?;
-    let data = interrupt::run(py, |_| read_imu_file(&path, fmt))?.map_err(err)?;
+    // a column map (`columns=`, the CLI's --imu-columns) or a profile's [imu] map
+    let with_profile = profile.is_some();
+    let cols = sdins_sim::fusion::files::ColumnOptions {
+        imu_columns: columns,
+        profile,
+        ..Default::default()
+    }
+    .resolve(&|n: &str| {
+        if n == "imu_columns" {
+            "columns".into()
+        } else {
+            n.to_string()
+        }
+    })
+    .map_err(err)?
+    .imu;
+    if with_profile && cols.is_none() {
+        return Err(err("profile: the profile has no [imu] map"));
+    }
+    let (data, rep) = interrupt::run(py, |_| {
+        sdins_sim::io::imu_columns::read_imu_any(&path, fmt, cols.as_ref())
+    })?
+    .map_err(err)?;
     let d = PyDict::new(py);
+    if let Some(r) = rep {
+        d.set_item("input", r.summary())?;
+    }
     let (a, b) = from_increments(py, &data.increments)?;
     let n = data.increments.len();
     let t: Vec<f64> = (0..n).map(|k| data.t0_s + k as f64 * data.dt_s).collect();

@@ -156,6 +156,7 @@ fn scenario_in_memory_and_through_files_give_bit_identical_estimates() {
             init: InitSource::Given(state, InitSigma::default()),
             truth: None,
             check_after_s: 30.0,
+            columns: Default::default(),
         };
         let ropts = RecordOptions {
             algo: opts.algo,

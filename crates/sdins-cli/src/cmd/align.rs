@@ -186,7 +186,12 @@ fn load(args: &Args) -> Result<AlignInput, CliError> {
             AlignInput::from_scenario(&scn, args.run, args.lat).map_err(run_error)
         }
         (None, Some(path)) => {
-            let data = read_imu_file(path, args.imu_format.imu_format).map_err(file_error)?;
+            let data = if args.imu_format.imu_columns.is_some() || args.imu_format.profile.is_some()
+            {
+                args.imu_format.read(path)?.0
+            } else {
+                read_imu_file(path, args.imu_format.imu_format).map_err(file_error)?
+            };
             AlignInput::from_imu_data(&path.display().to_string(), data, args.lat, args.h)
                 .map_err(run_error)
         }

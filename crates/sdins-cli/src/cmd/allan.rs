@@ -54,7 +54,15 @@ fn file_error(e: ImuFileError) -> CliError {
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let data = read_imu_file(&args.imu, args.imu_format.imu_format).map_err(file_error)?;
+    let (data, input) =
+        if args.imu_format.imu_columns.is_some() || args.imu_format.profile.is_some() {
+            args.imu_format.read(&args.imu)?
+        } else {
+            (
+                read_imu_file(&args.imu, args.imu_format.imu_format).map_err(file_error)?,
+                None,
+            )
+        };
     let n = data.increments.len();
     if n < 20 {
         return Err(CliError::bad(format!(
@@ -83,6 +91,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     toml.insert("imu_format".into(), data.format.name().into());
     let list: Vec<toml::Value> = warnings.iter().map(|w| w.as_str().into()).collect();
     toml.insert("warnings".into(), list.into());
+    crate::args::inputs_toml(&mut toml, input.as_ref());
     crate::report::write_run_toml(&args.out, toml)?;
     if args.json {
         outln!("{}", json(&report, &warnings));
@@ -395,9 +404,7 @@ mod tests {
         let out = dir.join("out");
         crate::output::finish(run(Args {
             imu: file.clone(),
-            imu_format: crate::args::ImuFormatArg {
-                imu_format: ImuFormat::Auto,
-            },
+            imu_format: crate::args::ImuFormatArg::auto(),
             out: out.clone(),
             json: true,
         }))
@@ -430,9 +437,7 @@ mod tests {
         .unwrap();
         let e = crate::output::finish(run(Args {
             imu: dir.join("bad.csv"),
-            imu_format: crate::args::ImuFormatArg {
-                imu_format: ImuFormat::Auto,
-            },
+            imu_format: crate::args::ImuFormatArg::auto(),
             out: out.clone(),
             json: false,
         }))

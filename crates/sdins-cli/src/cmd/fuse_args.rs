@@ -146,6 +146,9 @@ pub struct Args {
     /// print the summary as JSON
     #[arg(long)]
     pub json: bool,
+    /// column maps of one's own files
+    #[command(flatten)]
+    pub columns: crate::args::ColumnsArgs,
 }
 
 /// Three comma-separated finite numbers.
@@ -212,6 +215,7 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
                 static_s: a.static_s,
                 lever_arm_m: opt_triple("--lever-arm-m", &a.lever_arm_m)?,
                 truth: a.truth.clone(),
+                columns: a.columns.resolve()?,
             })
         }
         (None, Some(name)) => {
@@ -222,6 +226,10 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
                 ("--static-s", a.static_s.is_some()),
                 ("--truth", a.truth.is_some()),
                 ("--lever-arm-m", a.lever_arm_m.is_some()),
+                (
+                    "--imu-columns, --gnss-columns, --profile, …",
+                    a.columns.options().any(),
+                ),
             ] {
                 if given {
                     return Err(CliError::bad(format!(

@@ -140,9 +140,12 @@ pub fn run(args: &Args, req: &FuseRequest) -> Result<(), CliError> {
     if !plot.forward.pts.is_empty() || !plot.gnss.is_empty() {
         report(&out, args, d, &o, r, &plot)?;
     }
-    let mut toml = run_toml(args, d);
+    let mut toml = run_toml(args, d, r);
     super::fuse_args::health_toml(&mut toml, &o.health);
     crate::report::write_run_toml(&out, toml)?;
+    for rep in &r.inputs {
+        eprintln!("{}", rep.summary());
+    }
     for w in &r.imu_warnings {
         eprintln!("warning: {}: {w}", d.imu.0.display());
     }
@@ -259,11 +262,12 @@ fn summary(
         })),
         "forward_vs_truth": cmp_json(&r.forward),
         "smoothed_vs_truth": cmp_json(&r.smoothed),
+        "inputs": r.inputs.iter().map(|rep| (rep.kind.to_string(), serde_json::Value::String(rep.summary()))).collect::<serde_json::Map<_, _>>(),
         "units": "rmse: roll/pitch/yaw deg, v m/s, N/E/D m",
     })
 }
 
-fn run_toml(args: &Args, d: &FilesData) -> toml::Table {
+fn run_toml(args: &Args, d: &FilesData, r: &FilesResult) -> toml::Table {
     let mut f = toml::Table::new();
     f.insert("imu".into(), d.imu.0.display().to_string().into());
     f.insert("gnss".into(), d.gnss.0.display().to_string().into());
@@ -277,6 +281,14 @@ fn run_toml(args: &Args, d: &FilesData) -> toml::Table {
     }
     if let Some(e) = args.every_s {
         f.insert("every_s".into(), e.into());
+    }
+    if !r.inputs.is_empty() {
+        // the column maps' time bases, clock origin and offsets (docs/own-data.md)
+        let mut t = toml::Table::new();
+        for rep in &r.inputs {
+            t.insert(rep.kind.to_string(), rep.to_toml().into());
+        }
+        f.insert("inputs".into(), t.into());
     }
     f
 }

@@ -51,8 +51,8 @@ pub struct Args {
 }
 
 /// The run as the library takes it.
-fn request(args: &Args) -> NavFileRequest {
-    NavFileRequest {
+fn request(args: &Args) -> Result<NavFileRequest, CliError> {
+    Ok(NavFileRequest {
         imu: args.imu.clone(),
         imu_format: args.imu_format.imu_format,
         init: args.init.clone(),
@@ -61,12 +61,14 @@ fn request(args: &Args) -> NavFileRequest {
         coning: args.coning.clone(),
         earth: args.earth.clone(),
         truth: args.truth.clone(),
-    }
+        imu_columns: args.imu_format.columns()?,
+    })
 }
 
 /// Run the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let plan = recorded::prepare(&request(&args)).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let plan =
+        recorded::prepare(&request(&args)?).map_err(|e| CliError::BadInput(e.to_string()))?;
     let spec = plan.spec;
     let out = args
         .out
@@ -85,6 +87,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (mut write_err, mut final_state) = (None, None);
     // what was used, so that nobody has to guess a default
     eprintln!("{}", used(&args, &plan));
+    if let Some(r) = &plan.imu_report {
+        eprintln!("{}", r.summary());
+    }
     let rec = recorded::run_plan(&plan, &crate::progress::token(), |t, st| {
         final_state = Some((t, *st));
         if let Err(err) = nav_csv.row(&nav_row(t, st)) {
@@ -115,6 +120,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map(|w| w.as_str().into())
         .collect();
     toml.insert("warnings".into(), warnings.into());
+    crate::args::inputs_toml(&mut toml, plan.imu_report.as_ref());
     crate::report::write_run_toml(&out, toml)?;
     if args.json {
         let v = summary_json(&args, &plan, rec.wall_s, rec.errors.last(), final_state);
@@ -134,7 +140,9 @@ fn used(args: &Args, plan: &recorded::NavFilePlan) -> String {
     format!(
         "sdins nav: {} format {}, algorithm {}, N = {}, coning {}, earth {}",
         args.imu.display(),
-        if args.imu_format.imu_format == ImuFormat::Auto {
+        if plan.imu_report.is_some() {
+            "read through the column map".to_string()
+        } else if args.imu_format.imu_format == ImuFormat::Auto {
             format!("{} (detected)", data.format.name())
         } else {
             data.format.name().to_string()

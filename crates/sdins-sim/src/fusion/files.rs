@@ -10,12 +10,20 @@ use crate::fusion::records::{
     TruthComparison,
 };
 use crate::fusion::simulated::{FuseError, InitSigma};
+use crate::io::columns::{ColumnsError, InputKind, MapOrigin};
+use crate::io::gnss_columns::{read_gnss_columns, GnssColumns, GnssSigma};
+use crate::io::gnss_file::TimeBase;
 use crate::io::gnss_file::{
     clip_to_imu_span, imu_span_s, read_gnss_file, to_imu_time, GnssFileError, GnssFormat,
     GnssReadOptions, GnssReadReport, ImuClock,
 };
+use crate::io::imu_columns::{read_imu_record, ImuColumns, InputReport};
 use crate::io::imu_file::{read_imu_file, ImuFileError, ImuFormat};
 use crate::io::navego_params::{read_navego_imu_params, NavegoImuParams, ParamsError};
+use crate::io::reference_file::{
+    parse_generic_on, ColumnMap as ReferenceColumns, ReferenceFileError,
+};
+use crate::io::time::{ClockScale, RunClock};
 use crate::io::truth_file::{read_truth, TruthFileError};
 use crate::sensors::imu_error::ImuErrorModel;
 use sdins_core::nav::InitialState;
@@ -125,6 +133,133 @@ pub struct FilesInput {
     /// compare with the reference after this many seconds from the navigation start
     /// (the ±3σ fractions) \[s\]
     pub check_after_s: f64,
+    /// column maps of the IMU and GNSS files (each `None`: the file's fixed format)
+    pub columns: InputColumns,
+}
+
+/// Column maps of a fused run's files (`crate::io::columns`; docs/own-data.md).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InputColumns {
+    /// the IMU file's map (its format is then ignored)
+    pub imu: Option<ImuColumns>,
+    /// the GNSS file's map (its format is then ignored)
+    pub gnss: Option<GnssColumns>,
+    /// the reference trajectory's map (it needs the velocity columns)
+    pub truth: Option<ReferenceColumns>,
+}
+
+/// The column-map options as the user gives them (CLI `--imu-columns`, …; Python
+/// `imu_columns=`, …): maps as text, a profile, and the values a file cannot carry.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ColumnOptions {
+    /// IMU map text
+    pub imu_columns: Option<String>,
+    /// GNSS map text
+    pub gnss_columns: Option<String>,
+    /// reference map text
+    pub truth_columns: Option<String>,
+    /// TOML input profile with `[imu]`, `[gnss]`, `[reference]` maps
+    pub profile: Option<PathBuf>,
+    /// GPS week of `time=gps-sow` files without a week column
+    pub gps_week: Option<u32>,
+    /// σ of fixes without σ columns: `N,E,D[,vN,vE,vD]` \[m, m/s\]
+    pub gnss_sigma: Option<String>,
+    /// geoid undulation \[m\] for `alt_msl_m` maps
+    pub undulation_m: Option<f64>,
+}
+
+impl ColumnOptions {
+    /// Whether any option is given.
+    pub fn any(&self) -> bool {
+        *self != Self::default()
+    }
+    /// The maps of the options and the profile (a map given both ways is refused). `name`
+    /// spells an option for messages (`imu_columns` → `--imu-columns` on the CLI).
+    pub fn resolve(&self, name: &dyn Fn(&str) -> String) -> Result<InputColumns, ColumnsError> {
+        let opt = |o: &str, m: String| ColumnsError::map(&MapOrigin::Option(name(o)), m);
+        let mut c = match &self.profile {
+            Some(p) => {
+                let pr = crate::io::profile::Profile::read(p)?;
+                InputColumns {
+                    imu: pr.imu,
+                    gnss: pr.gnss,
+                    truth: pr.reference,
+                }
+            }
+            None => InputColumns::default(),
+        };
+        let both = |o: &str, t: &str| opt(o, format!("the profile has a [{t}] map too: give one"));
+        if let Some(text) = &self.imu_columns {
+            if c.imu.is_some() {
+                return Err(both("imu_columns", "imu"));
+            }
+            c.imu = Some(ImuColumns::parse(
+                text,
+                MapOrigin::Option(name("imu_columns")),
+            )?);
+        }
+        if let Some(text) = &self.gnss_columns {
+            if c.gnss.is_some() {
+                return Err(both("gnss_columns", "gnss"));
+            }
+            c.gnss = Some(GnssColumns::parse(
+                text,
+                MapOrigin::Option(name("gnss_columns")),
+            )?);
+        }
+        if let Some(text) = &self.truth_columns {
+            if c.truth.is_some() {
+                return Err(both("truth_columns", "reference"));
+            }
+            c.truth = Some(ReferenceColumns::new(crate::io::columns::ColumnMap::parse(
+                InputKind::Reference,
+                text,
+                MapOrigin::Option(name("truth_columns")),
+            )?));
+        }
+        if let Some(w) = self.gps_week {
+            if c.imu.is_none() && c.gnss.is_none() && c.truth.is_none() {
+                return Err(opt(
+                    "gps_week",
+                    "applies to files read through a column map".into(),
+                ));
+            }
+            if let Some(m) = c.imu.as_mut() {
+                m.gps_week = Some(w);
+            }
+            if let Some(m) = c.gnss.as_mut() {
+                m.gps_week = Some(w);
+            }
+            if let Some(m) = c.truth.as_mut() {
+                m.gps_week = Some(w);
+            }
+        }
+        let need_gnss = |o: &str| {
+            opt(
+                o,
+                format!(
+                    "applies to a GNSS file read through a column map ({} or a profile's [gnss])",
+                    name("gnss_columns")
+                ),
+            )
+        };
+        if let Some(s) = &self.gnss_sigma {
+            let m = c.gnss.as_mut().ok_or_else(|| need_gnss("gnss_sigma"))?;
+            m.sigma = Some(GnssSigma::parse(s).map_err(|e| opt("gnss_sigma", e))?);
+        }
+        if let Some(n) = self.undulation_m {
+            if c.gnss.is_none() && c.truth.is_none() {
+                return Err(need_gnss("undulation_m"));
+            }
+            if let Some(m) = c.gnss.as_mut() {
+                m.undulation_m = Some(n);
+            }
+            if let Some(m) = c.truth.as_mut() {
+                m.undulation_m = Some(n);
+            }
+        }
+        Ok(c)
+    }
 }
 
 /// Why a fused run on files failed.
@@ -143,6 +278,12 @@ pub enum FilesError {
     /// the reference trajectory
     #[error(transparent)]
     Truth(#[from] TruthFileError),
+    /// a column map or a file read through one
+    #[error(transparent)]
+    Columns(#[from] ColumnsError),
+    /// a reference trajectory read through a column map
+    #[error(transparent)]
+    Reference(#[from] ReferenceFileError),
     /// the filter or an option
     #[error(transparent)]
     Fuse(#[from] FuseError),
@@ -174,6 +315,8 @@ pub struct FilesResult {
     pub forward: Option<TruthComparison>,
     /// comparison of the smoothed solution with the reference
     pub smoothed: Option<TruthComparison>,
+    /// what the column maps did (time base, clock origin, offsets), IMU first
+    pub inputs: Vec<InputReport>,
 }
 
 /// Run it; `observe` sees every forward and smoothed point and every update, with the
@@ -185,8 +328,44 @@ pub fn fuse_files(
     cancel: &CancelToken,
     mut observe: impl FnMut(RecordEvent<'_>, Option<&[f64; 9]>),
 ) -> Result<FilesResult, FilesError> {
-    let imu = read_imu_file(&input.imu.0, input.imu.1)?;
-    let gnss = read_gnss_file(&input.gnss.0, input.gnss.1, &input.gnss_options)?;
+    let mut inputs = Vec::new();
+    let imu = match &input.columns.imu {
+        Some(c) => {
+            let (d, rep) = read_imu_record(&input.imu.0, c, None)?;
+            inputs.push(rep);
+            d
+        }
+        None => read_imu_file(&input.imu.0, input.imu.1)?,
+    };
+    let gnss = match &input.columns.gnss {
+        Some(c) => {
+            // on the IMU map's clock; alone, on its own scale from origin 0 (GPS seconds
+            // since the epoch or of week), which the fixed IMU formats' clocks understand
+            let alone = |scale| RunClock { scale, origin_s: 0 };
+            let (clock, base) = match inputs.first() {
+                Some(r) => (r.clock, TimeBase::FileSeconds),
+                None => match c.map.time.unwrap_or_default() {
+                    crate::io::columns::TimeKind::Relative => {
+                        (alone(ClockScale::File), TimeBase::FileSeconds)
+                    }
+                    crate::io::columns::TimeKind::GpsSow
+                        if c.gps_week.is_none() && c.map.get("week").is_none() =>
+                    {
+                        (
+                            alone(ClockScale::GpsWeekUnknown),
+                            TimeBase::GpsSecondsOfWeek,
+                        )
+                    }
+                    _ => (alone(ClockScale::Gpst), TimeBase::GpsSecondsSinceEpoch),
+                },
+            };
+            let (mut d, rep) = read_gnss_columns(&input.gnss.0, c, Some(&clock))?;
+            d.time_base = base;
+            inputs.push(rep);
+            d
+        }
+        None => read_gnss_file(&input.gnss.0, input.gnss.1, &input.gnss_options)?,
+    };
     let on_imu = to_imu_time(&input.gnss.0, &gnss, input.clock)?;
     let (first, last) = imu_span_s(&imu);
     let clip = clip_to_imu_span(&input.gnss.0, &on_imu, first, last)?;
@@ -221,9 +400,21 @@ pub fn fuse_files(
         }
         InitSource::StaticCoarse(w) => RecordInit::StaticCoarse { window_s: w },
     };
-    let truth = match &input.truth {
-        Some(p) => Some(read_truth(p)?),
-        None => None,
+    let truth = match (&input.truth, &input.columns.truth) {
+        (Some(p), Some(m)) => {
+            let (t, rep) = read_truth_columns(p, m, inputs.first().map(|r| r.clock))?;
+            inputs.push(rep);
+            Some(t)
+        }
+        (Some(p), None) => Some(read_truth(p)?),
+        (None, Some(m)) => {
+            return Err(ColumnsError::map(
+                &m.map.origin,
+                "a reference map needs a reference file (--truth FILE / truth=)",
+            )
+            .into())
+        }
+        (None, None) => None,
     };
     // the comparison starts counting ±3σ after the navigation start + check_after_s;
     // the start is known only inside fuse_records: use the later of the first fix and
@@ -261,5 +452,131 @@ pub fn fuse_files(
         fixes_outside: (clip.before, clip.after),
         forward: fwd,
         smoothed: smo,
+        inputs,
     })
+}
+
+/// A reference trajectory read through a map, as truth samples on the run's clock (the
+/// IMU map's, else the file's own). The comparison needs the velocity: a map without
+/// `v_n`/`v_e` columns is refused.
+fn read_truth_columns(
+    path: &Path,
+    m: &ReferenceColumns,
+    clock: Option<RunClock>,
+) -> Result<(Vec<crate::truth::TruthSample>, InputReport), FilesError> {
+    let bytes = crate::input::read_capped(path).map_err(|source| TruthFileError::Io {
+        file: path.into(),
+        source,
+    })?;
+    let text = crate::input::text_lossy(bytes);
+    let (rows, rep) = parse_generic_on(path, &text, m, clock.as_ref())?;
+    let mut out = Vec::with_capacity(rows.len());
+    for r in rows {
+        let Some(v) = r.v_n_mps else {
+            return Err(ColumnsError::map(
+                &m.map.origin,
+                "the comparison with the reference needs its velocity: map v_n, v_e and v_d (or v_u)",
+            )
+            .into());
+        };
+        out.push(crate::truth::TruthSample::new(
+            r.t_s,
+            Default::default(),
+            r.lat_rad,
+            r.lon_rad,
+            r.h_m,
+            v,
+            sdins_core::math::c_b_n_from_euler(&r.euler),
+        ));
+    }
+    Ok((out, rep))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    const IMU: &str =
+        "t_s=time,gyro_x_dps=gx,gyro_y_dps=gy,gyro_z_dps=gz,accel_x_g=ax,accel_y_g=ay,accel_z_g=az";
+    const GNSS: &str = "t_s=time,lat_deg=lat,lon_deg=lon,alt_msl_m=alt";
+
+    fn cli(n: &str) -> String {
+        format!("--{}", n.replace('_', "-"))
+    }
+
+    #[test]
+    fn column_options_resolve_and_name_the_caller_s_option() {
+        let o = ColumnOptions {
+            imu_columns: Some(IMU.into()),
+            gnss_columns: Some(GNSS.into()),
+            gnss_sigma: Some("1,1,2".into()),
+            undulation_m: Some(30.0),
+            gps_week: Some(2300),
+            ..Default::default()
+        };
+        let c = o.resolve(&cli).unwrap();
+        let g = c.gnss.unwrap();
+        assert_eq!(g.undulation_m, Some(30.0));
+        assert_eq!(g.gps_week, Some(2300));
+        assert!(g.sigma.is_some());
+        assert_eq!(c.imu.unwrap().gps_week, Some(2300));
+        assert!(!ColumnOptions::default().any() && o.any());
+        // σ without a GNSS map; a bad σ; a reflection: each names the option as spelled
+        let e = ColumnOptions {
+            gnss_sigma: Some("1,1,2".into()),
+            ..Default::default()
+        }
+        .resolve(&|n: &str| n.to_string())
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("gnss_sigma: ") && e.contains("gnss_columns"),
+            "{e}"
+        );
+        let e = ColumnOptions {
+            gnss_sigma: Some("1,1".into()),
+            ..o.clone()
+        }
+        .resolve(&cli)
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("--gnss-sigma: "), "{e}");
+        let e = ColumnOptions {
+            imu_columns: Some(format!("{IMU},axes=x:+y,y:+x,z:+z")),
+            ..Default::default()
+        }
+        .resolve(&cli)
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("--imu-columns: ") && e.contains("reflection"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_map_in_the_profile_and_an_option_is_refused() {
+        let dir = std::env::temp_dir().join(format!("sdins-colopt-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("p.toml");
+        std::fs::write(&p, format!("[imu]\ncolumns = \"{IMU}\"\n")).unwrap();
+        let from_profile = ColumnOptions {
+            profile: Some(p.clone()),
+            ..Default::default()
+        };
+        assert!(from_profile.resolve(&cli).unwrap().imu.is_some());
+        let e = ColumnOptions {
+            imu_columns: Some(IMU.into()),
+            ..from_profile
+        }
+        .resolve(&cli)
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("--imu-columns: the profile has a [imu] map"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }

@@ -14,7 +14,7 @@
 use super::health::{HealthMonitor, HealthVerdict, DEFAULT_MAX_SIGMA_H_M};
 use crate::cancel::CancelToken;
 use crate::fusion::files::{fuse_files, FilesError, FilesInput, FilesResult};
-use crate::fusion::files::{InitSource, SensorModelSource};
+use crate::fusion::files::{InitSource, InputColumns, SensorModelSource};
 use crate::fusion::records::{RecordEvent, RecordOptions, RecordPoint, TruthComparison};
 use crate::fusion::simulated::{
     fuse_scenario, FuseEpoch, FuseError, FuseEvent, FuseOptions, FuseSummary, InMotionInit,
@@ -79,6 +79,9 @@ pub struct FilesData {
     pub lever_arm_m: Option<[f64; 3]>,
     /// reference trajectory
     pub truth: Option<PathBuf>,
+    /// column maps of the IMU and GNSS files (docs/own-data.md; each `None`: the file's
+    /// format)
+    pub columns: InputColumns,
 }
 
 /// A fusion request.
@@ -447,6 +450,20 @@ pub fn files_input(
     }
     triple_ok("lever_arm_m", "--lever-arm-m", d.lever_arm_m)?;
     triple_ok("attitude_deg", "--attitude-deg", d.attitude_deg)?;
+    if d.columns.imu.is_some() && d.imu.1 != ImuFormat::Auto {
+        return Err(bad(
+            "imu_format",
+            "--imu-format",
+            "the IMU file is read through a column map (imu_columns / --imu-columns or a profile): give one",
+        ));
+    }
+    if d.columns.gnss.is_some() && d.gnss.1 != GnssFormat::Auto {
+        return Err(bad(
+            "gnss_format",
+            "--gnss-format",
+            "the GNSS file is read through a column map (gnss_columns / --gnss-columns or a profile): give one",
+        ));
+    }
     if !d.gnss_offset_s.is_finite() {
         return Err(bad("gnss_offset_s", "--gnss-offset-s", "must be finite"));
     }
@@ -475,6 +492,7 @@ pub fn files_input(
         init,
         truth: d.truth.clone(),
         check_after_s: 30.0,
+        columns: d.columns.clone(),
     };
     let opts = RecordOptions {
         algo,

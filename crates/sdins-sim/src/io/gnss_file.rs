@@ -59,6 +59,9 @@ pub enum GnssFormat {
     KfGins,
     /// RTKLIB `.pos`
     Rtklib,
+    /// any delimited text read through a column map (`crate::io::gnss_columns`); not a
+    /// `--gnss-format` value: a column map selects it
+    Columns,
 }
 
 impl GnssFormat {
@@ -72,6 +75,7 @@ impl GnssFormat {
             GnssFormat::NaveGo => "navego",
             GnssFormat::KfGins => "kfgins",
             GnssFormat::Rtklib => "rtklib",
+            GnssFormat::Columns => "columns",
         }
     }
 }
@@ -461,6 +465,13 @@ pub fn parse_gnss_str(
         GnssFormat::Sdins => sdins_csv::parse(file, text)?,
         GnssFormat::KfGins => kfgins::parse(file, text)?,
         GnssFormat::Rtklib | GnssFormat::Auto => rtklib::parse(file, text, opts)?,
+        GnssFormat::Columns => {
+            return Err(GnssFileError::UnknownFormat {
+                file: file.to_path_buf(),
+                line: 1,
+                why: "a column map is read by `io::gnss_columns::read_gnss_columns`".into(),
+            })
+        }
     };
     data.report.detection = detection;
     Ok(data)

@@ -5,9 +5,14 @@
 //! [`crate::io::truth_file`], converted to sdins conventions there), and any CSV with a header
 //! through a [`ColumnMap`] (NED velocity, body FRD, ZYX Euler angles).
 
+use crate::io::columns::{ColumnsError, HeaderMode, InputKind, MapOrigin, YawConvention};
+use crate::io::gnss_columns::{height, velocity};
+use crate::io::imu_columns::{delim_name, InputReport};
+use crate::io::table::Table;
+use crate::io::time::{RunClock, TimeConverter, TimeSpec};
 use crate::io::truth_file::TruthFileError;
 use crate::truth::reference::{ReferenceError, ReferenceSample};
-use sdins_core::math::{euler_from_c_b_n, Euler, Vec3};
+use sdins_core::math::{c_b_n_from_euler, euler_from_c_b_n, Euler, Mat3, Vec3};
 use std::path::{Path, PathBuf};
 
 /// Which reader a reference file needs.
@@ -20,93 +25,58 @@ pub enum ReferenceFormat {
     Generic(Box<ColumnMap>),
 }
 
-/// Angle unit of a generic column.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AngleUnit {
-    /// degrees (`*_deg` key)
-    Deg,
-    /// radians (`*_rad` key)
-    Rad,
-}
-
-/// Which header names of a generic CSV hold which quantity: the text form is
-/// `t_s=COL,lat_deg=COL,lon_deg=COL,h_m=COL,roll_deg=COL,pitch_deg=COL,yaw_deg=COL` with
-/// `_rad` instead of `_deg` for radians and, optionally, `v_n_mps=COL,v_e_mps=COL,v_d_mps=COL`
-/// (the file's own velocity, compared with the interpolant's).
+/// Which columns of a generic CSV hold which quantity: a reference map of the one
+/// column-map mechanism ([`crate::io::columns`]): `t_s=COL,lat_deg=COL,lon_deg=COL,h_m=COL,
+/// roll_deg=COL,pitch_deg=COL,yaw_deg=COL` with any unit of the vocabulary (`_rad`, `t_ms`,
+/// …), the height datum (`h_m` ellipsoidal, or `alt_msl_m` with `undulation_m=COL` or
+/// [`Self::undulation_m`]), optional velocity `v_n_mps,v_e_mps` with `v_d_mps` (NED) or
+/// `v_u_mps` (ENU), the attitude convention `yaw=ned|enu|enu-east`, the time base
+/// `time=relative|gps-sow|unix`, `delim=`, `header=`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ColumnMap {
-    /// time \[s\]
-    pub t: String,
-    /// latitude, longitude, height
-    pub pos: [(String, AngleUnit); 2],
-    /// height \[m\]
-    pub h: String,
-    /// roll, pitch, yaw
-    pub att: [(String, AngleUnit); 3],
-    /// NED velocity columns \[m/s\]
-    pub vel: Option<[String; 3]>,
+    /// the map
+    pub map: crate::io::columns::ColumnMap,
+    /// GPS week of a seconds-of-week file without week column
+    pub gps_week: Option<u32>,
+    /// constant time offset \[s\]
+    pub offset_s: f64,
+    /// constant geoid undulation \[m\] for `alt_msl_m`
+    pub undulation_m: Option<f64>,
 }
 
 impl ColumnMap {
-    /// Parse the text form (see [`ColumnMap`]).
+    /// Parse the text form (see [`ColumnMap`]); messages name `--columns`.
     pub fn parse(s: &str) -> Result<Self, ReferenceFileError> {
-        let bad = |m: String| ReferenceFileError::Columns { message: m };
-        let mut got: Vec<(String, String)> = Vec::new();
-        for item in s.split(',').map(str::trim).filter(|x| !x.is_empty()) {
-            let Some((k, v)) = item.split_once('=') else {
-                return Err(bad(format!("`{item}`: expected KEY=COLUMN")));
-            };
-            let (k, v) = (k.trim(), v.trim());
-            if v.is_empty() {
-                return Err(bad(format!("`{item}`: empty column name")));
-            }
-            if got.iter().any(|(g, _)| g == k) {
-                return Err(bad(format!("`{k}` given twice")));
-            }
-            got.push((k.to_string(), v.to_string()));
+        Ok(Self::new(crate::io::columns::ColumnMap::parse(
+            InputKind::Reference,
+            s,
+            MapOrigin::default(),
+        )?))
+    }
+    /// Default settings around a map.
+    pub fn new(map: crate::io::columns::ColumnMap) -> Self {
+        Self {
+            map,
+            gps_week: None,
+            offset_s: 0.0,
+            undulation_m: None,
         }
-        const KEYS: [&str; 13] = [
-            "t_s",
-            "lat_deg",
-            "lat_rad",
-            "lon_deg",
-            "lon_rad",
-            "h_m",
-            "roll_deg",
-            "roll_rad",
-            "pitch_deg",
-            "pitch_rad",
-            "yaw_deg",
-            "yaw_rad",
-            "v_n_mps",
-        ];
-        for (k, _) in &got {
-            if !KEYS.contains(&k.as_str()) && k != "v_e_mps" && k != "v_d_mps" {
-                return Err(bad(format!("unknown key `{k}`: expected t_s, lat_deg|lat_rad, lon_deg|lon_rad, h_m, roll_deg|roll_rad, pitch_deg|pitch_rad, yaw_deg|yaw_rad and optionally v_n_mps, v_e_mps, v_d_mps")));
-            }
+    }
+}
+
+/// `C_b^n` (FRD→NED) from a file's roll, pitch, yaw \[rad\] in its convention.
+pub fn c_b_n_from_convention(conv: YawConvention, roll: f64, pitch: f64, yaw: f64) -> Mat3 {
+    match conv {
+        YawConvention::Enu => crate::io::truth_file::c_b_n_from_psins(pitch, roll, yaw),
+        YawConvention::EnuEast => {
+            // C(FLU→ENU) = Rz(yaw) Ry(pitch) Rx(roll); ENU→NED swaps x, y and negates z,
+            // FRD→FLU negates y and z
+            let c = c_b_n_from_euler(&Euler::new(roll, pitch, yaw));
+            let q_n = Mat3::new(0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0);
+            let q_b = Mat3::from_diagonal(&Vec3::new(1.0, -1.0, -1.0));
+            q_n * c * q_b
         }
-        let one = |k: &str| got.iter().find(|(g, _)| g == k).map(|(_, v)| v.clone());
-        let need = |k: &str| one(k).ok_or_else(|| bad(format!("missing `{k}=COLUMN`")));
-        let angle = |q: &str| -> Result<(String, AngleUnit), ReferenceFileError> {
-            match (one(&format!("{q}_deg")), one(&format!("{q}_rad"))) {
-                (Some(c), None) => Ok((c, AngleUnit::Deg)),
-                (None, Some(c)) => Ok((c, AngleUnit::Rad)),
-                (Some(_), Some(_)) => Err(bad(format!("give `{q}_deg` or `{q}_rad`, not both"))),
-                (None, None) => Err(bad(format!("missing `{q}_deg=COLUMN` (or `{q}_rad`)"))),
-            }
-        };
-        let vel = match (one("v_n_mps"), one("v_e_mps"), one("v_d_mps")) {
-            (Some(n), Some(e), Some(d)) => Some([n, e, d]),
-            (None, None, None) => None,
-            _ => return Err(bad("give all of v_n_mps, v_e_mps, v_d_mps or none".into())),
-        };
-        Ok(Self {
-            t: need("t_s")?,
-            pos: [angle("lat")?, angle("lon")?],
-            h: need("h_m")?,
-            att: [angle("roll")?, angle("pitch")?, angle("yaw")?],
-            vel,
-        })
+        _ => c_b_n_from_euler(&Euler::new(roll, pitch, yaw)),
     }
 }
 
@@ -117,6 +87,9 @@ pub enum ReferenceFileError {
     /// A reader of a known format failed.
     #[error(transparent)]
     File(#[from] TruthFileError),
+    /// A column map or a file read through one.
+    #[error(transparent)]
+    Map(#[from] ColumnsError),
     /// The column map.
     #[error("--columns: {message}")]
     Columns {
@@ -149,148 +122,134 @@ pub enum ReferenceFileError {
     },
 }
 
-/// Read a generic CSV through `map`.
+/// Read a generic CSV through `map` (times on the file's own clock for relative time,
+/// else seconds after the first row's whole GPST second).
 pub fn parse_generic(
     path: &Path,
     text: &str,
     map: &ColumnMap,
 ) -> Result<Vec<ReferenceSample>, ReferenceFileError> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut rd = csv::ReaderBuilder::new()
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .flexible(true)
-        .from_reader(text.as_bytes());
-    let bad = |line: u64, field: &str, message: String| {
-        ReferenceFileError::File(TruthFileError::Invalid {
-            file: path.into(),
-            line: line as usize,
-            field: field.into(),
-            message,
-        })
-    };
-    let header = rd
-        .headers()
-        .map_err(|e| bad(1, "(header)", e.to_string()))?
-        .clone();
-    let idx = |name: &str| -> Result<usize, ReferenceFileError> {
-        header.iter().position(|h| h == name).ok_or_else(|| {
-            bad(
-                1,
-                name,
-                format!(
-                    "no such column in the header `{}`",
-                    header.iter().collect::<Vec<_>>().join(",")
-                ),
-            )
-        })
-    };
-    let unit = |u: AngleUnit| {
-        if u == AngleUnit::Deg {
-            1f64.to_radians()
-        } else {
-            1.0
-        }
-    };
-    let cols = [
-        (idx(&map.t)?, 1.0, map.t.as_str()),
-        (
-            idx(&map.pos[0].0)?,
-            unit(map.pos[0].1),
-            map.pos[0].0.as_str(),
-        ),
-        (
-            idx(&map.pos[1].0)?,
-            unit(map.pos[1].1),
-            map.pos[1].0.as_str(),
-        ),
-        (idx(&map.h)?, 1.0, map.h.as_str()),
-        (
-            idx(&map.att[0].0)?,
-            unit(map.att[0].1),
-            map.att[0].0.as_str(),
-        ),
-        (
-            idx(&map.att[1].0)?,
-            unit(map.att[1].1),
-            map.att[1].0.as_str(),
-        ),
-        (
-            idx(&map.att[2].0)?,
-            unit(map.att[2].1),
-            map.att[2].0.as_str(),
-        ),
+    Ok(parse_generic_on(path, text, map, None)?.0)
+}
+
+/// [`parse_generic`] on a run's clock (`None`: the file sets it), with the report.
+pub fn parse_generic_on(
+    path: &Path,
+    text: &str,
+    cm: &ColumnMap,
+    clock: Option<&RunClock>,
+) -> Result<(Vec<ReferenceSample>, InputReport), ReferenceFileError> {
+    let m = &cm.map;
+    let need = |q: &str, hint: &str| m.need(q, hint).cloned();
+    let tcol = need("t", "t_s, t_ms, t_us or t_ns")?;
+    let lat = need("lat", "lat_deg or lat_rad")?;
+    let lon = need("lon", "lon_deg or lon_rad")?;
+    let att = [
+        need("roll", "roll_deg or roll_rad")?,
+        need("pitch", "pitch_deg or pitch_rad")?,
+        need("yaw", "yaw_deg or yaw_rad")?,
     ];
-    let vel = match &map.vel {
-        Some(v) => Some([idx(&v[0])?, idx(&v[1])?, idx(&v[2])?]),
+    let t = Table::new(
+        path,
+        text,
+        m.delim.unwrap_or_default(),
+        m.header.unwrap_or(HeaderMode::Auto),
+    )?;
+    let (ti, lai, loi) = (t.index(&tcol)?, t.index(&lat)?, t.index(&lon)?);
+    let ai = [t.index(&att[0])?, t.index(&att[1])?, t.index(&att[2])?];
+    let wi = match m.get("week") {
+        Some(c) => Some(t.index(c)?),
         None => None,
     };
-    let mut out: Vec<ReferenceSample> = Vec::new();
-    for rec in rd.records() {
-        let rec = rec.map_err(|e| {
-            let line = e.position().map_or(0, |p| p.line());
-            bad(line, "(row)", e.to_string())
-        })?;
-        let line = rec.position().map_or(0, |p| p.line());
-        let num = |i: usize, name: &str| -> Result<f64, ReferenceFileError> {
-            let f = rec.get(i).ok_or_else(|| {
-                bad(
-                    line,
-                    name,
-                    format!("missing (the row has {} fields)", rec.len()),
-                )
-            })?;
-            let v: f64 = f
-                .parse()
-                .map_err(|_| bad(line, name, format!("`{f}` is not a number")))?;
-            if !v.is_finite() {
-                return Err(bad(line, name, format!("`{f}` is not finite")));
-            }
-            Ok(v)
+    let hgt = height(&t, m, cm.undulation_m)?;
+    let vel = velocity(&t, m)?;
+    let conv_yaw = m.yaw.unwrap_or_default();
+    let spec = TimeSpec {
+        kind: m.time.unwrap_or_default(),
+        gps_week: cm.gps_week,
+        week_column: wi.is_some(),
+        offset_s: cm.offset_s,
+    };
+    let mut conv = TimeConverter::new(&spec, clock).map_err(|e| ColumnsError::map(&m.origin, e))?;
+    let mut out: Vec<ReferenceSample> = Vec::with_capacity(t.lines.len());
+    let mut f = Vec::with_capacity(t.width);
+    for k in 0..t.lines.len() {
+        let line = t.row(k, &mut f)?;
+        let week = match wi {
+            Some(i) => Some(t.num(line, &f, i, "week")?),
+            None => None,
         };
-        let mut x = [0.0; 7];
-        for (k, &(i, scale, name)) in cols.iter().enumerate() {
-            x[k] = num(i, name)? * scale;
-        }
+        let tk = conv
+            .convert(f[ti], tcol.unit.time_exp10, week)
+            .map_err(|e| t.err(line, &tcol.key, e))?;
         if let Some(prev) = out.last() {
-            if x[0] <= prev.t_s {
-                return Err(bad(
-                    line,
-                    &map.t,
-                    format!(
-                        "{} s does not increase on the previous row's {} s",
-                        x[0], prev.t_s
-                    ),
-                ));
+            if tk <= prev.t_s {
+                return Err(t
+                    .err(
+                        line,
+                        &tcol.key,
+                        format!(
+                            "{tk} s does not increase on the previous row's {} s",
+                            prev.t_s
+                        ),
+                    )
+                    .into());
             }
         }
-        if x[1].abs() > 89.99f64.to_radians() {
-            return Err(bad(line, &map.pos[0].0, format!("latitude {:.4} deg is beyond ±89.99 deg (the NED mechanization is singular at the poles)", x[1].to_degrees())));
+        let la = t.num(line, &f, lai, &lat.key)? * lat.unit.to_si;
+        if la.abs() > 89.99f64.to_radians() {
+            return Err(t.err(line, &lat.key, format!("latitude {:.4} deg is beyond ±89.99 deg (the NED mechanization is singular at the poles)", la.to_degrees())).into());
         }
-        let v_n_mps = match vel {
-            Some([a, b, c]) => {
-                let names = map
-                    .vel
-                    .as_ref()
-                    .map_or(["", "", ""], |v| [&v[0], &v[1], &v[2]].map(|s| s.as_str()));
-                Some(Vec3::new(
-                    num(a, names[0])?,
-                    num(b, names[1])?,
-                    num(c, names[2])?,
-                ))
+        let lo = t.num(line, &f, loi, &lon.key)? * lon.unit.to_si;
+        let h = hgt.value(&t, line, &f)?;
+        let mut e = [0.0; 3];
+        for i in 0..3 {
+            e[i] = t.num(line, &f, ai[i], &att[i].key)? * att[i].unit.to_si;
+        }
+        let euler = if conv_yaw == YawConvention::Ned {
+            Euler::new(e[0], e[1], e[2])
+        } else {
+            euler_from_c_b_n(&c_b_n_from_convention(conv_yaw, e[0], e[1], e[2]))
+        };
+        let v_n_mps = match &vel {
+            Some(vc) => {
+                let mut v = [0.0; 3];
+                for (i, vi) in v.iter_mut().enumerate() {
+                    *vi = t.num(line, &f, vc.idx[i], &vc.keys[i])?;
+                }
+                if vc.up {
+                    v[2] = -v[2];
+                }
+                Some(Vec3::from(v))
             }
             None => None,
         };
         out.push(ReferenceSample {
-            t_s: x[0],
-            lat_rad: x[1],
-            lon_rad: x[2],
-            h_m: x[3],
-            euler: Euler::new(x[4], x[5], x[6]),
+            t_s: tk,
+            lat_rad: la,
+            lon_rad: lo,
+            h_m: h,
+            euler,
             v_n_mps,
         });
     }
-    Ok(out)
+    let clock = conv
+        .clock()
+        .ok_or_else(|| t.err(t.lines[0].0, &tcol.key, "no time".into()))?;
+    let report = InputReport {
+        kind: "reference",
+        map_origin: m.origin.to_string(),
+        time_base: spec.kind.name(),
+        clock,
+        offset_s: cm.offset_s,
+        gps_week: cm.gps_week,
+        rollovers: conv.rollovers,
+        delimiter: delim_name(t.delim),
+        header: t.header.is_some(),
+        rows: out.len(),
+        notes: Vec::new(),
+    };
+    Ok((out, report))
 }
 
 /// Read a reference file in `format`.
@@ -333,20 +292,55 @@ mod tests {
     #[test]
     fn column_map_parses_and_rejects() {
         let m = ColumnMap::parse(MAP).unwrap();
-        assert_eq!(m.t, "time");
-        assert_eq!(m.att[2], ("y".to_string(), AngleUnit::Deg));
-        assert!(m.vel.is_none());
+        assert_eq!(
+            m.map.get("t").unwrap().column,
+            crate::io::columns::ColumnRef::Name("time".into())
+        );
+        assert_eq!(m.map.get("yaw").unwrap().unit.suffix, "deg");
+        assert!(m.map.get("v_n").is_none());
         for (bad, what) in [
-            ("t_s=time", "missing `lat_deg"),
-            (&format!("{MAP},lat_rad=x"), "not both"),
-            (&format!("{MAP},v_n_mps=a"), "all of"),
-            (&format!("{MAP},speed=a"), "unknown key `speed`"),
-            (&format!("{MAP},t_s=b"), "twice"),
-            ("t_s", "KEY=COLUMN"),
+            (format!("{MAP},lat_rad=x"), "map the same quantity"),
+            (format!("{MAP},speed=a"), "unknown key `speed`"),
+            (format!("{MAP},t_s=b"), "twice"),
+            ("t_s".to_string(), "KEY=COLUMN"),
         ] {
-            let e = ColumnMap::parse(bad).unwrap_err().to_string();
+            let e = ColumnMap::parse(&bad).unwrap_err().to_string();
+            assert!(
+                e.starts_with("--columns: ") && e.contains(what),
+                "{bad}: {e}"
+            );
+        }
+        let p = Path::new("r.csv");
+        let ok = "time,lat,lon,alt,r,p,y\n0,45,7,10,1,2,3\n";
+        for (bad, what) in [
+            ("t_s=time".to_string(), "missing `lat_UNIT"),
+            (format!("{MAP},v_n_mps=a"), "all velocity columns"),
+        ] {
+            let e = parse_generic(p, ok, &ColumnMap::parse(&bad).unwrap())
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(what), "{bad}: {e}");
         }
+    }
+
+    #[test]
+    fn yaw_conventions_agree() {
+        // a level vehicle heading 30° east of north
+        let ned = c_b_n_from_convention(YawConvention::Ned, 0.0, 0.0, 30f64.to_radians());
+        let enu = c_b_n_from_convention(YawConvention::Enu, 0.0, 0.0, -30f64.to_radians());
+        let east = c_b_n_from_convention(YawConvention::EnuEast, 0.0, 0.0, 60f64.to_radians());
+        assert!((ned - enu).abs().max() < 1e-15);
+        assert!((ned - east).abs().max() < 1e-15);
+        // nose up 10°, right wing down 5°: KITTI's pitch is positive nose down
+        let ned = c_b_n_from_convention(YawConvention::Ned, 0.1, 0.2, 0.3);
+        let e = euler_from_c_b_n(&ned);
+        let east = c_b_n_from_convention(
+            YawConvention::EnuEast,
+            e.roll_rad,
+            -e.pitch_rad,
+            std::f64::consts::FRAC_PI_2 - e.yaw_rad,
+        );
+        assert!((ned - east).abs().max() < 1e-15);
     }
 
     #[test]
@@ -361,25 +355,28 @@ mod tests {
         for (text, needle) in [
             (
                 "time,lat,lon,alt,r,p\n0,45,7,10,1,2\n",
-                "r.csv:1: y: no such column",
+                "r.csv:1: yaw_deg: no column `y`",
             ),
             (
-                "time,lat,lon,alt,r,p,y\n0,45,7,10,1,2,3\n0,45,7,10,1,2,x\n",
-                "r.csv:3: y: `x` is not a number",
+                "time,lat,lon,alt,r,p,y\n0,45,7,10,1,2,3\n1,45,7,10,1,2,x\n",
+                "r.csv:3: yaw_deg: `x` is not a number",
             ),
             (
                 "time,lat,lon,alt,r,p,y\n0,45,7,10,1,2,3\n0,45,7,10,1,2,3\n",
-                "r.csv:3: time: 0 s does not increase",
+                "r.csv:3: t_s: 0 s does not increase",
             ),
             (
                 "time,lat,lon,alt,r,p,y\n0,45,7,10,1,2,NaN\n",
-                "r.csv:2: y: `NaN` is not finite",
+                "r.csv:2: yaw_deg: `NaN` is not finite",
             ),
             (
                 "time,lat,lon,alt,r,p,y\n0,90,7,10,1,2,3\n",
-                "r.csv:2: lat: latitude",
+                "r.csv:2: lat_deg: latitude",
             ),
-            ("time,lat,lon,alt,r,p,y\n0,45,7\n", "r.csv:2: alt: missing"),
+            (
+                "time,lat,lon,alt,r,p,y\n0,45,7\n",
+                "r.csv:2: (row): expected 7 fields, found 3",
+            ),
         ] {
             let e = parse_generic(p, text, &m).unwrap_err().to_string();
             assert!(e.contains(needle), "{e}");

@@ -8,7 +8,7 @@
 
 use crate::cancel::{CancelToken, Cancelled};
 use crate::io::imu_file::ImuData;
-use crate::io::imu_file::{read_imu_file, ImuFormat};
+use crate::io::imu_file::ImuFormat;
 use crate::io::initial::validate_initial_state;
 use crate::io::truth_file::c_b_n_from_psins;
 use crate::io::truth_file::read_truth;
@@ -231,6 +231,8 @@ pub struct NavFileRequest {
     pub earth: String,
     /// reference trajectory file
     pub truth: Option<PathBuf>,
+    /// the IMU file's column map (docs/own-data.md; `imu_format` must then be `Auto`)
+    pub imu_columns: Option<crate::io::imu_columns::ImuColumns>,
 }
 
 /// The loaded and checked inputs of a recorded run.
@@ -252,6 +254,8 @@ pub struct NavFilePlan {
     pub t0_s: f64,
     /// navigation updates the run will make
     pub updates: usize,
+    /// what the column map did (time base, clock, offsets), when one was given
+    pub imu_report: Option<crate::io::imu_columns::InputReport>,
 }
 
 /// Read and check the inputs of `sdins nav` (messages name the file, line and option).
@@ -270,7 +274,9 @@ pub fn prepare(req: &NavFileRequest) -> Result<NavFilePlan, NavInputError> {
         [] => return Err(bad("--algo: no algorithm given".into())),
         _ => return Err(bad("--algo: `nav` runs one algorithm".into())),
     };
-    let data = read_imu_file(&req.imu, req.imu_format).map_err(|e| bad(e.to_string()))?;
+    let (data, imu_report) =
+        crate::io::imu_columns::read_imu_any(&req.imu, req.imu_format, req.imu_columns.as_ref())
+            .map_err(bad)?;
     let truth = match &req.truth {
         Some(p) => Some(read_truth(p).map_err(|e| bad(e.to_string()))?),
         None => None,
@@ -306,6 +312,7 @@ pub fn prepare(req: &NavFileRequest) -> Result<NavFilePlan, NavInputError> {
         earth,
         t0_s,
         updates,
+        imu_report,
     })
 }
 
