@@ -93,7 +93,7 @@ fn generic_reference_to_truth_and_imu() {
         "back.csv",
         &(lines.join("\n") + "\n"),
         &["--columns", MAP],
-        "back.csv:6: time: 100.3 s does not increase",
+        "back.csv:6: t_s: 100.3 s does not increase",
     );
     bad(
         "short.csv",
@@ -105,7 +105,7 @@ fn generic_reference_to_truth_and_imu() {
         "cols.csv",
         &r,
         &["--columns", "t_s=time"],
-        "--columns: missing `lat_deg",
+        "--columns: missing `lat_UNIT=COLUMN` (lat_deg or lat_rad)",
     );
     bad(
         "rate.csv",
