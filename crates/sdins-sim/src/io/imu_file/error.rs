@@ -123,7 +123,7 @@ pub enum ImuFileError {
         /// this time \[s\]
         t_s: f64,
     },
-    /// A sample interval differs from the median by more than [`DT_TOLERANCE`].
+    /// A sample interval differs from the median by more than [`DT_TOLERANCE`](super::DT_TOLERANCE).
     #[error("{}:{line}: column 1 (time): sample interval {dt_s} s, expected the median {median_s} s within {tol_pct} %", file.display())]
     IrregularInterval {
         /// the file
@@ -165,7 +165,7 @@ pub enum ImuFileError {
         /// why
         why: String,
     },
-    /// The sample interval is outside [`DT_RANGE_S`].
+    /// The sample interval is outside [`DT_RANGE_S`](super::DT_RANGE_S).
     #[error("{}:{line}: column 1 (time): sample interval {dt_s:e} s, expected {min_s:e} .. {max_s} s", file.display())]
     IntervalOutOfRange {
         /// the file
