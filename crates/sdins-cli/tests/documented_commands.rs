@@ -140,6 +140,31 @@ const RULES: &[Rule] = &[
         Replace(" imu1_params.txt", " ../shared/data/csv/navego/imu1_params.txt"),
     ),
     rule("csv/navego/", NeedsData("csv/navego/imu1.csv")),
+    // the RINEX files of the IGS station ABPO
+    rule(
+        " abpo0080.15o",
+        Replace(" abpo0080.15o", " ../shared/data/psins_gnss/abpo0080.15o"),
+    ),
+    rule(
+        " abpo0080.15n",
+        Replace(" abpo0080.15n", " ../shared/data/psins_gnss/abpo0080.15n"),
+    ),
+    rule("psins_gnss/abpo", NeedsData("psins_gnss/abpo0080.15o")),
+    // fuse Monte Carlo shards to merge: two small ones
+    rule(
+        "sdins fuse --merge mc/s0 mc/s1 ",
+        Before("rm -rf mc && for i in 0 1; do sdins fuse dq-paper --grade tactical --no-gate --runs 32 --seed 1 --until-s 5 --shard $i/2 --out mc/s$i; done"),
+    ),
+    // a logger's own files, described in docs/own-data.md: tests/own_data_cli.rs writes
+    // such files and runs these maps (worked_example_matches_sdins_files)
+    rule(
+        "--imu rates.csv",
+        Skip("a logger's own files; own_data_cli runs the same maps on generated files"),
+    ),
+    rule(
+        "--imu imu.txt",
+        Skip("a logger's own files; own_data_cli runs the same maps on generated files"),
+    ),
     rule("../shared/data", NeedsData("")),
 ];
 
