@@ -163,7 +163,7 @@ fn mc_rows(m: &MonteCarloSummary) -> Vec<Vec<String>> {
 pub fn run(args: Args) -> Result<(), CliError> {
     if args.imu_format.imu_columns.is_some() || args.imu_format.profile.is_some() {
         return Err(CliError::bad(
-            "--imu-columns/--profile: calibrate does not read column maps yet (issue 27 part 2): convert the file to sdins's imu.csv",
+            "--imu-columns/--profile: calibrate does not read column maps yet: convert the file to sdins's imu.csv",
         ));
     }
     let scn = Scenario::load(&args.scenario)?;
