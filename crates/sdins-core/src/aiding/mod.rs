@@ -10,4 +10,5 @@ pub mod layout;
 pub mod linalg;
 pub mod meas;
 pub mod rts;
+pub mod sensors;
 pub mod stationarity;

@@ -13,6 +13,10 @@
 //!   arrives;
 //! * `Rest`: the vehicle is (or is no longer) at rest (the scenario's truth; later a
 //!   detector).
+//! * `Meas`: a measurement of another sensor (barometer, odometer, magnetometer, dual
+//!   antenna, body velocity), with its arrival time, handled like a fix;
+//! * `SensorTruth`: the true sensor parameters from now on (scenarios; passed to the
+//!   rows).
 //!
 //! ## The loop
 //! Every `N` IMU samples one navigation update (`Ekf::propagate`). Then, in arrival
@@ -31,6 +35,7 @@
 use crate::cancel::{CancelToken, Cancelled};
 use crate::fusion::smoother::{SmootherError, SmootherLog};
 use crate::nav::epochs::EpochGrid;
+use crate::sensors::aiding::{shifted, SensorTruth};
 use crate::sensors::gnss_fix::GnssFix;
 use crate::truth::TruthSample;
 use sdins_core::aiding::ekf::{
@@ -39,6 +44,7 @@ use sdins_core::aiding::ekf::{
 use sdins_core::aiding::layout::{Cov, StateLayout, XVec};
 use sdins_core::aiding::linalg::MAX_ROWS;
 use sdins_core::aiding::meas::{GnssMeasurement, MeasKind};
+use sdins_core::aiding::sensors::AidingMeas;
 use sdins_core::coning::Increment;
 use sdins_core::earth::EarthModel;
 use sdins_core::math::Vec3;
@@ -67,6 +73,16 @@ pub enum Event {
     },
     /// at rest from now on (`true`) or moving
     Rest(bool),
+    /// a measurement of any other kind (its time of validity on the source clock)
+    /// arriving at `arrival_s`
+    Meas {
+        /// the measurement
+        meas: AidingMeas,
+        /// arrival time \[s\]
+        arrival_s: f64,
+    },
+    /// the true sensor parameters from now on (scenarios)
+    SensorTruth(SensorTruth),
 }
 
 /// Where and how the filter starts.
@@ -84,6 +100,8 @@ pub struct Start {
     pub est0: XVec,
     /// the truth at the start (scenarios)
     pub truth: Option<TruthSample>,
+    /// the true sensor parameters at the start (scenarios with aiding sensors)
+    pub sensor_truth: Option<SensorTruth>,
 }
 
 /// The loop's settings.
@@ -141,6 +159,8 @@ pub struct Row<'a> {
     pub layout: &'a StateLayout,
     /// the truth at the row (scenarios)
     pub truth: Option<&'a TruthSample>,
+    /// the true sensor parameters at the row (scenarios with aiding sensors)
+    pub sensor_truth: Option<&'a SensorTruth>,
 }
 
 /// What the loop reports.
@@ -225,6 +245,7 @@ struct Track {
     /// per row: the forward state
     rows: Vec<NavState>,
     truth: Vec<TruthSample>,
+    sensor_truth: Vec<SensorTruth>,
     /// update interval \[s\]
     dt_update_s: f64,
 }
@@ -300,6 +321,7 @@ pub fn run_engine(
             epoch_state: Vec::with_capacity(epochs),
             rows: Vec::with_capacity(rows.min(cfg.total_updates as usize + 1)),
             truth: Vec::new(),
+            sensor_truth: Vec::new(),
             dt_update_s: cfg.dt_s * n as f64,
         }
     });
@@ -309,11 +331,13 @@ pub fn run_engine(
         t.epoch(&ekf.initial_epoch(), ekf.estimates(), &cov_state)?;
     }
     let mut truth = start.truth;
+    let mut sensor_truth = start.sensor_truth;
     let emit_row = |ekf: &Ekf<AnyMechanization>,
                     j: u64,
                     cov_state: &NavState,
                     epoch: usize,
                     truth: Option<&TruthSample>,
+                    sensor_truth: Option<&SensorTruth>,
                     track: &mut Option<Track>,
                     observe: &mut dyn FnMut(EngineEvent<'_>)| {
         let st = ekf.state();
@@ -327,6 +351,7 @@ pub fn run_engine(
             epoch,
             layout: ekf.layout(),
             truth,
+            sensor_truth,
         };
         observe(EngineEvent::Forward(&row));
         if let Some(t) = track.as_mut() {
@@ -334,15 +359,27 @@ pub fn run_engine(
             if let Some(tr) = truth {
                 t.truth.push(*tr);
             }
+            if let Some(s) = sensor_truth {
+                t.sensor_truth.push(*s);
+            }
         }
     };
     let mut last_row = None;
     if cursor.is_output(0) {
-        emit_row(&ekf, 0, &cov_state, 0, truth.as_ref(), &mut track, observe);
+        emit_row(
+            &ekf,
+            0,
+            &cov_state,
+            0,
+            truth.as_ref(),
+            sensor_truth.as_ref(),
+            &mut track,
+            observe,
+        );
         last_row = Some(0);
     }
     let mut counts = [KindCounts::default(); MeasKind::COUNT];
-    let mut pending: VecDeque<(f64, GnssFix)> = VecDeque::new();
+    let mut pending: VecDeque<(f64, Pending)> = VecDeque::new();
     let mut held: Option<Event> = None;
     let mut at_rest = false;
     let mut incs = [Increment::default(); 4];
@@ -377,8 +414,12 @@ pub fn run_engine(
                         truth = tr;
                     }
                 }
-                Event::Gnss { fix, arrival_s } => pending.push_back((arrival_s, fix)),
+                Event::Gnss { fix, arrival_s } => pending.push_back((arrival_s, Pending::Fix(fix))),
+                Event::Meas { meas, arrival_s } => {
+                    pending.push_back((arrival_s, Pending::Meas(meas)))
+                }
                 Event::Rest(r) => at_rest = r,
+                Event::SensorTruth(s) => sensor_truth = Some(s),
             }
         }
         ekf.propagate(&incs[..n])?;
@@ -387,17 +428,20 @@ pub fn run_engine(
         let mut i = 0;
         while i < pending.len() {
             if pending[i].0 - t0 <= t_nav + 1e-9 {
-                let Some((_, f)) = pending.remove(i) else {
+                let Some((_, p)) = pending.remove(i) else {
                     break;
                 };
-                let m = GnssMeasurement {
-                    t_s: f.t_s - t0,
-                    lat_rad: f.lat_rad,
-                    lon_rad: f.lon_rad,
-                    h_m: f.h_m,
-                    pos_cov_ned_m2: f.pos_cov_ned_m2,
-                    vel: f.vel,
-                    lever_arm_b_m: cfg.lever_arm_b_m,
+                let m = match p {
+                    Pending::Fix(f) => AidingMeas::Gnss(GnssMeasurement {
+                        t_s: f.t_s - t0,
+                        lat_rad: f.lat_rad,
+                        lon_rad: f.lon_rad,
+                        h_m: f.h_m,
+                        pos_cov_ned_m2: f.pos_cov_ned_m2,
+                        vel: f.vel,
+                        lever_arm_b_m: cfg.lever_arm_b_m,
+                    }),
+                    Pending::Meas(m) => shifted(m, t0),
                 };
                 let rep = ekf.update(&m)?;
                 report(&rep, &mut counts, t0, observe);
@@ -431,6 +475,7 @@ pub fn run_engine(
                 &cov_state,
                 epoch,
                 truth.as_ref(),
+                sensor_truth.as_ref(),
                 &mut track,
                 observe,
             );
@@ -444,6 +489,7 @@ pub fn run_engine(
             &cov_state,
             epoch,
             truth.as_ref(),
+            sensor_truth.as_ref(),
             &mut track,
             observe,
         );
@@ -464,6 +510,14 @@ pub fn run_engine(
         t_start_s: t0,
         smoother_bytes,
     })
+}
+
+/// A measurement waiting for its arrival time.
+#[derive(Clone, Copy, Debug)]
+#[allow(clippy::large_enum_variant)]
+enum Pending {
+    Fix(GnssFix),
+    Meas(AidingMeas),
 }
 
 /// Count a report and pass it on with its times on the source clock.
@@ -535,6 +589,7 @@ fn smooth_rows(
             epoch: e,
             layout,
             truth: t.truth.get(i),
+            sensor_truth: t.sensor_truth.get(i),
         };
         observe(EngineEvent::Smoothed(&row));
     }

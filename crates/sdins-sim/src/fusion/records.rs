@@ -459,6 +459,7 @@ pub fn fuse_records(
         p0: p0n,
         est0,
         truth: None,
+        sensor_truth: None,
     };
     // σ of the forward rows change only at covariance epochs (cached by epoch), of the
     // smoothed rows they come from the backward pass

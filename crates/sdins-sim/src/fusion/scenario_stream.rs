@@ -15,6 +15,7 @@ use crate::fusion::simulated::{
     IN_MOTION_MAX_SIGMA_RAD,
 };
 use crate::scenario::Scenario;
+use crate::sensors::aiding::{add_blocks, AidingSimulator};
 use crate::sensors::gnss::{GnssConfig, GnssSimulator};
 use crate::sensors::gnss_fix::GnssFix;
 use crate::sensors::imu_error::{ImuErrorState, DEG};
@@ -24,6 +25,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
 use sdins_core::aiding::layout::{BlockKind, Cov, XVec};
+use sdins_core::aiding::meas::Measurement;
+use sdins_core::aiding::sensors::AidingMeas;
 use sdins_core::coning::Increment;
 use sdins_core::math::{Mat3, Quat, Vec3};
 use sdins_core::nav::InitialState;
@@ -35,6 +38,8 @@ pub struct ScenarioStream<'a> {
     traj: &'a Trajectory,
     sensor: ImuErrorState,
     gsim: GnssSimulator,
+    aiding: Option<AidingSimulator>,
+    aid_out: Vec<AidingMeas>,
     prev: TruthSample,
     dt_s: f64,
     queue: VecDeque<Event>,
@@ -53,6 +58,10 @@ impl Iterator for ScenarioStream<'_> {
         let ts = self.truth.next()?;
         let inc = self.sensor.apply(&ts.inc, self.dt_s);
         self.gsim.step(self.traj, &self.prev, &ts, &mut self.fixes);
+        if let Some(a) = self.aiding.as_mut() {
+            a.step(self.traj, &self.prev, &ts, &mut self.aid_out);
+            self.queue.push_back(Event::SensorTruth(a.truth()));
+        }
         self.prev = ts;
         if let Some(thr) = self.zupt_speed_mps {
             let rest = ts.v_n_mps.norm() < thr;
@@ -69,6 +78,10 @@ impl Iterator for ScenarioStream<'_> {
                 },
                 arrival_s: f.t_s,
             });
+        }
+        for m in self.aid_out.drain(..) {
+            let arrival_s = m.t_valid_s();
+            self.queue.push_back(Event::Meas { meas: m, arrival_s });
         }
         Some(Event::Imu {
             t_s: ts.t_s,
@@ -173,6 +186,9 @@ pub fn scenario_start<'a>(
     run: u64,
 ) -> Result<ScenarioSetup<'a>, FuseError> {
     check_options(opts)?;
+    scn.aiding
+        .validate()
+        .map_err(|e| FuseError::Option("aiding", e.to_string()))?;
     let gnss = effective_gnss(scn, gnss)?;
     let earth = scn.nav.earth.model();
     let dt = scn.imu.dt_s();
@@ -203,6 +219,11 @@ pub fn scenario_start<'a>(
         traj: &scn.trajectory,
         sensor,
         gsim: GnssSimulator::new(&gnss, earth, run)?,
+        aiding: scn
+            .aiding
+            .any()
+            .then(|| AidingSimulator::new(&scn.aiding, earth, run)),
+        aid_out: Vec::with_capacity(8),
         prev,
         dt_s: dt,
         queue: VecDeque::new(),
@@ -315,6 +336,8 @@ pub fn scenario_start<'a>(
         p0[(9 + i, 9 + i)] = s_ba[i].powi(2);
         p0[(12 + i, 12 + i)] = s_bg[i].powi(2);
     }
+    layout = add_blocks(&scn.aiding, layout, &mut p0)
+        .map_err(|e| FuseError::Option("aiding", e.to_string()))?;
     if let (Some((f, ts, meas)), Some(im)) = (moving, opts.in_motion) {
         init = in_motion_start(&f, &ts, &meas, dt, &gnss, &earth, &im, &mut p0);
     }
@@ -347,6 +370,7 @@ pub fn scenario_start<'a>(
     cfg.zupt_sigma_mps = opts.zupt.map(|z| z.0);
     cfg.nhc_sigma_mps = opts.nhc_sigma_mps;
     cfg.smooth = opts.smooth;
+    let sensor_truth = stream.aiding.as_ref().map(AidingSimulator::truth);
     Ok(ScenarioSetup {
         stream,
         start: Start {
@@ -356,6 +380,7 @@ pub fn scenario_start<'a>(
             p0,
             est0,
             truth: Some(start_truth),
+            sensor_truth,
         },
         cfg,
         truths: Truths {

@@ -461,6 +461,9 @@ fn epoch_of(
             }
         }
     }
+    if let Some(t) = row.sensor_truth {
+        crate::sensors::aiding::truth_errors(row.layout, t, est, &mut err);
+    }
     let r = earth.radii(truth.lat_rad);
     FuseEpoch {
         t_s: row.t_s,

@@ -53,6 +53,12 @@ pub(super) struct FileDoc {
     pub(super) mounting: Option<S<MountingDoc>>,
     // [gnss] section
     pub(super) gnss: Option<S<crate::sensors::gnss::GnssConfig>>,
+    // aiding-sensor tables
+    pub(super) baro: Option<S<crate::sensors::aiding::BaroConfig>>,
+    pub(super) odometer: Option<S<crate::sensors::aiding::OdometerConfig>>,
+    pub(super) magnetometer: Option<S<crate::sensors::aiding::MagnetometerConfig>>,
+    pub(super) dual_antenna: Option<S<crate::sensors::aiding::DualAntennaConfig>>,
+    pub(super) body_velocity: Option<S<crate::sensors::aiding::BodyVelocityConfig>>,
     pub(super) calibration: Option<S<CalibrationDoc>>,
     pub(super) body_motion: Option<S<BodyMotionDoc>>,
     #[serde(default)]

@@ -172,6 +172,7 @@ pub fn scenario_from_reference(
         nav,
         trajectory,
         gnss: None,
+        aiding: Default::default(),
         source_toml: format!(
             "# sdins truth --from-reference {} --rate-hz {}\n",
             path.display(),

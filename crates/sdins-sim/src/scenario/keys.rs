@@ -18,6 +18,11 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "angle_of_attack_deg",
             "mounting",
             "gnss",
+            "baro",
+            "odometer",
+            "magnetometer",
+            "dual_antenna",
+            "body_velocity",
             "calibration",
             "body_motion",
             "command",
@@ -103,6 +108,66 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
         ],
     ),
     GNSS_KEYS,
+    (
+        "baro",
+        &[
+            "rate_hz",
+            "sigma_m",
+            "bias_sigma_m",
+            "bias_tau_s",
+            "outages_s",
+            "seed",
+        ],
+    ),
+    (
+        "odometer",
+        &[
+            "rate_hz",
+            "sigma_mps",
+            "resolution_mps",
+            "scale_sigma",
+            "lever_arm_b_m",
+            "mount_deg",
+            "nhc_sigma_mps",
+            "outages_s",
+            "seed",
+        ],
+    ),
+    (
+        "magnetometer",
+        &[
+            "rate_hz",
+            "sigma_ut",
+            "declination_deg",
+            "inclination_deg",
+            "intensity_ut",
+            "hard_iron_sigma_ut",
+            "outages_s",
+            "seed",
+        ],
+    ),
+    (
+        "dual_antenna",
+        &[
+            "rate_hz",
+            "baseline_b_m",
+            "sigma_rel_m",
+            "heading_only",
+            "outages_s",
+            "seed",
+        ],
+    ),
+    (
+        "body_velocity",
+        &[
+            "rate_hz",
+            "sigma_mps",
+            "lever_arm_b_m",
+            "mount_deg",
+            "outages_s",
+            "seed",
+        ],
+    ),
 ];
 
 // ---- [body_motion] and [[command]] (gnss-ins-sim motion commands) ----

@@ -187,6 +187,9 @@ pub struct Scenario {
     pub trajectory: Trajectory,
     /// GNSS receiver simulation (`[gnss]`), if the scenario has one
     pub gnss: Option<crate::sensors::gnss::GnssConfig>,
+    /// aiding sensors (`[baro]`, `[odometer]`, `[magnetometer]`, `[dual_antenna]`,
+    /// `[body_velocity]`)
+    pub aiding: crate::sensors::aiding::AidingConfig,
     /// the scenario text exactly as it was read (provenance: `run.toml` records this, not
     /// the file as it may be later)
     pub source_toml: String,

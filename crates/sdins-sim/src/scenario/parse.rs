@@ -792,6 +792,8 @@ impl Scenario {
                 Some(cfg)
             }
         };
+        // aiding-sensor tables
+        let aiding = parse_aiding(&cx, &doc)?;
         Ok(Scenario {
             name: doc.name.unwrap_or_else(|| {
                 Path::new(file)
@@ -804,10 +806,39 @@ impl Scenario {
             nav,
             trajectory,
             gnss,
+            aiding,
             source_toml: text.to_string(),
             mounting,
             vibration: vib_reports,
             route: route_report,
         })
     }
+}
+
+/// The aiding-sensor tables, each validated with its located error.
+fn parse_aiding(
+    cx: &Ctx<'_>,
+    doc: &FileDoc,
+) -> Result<crate::sensors::aiding::AidingConfig, ScenarioError> {
+    use crate::sensors::aiding::{AidingConfig, AidingConfigError};
+    fn take<T: Clone>(
+        cx: &Ctx<'_>,
+        v: &Option<S<T>>,
+        check: impl Fn(&T) -> Result<(), AidingConfigError>,
+    ) -> Result<Option<T>, ScenarioError> {
+        let Some(v) = v else { return Ok(None) };
+        match check(v.get_ref()) {
+            Ok(()) => Ok(Some(v.get_ref().clone())),
+            Err(AidingConfigError::Invalid { table, key, what }) => {
+                cx.err(v.span(), &format!("{table}.{key}"), what)
+            }
+        }
+    }
+    Ok(AidingConfig {
+        baro: take(cx, &doc.baro, |c| c.validate())?,
+        odometer: take(cx, &doc.odometer, |c| c.validate())?,
+        magnetometer: take(cx, &doc.magnetometer, |c| c.validate())?,
+        dual_antenna: take(cx, &doc.dual_antenna, |c| c.validate())?,
+        body_velocity: take(cx, &doc.body_velocity, |c| c.validate())?,
+    })
 }

@@ -2,6 +2,7 @@
 //! simulator ([`gnss`]) and the GNSS fix it produces ([`gnss_fix`], the datum the readers
 //! and the filter share).
 
+pub mod aiding;
 pub mod gnss;
 pub mod gnss_fix;
 pub mod imu_error;
