@@ -34,19 +34,43 @@ pub enum MeasKind {
     Zupt,
     /// non-holonomic constraint (body y, z velocity)
     Nhc,
+    /// barometric altitude
+    Baro,
+    /// odometer
+    Odometer,
+    /// magnetometer
+    Magnetometer,
+    /// dual antenna
+    DualAntenna,
+    /// body velocity
+    BodyVelocity,
 }
 
 impl MeasKind {
     /// Number of kinds.
-    pub const COUNT: usize = 3;
+    pub const COUNT: usize = 8;
     /// Every kind, in [`MeasKind::index`] order.
-    pub const ALL: [MeasKind; MeasKind::COUNT] = [MeasKind::Gnss, MeasKind::Zupt, MeasKind::Nhc];
+    pub const ALL: [MeasKind; MeasKind::COUNT] = [
+        MeasKind::Gnss,
+        MeasKind::Zupt,
+        MeasKind::Nhc,
+        MeasKind::Baro,
+        MeasKind::Odometer,
+        MeasKind::Magnetometer,
+        MeasKind::DualAntenna,
+        MeasKind::BodyVelocity,
+    ];
     /// Index `0 … COUNT−1`.
     pub fn index(self) -> usize {
         match self {
             MeasKind::Gnss => 0,
             MeasKind::Zupt => 1,
             MeasKind::Nhc => 2,
+            MeasKind::Baro => 3,
+            MeasKind::Odometer => 4,
+            MeasKind::Magnetometer => 5,
+            MeasKind::DualAntenna => 6,
+            MeasKind::BodyVelocity => 7,
         }
     }
     /// Name (CSV `kind` column).
@@ -55,6 +79,11 @@ impl MeasKind {
             MeasKind::Gnss => "gnss",
             MeasKind::Zupt => "zupt",
             MeasKind::Nhc => "nhc",
+            MeasKind::Baro => "baro",
+            MeasKind::Odometer => "odometer",
+            MeasKind::Magnetometer => "magnetometer",
+            MeasKind::DualAntenna => "dual_antenna",
+            MeasKind::BodyVelocity => "body_velocity",
         }
     }
 }

@@ -31,6 +31,7 @@ impl AidingMeas {
             AidingMeas::Gnss(m) => m,
             AidingMeas::Zupt(m) => m,
             AidingMeas::Nhc(m) => m,
+            AidingMeas::Baro(m) => m,
             _ => &Zupt {
                 t_s: f64::NAN,
                 sigma_mps: 1.0,
@@ -133,4 +134,19 @@ pub struct DualAntenna {
     pub baseline_b_m: Vec3,
     pub sigma_rel_m: f64,
     pub heading_only: bool,
+}
+
+impl Measurement for Baro {
+    fn kind(&self) -> MeasKind { MeasKind::Baro }
+    fn t_valid_s(&self) -> f64 { self.t_s }
+    fn gated(&self) -> bool { true }
+    fn evaluate(&self, at: &MeasPoint<'_>, out: &mut MeasModel) -> Result<(), MeasError> {
+        let o = at.layout.offset(super::layout::BlockKind::BaroBias).ok_or(MeasError::MissingBlock(super::layout::BlockKind::BaroBias))?;
+        *out = MeasModel::zeros(1);
+        out.nu[0] = at.h_m + at.est[o] - self.h_baro_m;
+        out.h[(0, 2)] = 1.0;
+        out.h[(0, o)] = -1.0;
+        out.r[(0, 0)] = self.sigma_m * self.sigma_m;
+        Ok(())
+    }
 }

@@ -31,12 +31,13 @@ use crate::fusion::simulated::{
     fuse_scenario_with, scenario_truth, FuseEpoch, FuseEvent, FuseOptions,
 };
 use crate::scenario::Scenario;
+use crate::sensors::aiding::{add_blocks, AidingConfig};
 use crate::sensors::gnss::GnssConfig;
 use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
-use sdins_core::aiding::layout::{BlockKind, StateLayout};
+use sdins_core::aiding::layout::{BlockKind, Cov, StateLayout};
 use sdins_core::aiding::meas::MeasKind;
 use serde::{Deserialize, Serialize};
 
@@ -47,7 +48,7 @@ pub const FORMAT: &str = "sdins-fuse-montecarlo-state-1";
 pub const MAX_RUNS: u64 = 10_000_000;
 
 /// The blocks whose truth a scenario run knows.
-const KNOWN: [BlockKind; 7] = [
+const KNOWN: [BlockKind; 10] = [
     BlockKind::Position,
     BlockKind::Velocity,
     BlockKind::Attitude,
@@ -55,6 +56,9 @@ const KNOWN: [BlockKind; 7] = [
     BlockKind::GyroBias,
     BlockKind::AccelScale,
     BlockKind::GyroScale,
+    BlockKind::BaroBias,
+    BlockKind::OdometerScale,
+    BlockKind::MagHardIron,
 ];
 
 /// Options of a fusion Monte Carlo.
@@ -165,8 +169,12 @@ pub struct FuseMcStats {
     pub columns: Vec<ColumnStats>,
 }
 
-/// The columns and their dof for a layout and the GNSS settings.
-pub fn columns(layout: &StateLayout, gnss: &GnssConfig) -> (Vec<String>, Vec<u32>) {
+/// The columns and their dof for a layout, the GNSS and the aiding-sensor settings.
+pub fn columns(
+    layout: &StateLayout,
+    gnss: &GnssConfig,
+    aiding: &AidingConfig,
+) -> (Vec<String>, Vec<u32>) {
     let (mut c, mut d) = (Vec::new(), Vec::new());
     for b in layout.blocks() {
         if KNOWN.contains(&b.kind) {
@@ -181,6 +189,17 @@ pub fn columns(layout: &StateLayout, gnss: &GnssConfig) -> (Vec<String>, Vec<u32
             MeasKind::Gnss => 3,
             MeasKind::Zupt => 3,
             MeasKind::Nhc => 2,
+            MeasKind::Baro => 1,
+            MeasKind::Odometer => match &aiding.odometer {
+                Some(o) if o.nhc_sigma_mps > 0.0 => 3,
+                _ => 1,
+            },
+            MeasKind::Magnetometer => 3,
+            MeasKind::DualAntenna => match &aiding.dual_antenna {
+                Some(d) if d.heading_only => 1,
+                _ => 2,
+            },
+            MeasKind::BodyVelocity => 3,
             _ => 0,
         });
     }
@@ -215,6 +234,7 @@ fn setup(
     scn.imu.seed = mc.seed;
     let mut gnss = scn.gnss.clone().unwrap_or_default();
     gnss.seed = mc.seed;
+    scn.aiding.set_seed(mc.seed);
     let mut layout = crate::fusion::simulated::noise_from_model(&scn.imu.model)
         .0
         .layout();
@@ -223,7 +243,9 @@ fn setup(
             .with_scale_factors()
             .map_err(|e| FuseMcError::Config(e.to_string()))?;
     }
-    let (columns, dof) = columns(&layout, &gnss);
+    let layout = add_blocks(&scn.aiding, layout, &mut Cov::zeros())
+        .map_err(|e| FuseMcError::Config(e.to_string()))?;
+    let (columns, dof) = columns(&layout, &gnss, &scn.aiding);
     let job = FuseMcJob {
         scenario: scn.name.clone(),
         fingerprint: fnv1a_hex(&format!("{scn:?}|{gnss:?}|{opts:?}")),

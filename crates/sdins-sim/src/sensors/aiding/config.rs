@@ -399,6 +399,25 @@ impl AidingConfig {
             || self.dual_antenna.is_some()
             || self.body_velocity.is_some()
     }
+    /// Give every configured sensor the seed `seed` (a Monte Carlo's; the sensors' streams
+    /// stay distinct by channel).
+    pub fn set_seed(&mut self, seed: u64) {
+        if let Some(c) = self.baro.as_mut() {
+            c.seed = seed;
+        }
+        if let Some(c) = self.odometer.as_mut() {
+            c.seed = seed;
+        }
+        if let Some(c) = self.magnetometer.as_mut() {
+            c.seed = seed;
+        }
+        if let Some(c) = self.dual_antenna.as_mut() {
+            c.seed = seed;
+        }
+        if let Some(c) = self.body_velocity.as_mut() {
+            c.seed = seed;
+        }
+    }
     /// Check every configured sensor.
     pub fn validate(&self) -> Result<(), AidingConfigError> {
         if let Some(c) = &self.baro {

@@ -17,7 +17,9 @@
 //! * Random numbers: per sensor one ChaCha20 stream per (seed, run, channel), stream
 //!   numbers `2⁶³ + 2⁶² + 16·run + channel`: disjoint from the IMU (`6·run + channel`)
 //!   and GNSS (`2⁶³ + 16·run + channel`) streams; every epoch draws the same count
-//!   whatever happens to it (outages too).
+//!   whatever happens to it (outages too). Channels: sensor i's noise i (barometer 0,
+//!   odometer 1, magnetometer 2, dual antenna 3, body velocity 4); the run's parameters
+//!   8 + i (barometer bias path 8, odometer scale factor 9, hard iron 10).
 
 use super::config::AidingConfig;
 use crate::sensors::gnss::exact_antenna;
@@ -130,9 +132,10 @@ impl AidingSimulator {
             cfg.dual_antenna.as_ref().map_or(1.0, |c| c.rate_hz),
             cfg.body_velocity.as_ref().map_or(1.0, |c| c.rate_hz),
         ];
-        let mut rngs: [ChaCha20Rng; 5] = core::array::from_fn(|i| rng(seeds[i], run, i as u64));
+        let rngs: [ChaCha20Rng; 5] = core::array::from_fn(|i| rng(seeds[i], run, i as u64));
+        // the run's parameters: channel 8 + i of sensor i's seed (distinct even when the
+        // seeds are equal)
         let mut bias_rng = rng(seeds[0], run, 8);
-        // the run's parameters: channel 9 of each sensor's seed
         let mut truth = SensorTruth::default();
         if let Some(c) = &cfg.baro {
             truth.baro_bias_m = c.bias_sigma_m * normal(&mut bias_rng);
@@ -142,7 +145,7 @@ impl AidingSimulator {
             truth.odometer_scale = c.scale_sigma * normal(&mut r);
         }
         if let Some(c) = &cfg.magnetometer {
-            let mut r = rng(c.seed, run, 9);
+            let mut r = rng(c.seed, run, 10);
             truth.hard_iron_ut = Vec3::from_fn(|_, _| c.hard_iron_sigma_ut * normal(&mut r));
         }
         let mag_n_ut = cfg.magnetometer.as_ref().map_or(Vec3::zeros(), |c| {
@@ -152,7 +155,6 @@ impl AidingSimulator {
                 c.intensity_ut,
             )
         });
-        let _ = &mut rngs;
         Self {
             cfg: cfg.clone(),
             earth,
