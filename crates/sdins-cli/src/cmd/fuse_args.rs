@@ -90,9 +90,21 @@ pub struct Args {
     /// start at the truth (no drawn initial errors)
     #[arg(long)]
     pub exact_start: bool,
-    /// ZUPT σ [m/s] when the truth is at rest (off if absent)
+    /// ZUPT σ [m/s]: on scenarios when the truth is at rest, with --zupt-detector (also on
+    /// recorded data) when the IMU's stationarity detector declares rest (off if absent)
     #[arg(long)]
     pub zupt_sigma_mps: Option<f64>,
+    /// trigger the ZUPT by the IMU's stationarity detector (docs/theory/aiding-sensors.md
+    /// "Stationarity detection") instead of the truth; needs --zupt-sigma-mps
+    #[arg(long)]
+    pub zupt_detector: bool,
+    /// the detector's window [s] (the nearest of 10, 20, 50, 100, 200, 400 samples)
+    #[arg(long, default_value_t = 0.5)]
+    pub zupt_window_s: f64,
+    /// the detector's false-alarm rate: probability that a window at rest is declared
+    /// moving
+    #[arg(long, default_value_t = 1e-3)]
+    pub zupt_false_alarm: f64,
     /// non-holonomic constraint σ [m/s] (off if absent)
     #[arg(long)]
     pub nhc_sigma_mps: Option<f64>,
@@ -187,10 +199,14 @@ pub fn run_err(e: FuseRunError) -> CliError {
 pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
     let data = match (&a.imu, &a.scenario) {
         (Some(imu), _) => {
+            if a.zupt_sigma_mps.is_some() && !a.zupt_detector {
+                return Err(CliError::bad(
+                    "--zupt-sigma-mps on recorded data needs --zupt-detector (the rest decision comes from the IMU's stationarity detector; there is no truth)",
+                ));
+            }
             for (flag, given) in [
                 ("--in-motion", a.in_motion),
                 ("--exact-start", a.exact_start),
-                ("--zupt-sigma-mps", a.zupt_sigma_mps.is_some()),
                 ("--runs", a.runs.is_some()),
                 ("--until-s", a.until_s.is_some()),
             ] {
@@ -242,7 +258,7 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
                 run: a.run,
                 exact_start: a.exact_start,
                 in_motion: a.in_motion,
-                zupt_sigma_mps: a.zupt_sigma_mps,
+                zupt_sigma_mps: a.zupt_sigma_mps.filter(|_| !a.zupt_detector),
             })
         }
         (None, None) => {
@@ -256,6 +272,18 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
     req.cov_rate_hz = a.cov_rate_hz;
     req.gate = !a.no_gate;
     req.nhc_sigma_mps = a.nhc_sigma_mps;
+    if a.zupt_detector {
+        let sigma = a.zupt_sigma_mps.ok_or_else(|| {
+            CliError::bad("--zupt-detector needs --zupt-sigma-mps S (the ZUPT's σ)")
+        })?;
+        req.zupt_detector = Some((
+            sigma,
+            sdins_sim::fusion::detector::DetectorSettings {
+                window_s: a.zupt_window_s,
+                false_alarm: a.zupt_false_alarm,
+            },
+        ));
+    }
     req.smooth = a.smooth;
     req.scale_factors = a
         .scale_factors_ppm

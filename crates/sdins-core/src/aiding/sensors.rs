@@ -137,11 +137,20 @@ pub struct DualAntenna {
 }
 
 impl Measurement for Baro {
-    fn kind(&self) -> MeasKind { MeasKind::Baro }
-    fn t_valid_s(&self) -> f64 { self.t_s }
-    fn gated(&self) -> bool { true }
+    fn kind(&self) -> MeasKind {
+        MeasKind::Baro
+    }
+    fn t_valid_s(&self) -> f64 {
+        self.t_s
+    }
+    fn gated(&self) -> bool {
+        true
+    }
     fn evaluate(&self, at: &MeasPoint<'_>, out: &mut MeasModel) -> Result<(), MeasError> {
-        let o = at.layout.offset(super::layout::BlockKind::BaroBias).ok_or(MeasError::MissingBlock(super::layout::BlockKind::BaroBias))?;
+        let o = at
+            .layout
+            .offset(super::layout::BlockKind::BaroBias)
+            .ok_or(MeasError::MissingBlock(super::layout::BlockKind::BaroBias))?;
         *out = MeasModel::zeros(1);
         out.nu[0] = at.h_m + at.est[o] - self.h_baro_m;
         out.h[(0, 2)] = 1.0;

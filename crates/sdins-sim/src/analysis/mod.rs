@@ -5,6 +5,7 @@
 
 pub mod allan;
 pub mod consistency;
+pub mod detection;
 pub mod error_analysis;
 pub mod errors_run;
 pub mod fuse_mc;

@@ -11,8 +11,10 @@
 //! * `Gnss`: a fix (its `t_s` the time of validity) and its arrival time; a source may
 //!   deliver a measurement before it arrives, never after the IMU sample during which it
 //!   arrives;
-//! * `Rest`: the vehicle is (or is no longer) at rest (the scenario's truth; later a
-//!   detector).
+//! * `Rest`: the vehicle is (or is no longer) at rest (the scenario's truth, or a flag
+//!   column); ignored when the loop's own stationarity detector decides
+//!   ([`EngineConfig::zupt_detector`]: every raw sample goes through it, with the filter's
+//!   bias estimates and attitude refreshed at each covariance epoch);
 //! * `Meas`: a measurement of another sensor (barometer, odometer, magnetometer, dual
 //!   antenna, body velocity), with its arrival time, handled like a fix;
 //! * `SensorTruth`: the true sensor parameters from now on (scenarios; passed to the
@@ -33,6 +35,7 @@
 //! reported.
 
 use crate::cancel::{CancelToken, Cancelled};
+use crate::fusion::detector::{AnyDetector, DetectorError, DetectorSettings};
 use crate::fusion::smoother::{SmootherError, SmootherLog};
 use crate::nav::epochs::EpochGrid;
 use crate::sensors::aiding::{shifted, SensorTruth};
@@ -129,6 +132,9 @@ pub struct EngineConfig {
     pub zupt_sigma_mps: Option<f64>,
     /// NHC σ \[m/s\] (applied at the regular covariance epochs while moving)
     pub nhc_sigma_mps: Option<f64>,
+    /// decide rest with the IMU's stationarity detector ([`crate::fusion::detector`])
+    /// instead of the stream's `Rest` events (which are then ignored)
+    pub zupt_detector: Option<DetectorSettings>,
     /// run the smoother
     pub smooth: bool,
     /// output rows: the updates nearest to `t_start + k·every_s` \[s\]
@@ -234,6 +240,9 @@ pub enum EngineError {
     /// Cancelled.
     #[error("cancelled")]
     Cancelled(#[from] Cancelled),
+    /// The zero-velocity detector cannot be built.
+    #[error(transparent)]
+    Detector(#[from] DetectorError),
 }
 
 /// The smoother's forward records.
@@ -378,6 +387,10 @@ pub fn run_engine(
         );
         last_row = Some(0);
     }
+    let mut detector = match cfg.zupt_detector {
+        Some(ds) if cfg.zupt_sigma_mps.is_some() => Some(build_detector(&ds, cfg, start)?),
+        _ => None,
+    };
     let mut counts = [KindCounts::default(); MeasKind::COUNT];
     let mut pending: VecDeque<(f64, Pending)> = VecDeque::new();
     let mut held: Option<Event> = None;
@@ -410,6 +423,12 @@ pub fn run_engine(
                     }
                     incs[got] = inc;
                     got += 1;
+                    if let Some(d) = detector.as_mut() {
+                        // a non-finite sample fails the propagation below with its time
+                        if let Ok(Some(r)) = d.push(&inc) {
+                            at_rest = r;
+                        }
+                    }
                     if tr.is_some() {
                         truth = tr;
                     }
@@ -418,7 +437,8 @@ pub fn run_engine(
                 Event::Meas { meas, arrival_s } => {
                     pending.push_back((arrival_s, Pending::Meas(meas)))
                 }
-                Event::Rest(r) => at_rest = r,
+                Event::Rest(r) if detector.is_none() => at_rest = r,
+                Event::Rest(_) => {}
                 Event::SensorTruth(s) => sensor_truth = Some(s),
             }
         }
@@ -460,6 +480,12 @@ pub fn run_engine(
             }
         }
         if let Some(ep) = ekf.take_epoch() {
+            if let Some(d) = detector.as_mut() {
+                let (st, est) = (ekf.state(), ekf.estimates());
+                let b_a = Vec3::new(est[9], est[10], est[11]);
+                let b_g = Vec3::new(est[12], est[13], est[14]);
+                let _ = d.set_estimates(&b_a, &b_g, &st.c_b_n, &cfg.earth.omega_ie_n(st.lat_rad));
+            }
             cov_epochs += 1;
             epoch += 1;
             cov_state = ekf.state();
@@ -510,6 +536,41 @@ pub fn run_engine(
         t_start_s: t0,
         smoother_bytes,
     })
+}
+
+/// The detector from the filter's white noise (largest axis), gravity at the start and
+/// the prior σ of the bias blocks (largest axis) as the residual biases.
+fn build_detector(
+    ds: &DetectorSettings,
+    cfg: &EngineConfig,
+    start: &Start,
+) -> Result<AnyDetector, EngineError> {
+    let max3 = |v: &Vec3| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    let sd = |o: usize| {
+        (0..3).fold(0.0f64, |a, i| {
+            a.max(start.p0[(o + i, o + i)].max(0.0).sqrt())
+        })
+    };
+    let g = cfg.earth.gravity(start.state.lat_rad, start.state.h_m);
+    let mut d = AnyDetector::new(
+        ds,
+        max3(&cfg.noise.vrw_mps_per_sqrt_s),
+        max3(&cfg.noise.arw_rad_per_sqrt_s),
+        cfg.dt_s,
+        g,
+        sd(9),
+        sd(12),
+    )?;
+    let b_a = Vec3::new(start.est0[9], start.est0[10], start.est0[11]);
+    let b_g = Vec3::new(start.est0[12], start.est0[13], start.est0[14]);
+    d.set_estimates(
+        &b_a,
+        &b_g,
+        &start.state.c_b_n,
+        &cfg.earth.omega_ie_n(start.state.lat_rad),
+    )
+    .map_err(|e| EngineError::Option("zupt_detector", format!("{e}")))?;
+    Ok(d)
 }
 
 /// A measurement waiting for its arrival time.

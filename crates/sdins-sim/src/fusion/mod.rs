@@ -4,6 +4,7 @@
 //! ([`smoother`]); the `sdins fuse` request as one library call ([`request`]). The filter
 //! itself is `sdins_core::aiding`.
 
+pub mod detector;
 pub mod engine;
 pub mod files;
 pub mod health;

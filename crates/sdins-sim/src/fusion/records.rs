@@ -165,6 +165,8 @@ pub struct RecordOptions {
     /// non-holonomic constraint σ \[m/s\] (body = vehicle frame), applied at the
     /// covariance rate
     pub nhc_sigma_mps: Option<f64>,
+    /// zero-velocity updates of σ \[m/s\] when the stationarity detector declares rest
+    pub zupt_detector: Option<(f64, crate::fusion::detector::DetectorSettings)>,
     /// run the smoother
     pub smooth: bool,
     /// estimate accelerometer and gyro scale factors (the 21-state filter)
@@ -185,6 +187,7 @@ impl Default for RecordOptions {
             max_consecutive_rejections: 5,
             lever_arm_b_m: [0.0; 3],
             nhc_sigma_mps: None,
+            zupt_detector: None,
             smooth: false,
             scale_factors: None,
             every_s: None,
@@ -438,6 +441,8 @@ pub fn fuse_records(
     cfg.max_consecutive_rejections = opts.max_consecutive_rejections;
     cfg.max_latency_s = opts.max_latency_s;
     cfg.nhc_sigma_mps = opts.nhc_sigma_mps;
+    cfg.zupt_sigma_mps = opts.zupt_detector.map(|z| z.0);
+    cfg.zupt_detector = opts.zupt_detector.map(|z| z.1);
     cfg.smooth = opts.smooth;
     // fixes before the navigation start (and the initialising one) are not used
     let mut first = skip_fixes;

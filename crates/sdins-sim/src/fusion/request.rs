@@ -13,6 +13,7 @@
 
 use super::health::{HealthMonitor, HealthVerdict, DEFAULT_MAX_SIGMA_H_M};
 use crate::cancel::CancelToken;
+use crate::fusion::detector::DetectorSettings;
 use crate::fusion::files::{fuse_files, FilesError, FilesInput, FilesResult};
 use crate::fusion::files::{InitSource, InputColumns, SensorModelSource};
 use crate::fusion::records::{RecordEvent, RecordOptions, RecordPoint, TruthComparison};
@@ -115,6 +116,10 @@ pub struct FuseRequest {
     /// the health verdict's largest horizontal σ \[m\] (default
     /// [`health::DEFAULT_MAX_SIGMA_H_M`](super::health::DEFAULT_MAX_SIGMA_H_M))
     pub health_max_sigma_m: Option<f64>,
+    /// zero-velocity updates of σ \[m/s\] whenever the IMU's stationarity detector
+    /// declares rest ([`crate::fusion::detector`]; scenarios and files; on scenarios in
+    /// place of the truth trigger `ScenarioData::zupt_sigma_mps`)
+    pub zupt_detector: Option<(f64, DetectorSettings)>,
 }
 
 impl FuseRequest {
@@ -135,6 +140,7 @@ impl FuseRequest {
             until_s: None,
             max_latency_s: None,
             health_max_sigma_m: None,
+            zupt_detector: None,
         }
     }
 }
@@ -274,6 +280,17 @@ fn common(req: &FuseRequest, default_samples: usize) -> Result<AlgorithmSpec, Fu
     }
     positive("cov_rate_hz", "--cov-rate-hz", Some(req.cov_rate_hz))?;
     positive("nhc_sigma_mps", "--nhc-sigma-mps", req.nhc_sigma_mps)?;
+    if let Some((sigma, ds)) = &req.zupt_detector {
+        positive("zupt_sigma_mps", "--zupt-sigma-mps", Some(*sigma))?;
+        positive("zupt_window_s", "--zupt-window-s", Some(ds.window_s))?;
+        if !(1e-9..=0.5).contains(&ds.false_alarm) {
+            return Err(bad(
+                "zupt_false_alarm",
+                "--zupt-false-alarm",
+                format!("must be in [1e-9, 0.5], got {}", ds.false_alarm),
+            ));
+        }
+    }
     positive("every_s", "--every-s", req.every_s)?;
     positive("until_s", "--until-s", req.until_s)?;
     if let Some(l) = req.max_latency_s {
@@ -373,12 +390,25 @@ pub fn scenario_options(
 ) -> Result<FuseOptions, FuseRunError> {
     let algo = common(req, scn.nav.samples)?;
     positive("zupt_sigma_mps", "--zupt-sigma-mps", d.zupt_sigma_mps)?;
+    let zupt = match (d.zupt_sigma_mps, &req.zupt_detector) {
+        (Some(_), Some(_)) => {
+            return Err(bad(
+                "zupt_detector",
+                "--zupt-detector",
+                "a scenario's ZUPT comes from the truth (zupt_sigma_mps) or from the detector, not both",
+            ))
+        }
+        (Some(s), None) => Some((s, 1e-3)),
+        (None, Some((s, _))) => Some((*s, 1e-3)),
+        (None, None) => None,
+    };
     Ok(FuseOptions {
         algo,
         cov_rate_hz: req.cov_rate_hz,
         draw_initial_errors: !d.exact_start,
         gate_chi2: req.gate.then_some(CHI2_999),
-        zupt: d.zupt_sigma_mps.map(|s| (s, 1e-3)),
+        zupt,
+        zupt_detector: req.zupt_detector.map(|z| z.1),
         nhc_sigma_mps: req.nhc_sigma_mps,
         until_s: req.until_s,
         smooth: req.smooth,
@@ -500,6 +530,7 @@ pub fn files_input(
         gate_chi2: req.gate.then_some(CHI2_999),
         lever_arm_b_m: d.lever_arm_m.unwrap_or([0.0; 3]),
         nhc_sigma_mps: req.nhc_sigma_mps,
+        zupt_detector: req.zupt_detector,
         smooth: req.smooth,
         scale_factors: req.scale_factors,
         every_s: req.every_s,

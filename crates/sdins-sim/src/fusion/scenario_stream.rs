@@ -233,7 +233,10 @@ pub fn scenario_start<'a>(
         } else {
             0.0
         },
-        zupt_speed_mps: opts.zupt.map(|z| z.1),
+        zupt_speed_mps: opts
+            .zupt
+            .filter(|_| opts.zupt_detector.is_none())
+            .map(|z| z.1),
         rest: false,
     };
     // in-motion start: run the sensors and the receiver until the first fix at speed
@@ -369,6 +372,7 @@ pub fn scenario_start<'a>(
     cfg.max_latency_s = opts.max_latency_s;
     cfg.zupt_sigma_mps = opts.zupt.map(|z| z.0);
     cfg.nhc_sigma_mps = opts.nhc_sigma_mps;
+    cfg.zupt_detector = opts.zupt_detector;
     cfg.smooth = opts.smooth;
     let sensor_truth = stream.aiding.as_ref().map(AidingSimulator::truth);
     Ok(ScenarioSetup {

@@ -86,6 +86,9 @@ pub struct FuseOptions {
     pub zupt: Option<(f64, f64)>,
     /// NHC σ \[m/s\]
     pub nhc_sigma_mps: Option<f64>,
+    /// with `zupt`: decide rest with the IMU's stationarity detector instead of the
+    /// truth's speed (the speed threshold of `zupt` is then unused)
+    pub zupt_detector: Option<crate::fusion::detector::DetectorSettings>,
     /// tell the filter the GNSS lever arm (false: the filter assumes zero)
     pub model_lever_arm: bool,
     /// stop after this time \[s\]
@@ -180,6 +183,7 @@ impl Default for FuseOptions {
             max_consecutive_rejections: 5,
             zupt: None,
             nhc_sigma_mps: None,
+            zupt_detector: None,
             model_lever_arm: true,
             until_s: None,
             smooth: false,
@@ -222,6 +226,7 @@ impl From<EngineError> for FuseError {
             EngineError::Filter(f) => FuseError::Filter(f),
             EngineError::Smoother(s) => FuseError::Smoother(s),
             EngineError::Cancelled(c) => FuseError::Cancelled(c),
+            EngineError::Detector(d) => FuseError::Option("zupt_detector", d.to_string()),
         }
     }
 }
@@ -597,6 +602,7 @@ pub(crate) fn engine_config(
         lever_arm_b_m,
         zupt_sigma_mps: None,
         nhc_sigma_mps: None,
+        zupt_detector: None,
         smooth: false,
         every_s: every_s.unwrap_or(cov_updates as f64 * n as f64 * dt_s),
         total_updates,
