@@ -15,7 +15,9 @@
 //! gated kinds, the Joseph-form update and the report.
 //!
 //! Equations (Groves 2nd ed.): GNSS position of the antenna (14.110), velocity (14.111);
-//! ZUPT and NHC §15.3 (zero velocity, zero lateral and vertical body velocity).
+//! ZUPT and NHC §15.3 (zero velocity, zero lateral and vertical body velocity). The other
+//! aiding sensors (barometer, odometer, magnetometer, dual-antenna GNSS, body velocity) and
+//! the enum of every measurement are in [`super::sensors`].
 
 use super::error_model::position_scale;
 use super::layout::{BlockKind, Cov, StateLayout, XVec};
@@ -34,15 +36,15 @@ pub enum MeasKind {
     Zupt,
     /// non-holonomic constraint (body y, z velocity)
     Nhc,
-    /// barometric altitude
+    /// barometric height ([`super::sensors::Baro`])
     Baro,
-    /// odometer
+    /// odometer speed, optionally with the vehicle-frame NHC ([`super::sensors::Odometer`])
     Odometer,
-    /// magnetometer
+    /// three-axis magnetometer ([`super::sensors::Magnetometer`])
     Magnetometer,
-    /// dual antenna
+    /// dual-antenna GNSS baseline azimuth and elevation ([`super::sensors::DualAntenna`])
     DualAntenna,
-    /// body velocity
+    /// vehicle-frame velocity, e.g. a Doppler velocity log ([`super::sensors::BodyVelocity`])
     BodyVelocity,
 }
 
@@ -187,7 +189,7 @@ pub struct GnssMeasurement {
     pub lever_arm_b_m: Vec3,
 }
 
-fn finite(v: impl IntoIterator<Item = f64>) -> bool {
+pub(super) fn finite(v: impl IntoIterator<Item = f64>) -> bool {
     v.into_iter().all(f64::is_finite)
 }
 
@@ -355,7 +357,7 @@ impl Measurement for Nhc {
     }
 }
 
-fn set3<const R: usize, const C: usize>(
+pub(super) fn set3<const R: usize, const C: usize>(
     m: &mut nalgebra::SMatrix<f64, R, C>,
     r0: usize,
     c0: usize,

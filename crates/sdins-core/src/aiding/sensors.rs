@@ -1,161 +1,129 @@
-//! TEMPORARY: replaced by the sensors branch.
+//! Measurement models of the aiding sensors besides GNSS position/velocity, ZUPT and the
+//! body-frame NHC of [`super::meas`]: barometric height ([`Baro`]), odometer speed with the
+//! optional vehicle-frame non-holonomic constraint ([`Odometer`]), a vehicle-frame velocity
+//! such as a Doppler velocity log ([`BodyVelocity`]), the three-axis magnetometer
+//! ([`Magnetometer`]) and the dual-antenna GNSS baseline ([`DualAntenna`]); and
+//! [`AidingMeas`], one `Copy` enum of every measurement of the crate.
+//!
+//! Every model follows the conventions of [`super::layout`]: navigation states estimate −
+//! truth (δL, δλ, δh; δv^n; ε with `Ĉ_b^n = (I + [ε×]) C_b^n`), sensor-parameter blocks
+//! truth − estimate (`x_b = b − b̂`), compensated rate `ω̂_ib^b − ω_ib^b = x_bg +
+//! diag(ω_ib^b) x_sg`; innovation `ν = ĥ(x̂) − z = H x + v` to first order. Every model is
+//! gated (χ² test of [`super::ekf`]) and refuses non-finite inputs or a non-positive σ
+//! with [`MeasError::NonFinite`].
+//!
+//! Sources: Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
+//! Systems*, 2nd ed. (2013): ch. 6 (magnetometer, barometric altimeter, odometer, Doppler
+//! velocity), ch. 10 (GNSS attitude), ch. 16 (INS/other-sensor integration). Theory and the
+//! choices made: `docs/theory/aiding-sensors.md`.
+
+mod baro;
+mod dual_antenna;
+mod magnetometer;
+mod velocity;
+
+#[cfg(test)]
+mod tests;
+
+pub use baro::Baro;
+pub use dual_antenna::{baseline_az_el, DualAntenna};
+pub use magnetometer::{mag_field_ned_ut, Magnetometer};
+pub use velocity::{
+    vehicle_velocity, vehicle_velocity_jacobian, BodyVelocity, Odometer, VehicleVelocity,
+};
+
 use super::layout::{Cov, StateLayout};
 use super::meas::{
     GnssMeasurement, MeasError, MeasKind, MeasModel, MeasPoint, Measurement, Nhc, Zupt,
 };
 
-/// Any measurement.
+/// Every measurement of the crate in one `Copy` value (a queue of mixed measurements),
+/// implementing [`Measurement`] by delegation to the wrapped model.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)]
 pub enum AidingMeas {
-    /// GNSS
+    /// GNSS position (and velocity) of the antenna
     Gnss(GnssMeasurement),
-    /// ZUPT
+    /// zero-velocity update
     Zupt(Zupt),
-    /// NHC
+    /// body-frame non-holonomic constraint
     Nhc(Nhc),
-    /// baro
+    /// barometric height
     Baro(Baro),
-    /// odo
+    /// odometer speed (+ vehicle-frame NHC)
     Odometer(Odometer),
-    /// dvl
+    /// vehicle-frame velocity (Doppler velocity log)
     BodyVelocity(BodyVelocity),
-    /// mag
+    /// three-axis magnetometer
     Magnetometer(Magnetometer),
-    /// dual
+    /// dual-antenna GNSS baseline azimuth (and elevation)
     DualAntenna(DualAntenna),
 }
 
-impl AidingMeas {
-    fn inner(&self) -> &dyn Measurement {
-        match self {
-            AidingMeas::Gnss(m) => m,
-            AidingMeas::Zupt(m) => m,
-            AidingMeas::Nhc(m) => m,
-            AidingMeas::Baro(m) => m,
-            _ => &Zupt {
-                t_s: f64::NAN,
-                sigma_mps: 1.0,
-            },
+macro_rules! delegate {
+    ($self:ident, $m:ident => $e:expr) => {
+        match $self {
+            AidingMeas::Gnss($m) => $e,
+            AidingMeas::Zupt($m) => $e,
+            AidingMeas::Nhc($m) => $e,
+            AidingMeas::Baro($m) => $e,
+            AidingMeas::Odometer($m) => $e,
+            AidingMeas::BodyVelocity($m) => $e,
+            AidingMeas::Magnetometer($m) => $e,
+            AidingMeas::DualAntenna($m) => $e,
         }
-    }
+    };
 }
 
 impl Measurement for AidingMeas {
     fn kind(&self) -> MeasKind {
-        self.inner().kind()
+        delegate!(self, m => m.kind())
     }
     fn t_valid_s(&self) -> f64 {
-        self.inner().t_valid_s()
+        delegate!(self, m => m.t_valid_s())
     }
     fn gated(&self) -> bool {
-        self.inner().gated()
+        delegate!(self, m => m.gated())
     }
     fn evaluate(&self, at: &MeasPoint<'_>, out: &mut MeasModel) -> Result<(), MeasError> {
-        self.inner().evaluate(at, out)
+        delegate!(self, m => m.evaluate(at, out))
     }
     fn reset(&self, p: &mut Cov, model: &MeasModel, layout: &StateLayout) {
-        self.inner().reset(p, model, layout)
+        delegate!(self, m => m.reset(p, model, layout))
     }
 }
 
-use crate::math::{Mat3, Vec3};
-
-/// TEMP
-pub fn vehicle_velocity(
-    c_b_n: &Mat3,
-    v_n_mps: &Vec3,
-    omega_ib_b: &Vec3,
-    omega_ie_n: &Vec3,
-    c_b_v: &Mat3,
-    lever_arm_b_m: &Vec3,
-) -> Vec3 {
-    let ct = c_b_n.transpose();
-    let w_eb = omega_ib_b - ct * omega_ie_n;
-    c_b_v * (ct * v_n_mps + w_eb.cross(lever_arm_b_m))
-}
-/// TEMP
-pub fn baseline_az_el(c_b_n: &Mat3, baseline_b_m: &Vec3) -> (f64, f64) {
-    let u = c_b_n * baseline_b_m;
-    (
-        libm::atan2(u.y, u.x),
-        libm::atan2(-u.z, libm::hypot(u.x, u.y)),
-    )
-}
-/// TEMP
-pub fn mag_field_ned_ut(declination_rad: f64, inclination_rad: f64, intensity_ut: f64) -> Vec3 {
-    let (si, ci) = libm::sincos(inclination_rad);
-    let (sd, cd) = libm::sincos(declination_rad);
-    Vec3::new(
-        intensity_ut * ci * cd,
-        intensity_ut * ci * sd,
-        intensity_ut * si,
-    )
-}
-/// TEMP
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Baro {
-    pub t_s: f64,
-    pub h_baro_m: f64,
-    pub sigma_m: f64,
-}
-/// TEMP
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Odometer {
-    pub t_s: f64,
-    pub speed_mps: f64,
-    pub sigma_mps: f64,
-    pub c_b_v: Mat3,
-    pub lever_arm_b_m: Vec3,
-    pub nhc_sigma_mps: Option<f64>,
-}
-/// TEMP
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BodyVelocity {
-    pub t_s: f64,
-    pub v_v_mps: Vec3,
-    pub cov_mps2: Mat3,
-    pub c_b_v: Mat3,
-    pub lever_arm_b_m: Vec3,
-}
-/// TEMP
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Magnetometer {
-    pub t_s: f64,
-    pub m_b_ut: Vec3,
-    pub m_n_ut: Vec3,
-    pub sigma_ut: f64,
-}
-/// TEMP
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DualAntenna {
-    pub t_s: f64,
-    pub az_rad: f64,
-    pub el_rad: f64,
-    pub baseline_b_m: Vec3,
-    pub sigma_rel_m: f64,
-    pub heading_only: bool,
+macro_rules! from_variant {
+    ($($v:ident($t:ty)),*) => {$(
+        impl From<$t> for AidingMeas {
+            fn from(m: $t) -> Self {
+                AidingMeas::$v(m)
+            }
+        }
+    )*};
 }
 
-impl Measurement for Baro {
-    fn kind(&self) -> MeasKind {
-        MeasKind::Baro
-    }
-    fn t_valid_s(&self) -> f64 {
-        self.t_s
-    }
-    fn gated(&self) -> bool {
-        true
-    }
-    fn evaluate(&self, at: &MeasPoint<'_>, out: &mut MeasModel) -> Result<(), MeasError> {
-        let o = at
-            .layout
-            .offset(super::layout::BlockKind::BaroBias)
-            .ok_or(MeasError::MissingBlock(super::layout::BlockKind::BaroBias))?;
-        *out = MeasModel::zeros(1);
-        out.nu[0] = at.h_m + at.est[o] - self.h_baro_m;
-        out.h[(0, 2)] = 1.0;
-        out.h[(0, o)] = -1.0;
-        out.r[(0, 0)] = self.sigma_m * self.sigma_m;
-        Ok(())
-    }
+from_variant!(
+    Gnss(GnssMeasurement),
+    Zupt(Zupt),
+    Nhc(Nhc),
+    Baro(Baro),
+    Odometer(Odometer),
+    BodyVelocity(BodyVelocity),
+    Magnetometer(Magnetometer),
+    DualAntenna(DualAntenna)
+);
+
+/// Whether a σ is finite and positive.
+fn positive(sigma: f64) -> bool {
+    sigma.is_finite() && sigma > 0.0
+}
+
+/// Whether the first `dim` rows of a filled model are finite (over the layout's `n` columns).
+fn model_finite(out: &MeasModel, n: usize) -> bool {
+    (0..out.dim).all(|i| {
+        out.nu[i].is_finite()
+            && (0..n).all(|j| out.h[(i, j)].is_finite())
+            && (0..out.dim).all(|j| out.r[(i, j)].is_finite())
+    })
 }
