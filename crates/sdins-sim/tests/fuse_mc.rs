@@ -117,7 +117,7 @@ fn bit_identical_for_threads_and_shards() {
     let (a, b) = (one.statistics(), merged.statistics());
     assert_eq!(a.to_csv(), b.to_csv());
     assert!(a.complete && a.runs == 13);
-    // 20 s at 10 Hz: 201 rows; NEES of 5 blocks, NIS of 3 kinds
+    // 20 s at 10 Hz: 201 rows; NEES of 5 blocks, NIS of 8 kinds
     assert_eq!(a.times_s.len(), 201);
     let names: Vec<&str> = a.columns.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(
@@ -130,7 +130,12 @@ fn bit_identical_for_threads_and_shards() {
             "nees_gyro_bias",
             "nis_gnss",
             "nis_zupt",
-            "nis_nhc"
+            "nis_nhc",
+            "nis_baro",
+            "nis_odometer",
+            "nis_magnetometer",
+            "nis_dual_antenna",
+            "nis_body_velocity"
         ]
     );
     // a fix per run at the whole seconds (6 dof), none in between

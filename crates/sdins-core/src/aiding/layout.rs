@@ -75,7 +75,7 @@ pub enum BlockKind {
     BaroScale,
     /// heading (magnetic or dual-antenna) bias \[rad\]
     HeadingBias,
-    /// magnetometer hard iron, body \[T\]
+    /// magnetometer hard iron, body \[µT\]
     MagHardIron,
     /// vehicle-frame misalignment (pitch, yaw) of the body frame \[rad\]
     VehicleMisalignment,

@@ -15,7 +15,9 @@
 //! gated kinds, the Joseph-form update and the report.
 //!
 //! Equations (Groves 2nd ed.): GNSS position of the antenna (14.110), velocity (14.111);
-//! ZUPT and NHC §15.3 (zero velocity, zero lateral and vertical body velocity).
+//! ZUPT and NHC §15.3 (zero velocity, zero lateral and vertical body velocity). The other
+//! aiding sensors (barometer, odometer, magnetometer, dual-antenna GNSS, body velocity) and
+//! the enum of every measurement are in [`super::sensors`].
 
 use super::error_model::position_scale;
 use super::layout::{BlockKind, Cov, StateLayout, XVec};
@@ -34,19 +36,43 @@ pub enum MeasKind {
     Zupt,
     /// non-holonomic constraint (body y, z velocity)
     Nhc,
+    /// barometric height ([`super::sensors::Baro`])
+    Baro,
+    /// odometer speed, optionally with the vehicle-frame NHC ([`super::sensors::Odometer`])
+    Odometer,
+    /// three-axis magnetometer ([`super::sensors::Magnetometer`])
+    Magnetometer,
+    /// dual-antenna GNSS baseline azimuth and elevation ([`super::sensors::DualAntenna`])
+    DualAntenna,
+    /// vehicle-frame velocity, e.g. a Doppler velocity log ([`super::sensors::BodyVelocity`])
+    BodyVelocity,
 }
 
 impl MeasKind {
     /// Number of kinds.
-    pub const COUNT: usize = 3;
+    pub const COUNT: usize = 8;
     /// Every kind, in [`MeasKind::index`] order.
-    pub const ALL: [MeasKind; MeasKind::COUNT] = [MeasKind::Gnss, MeasKind::Zupt, MeasKind::Nhc];
+    pub const ALL: [MeasKind; MeasKind::COUNT] = [
+        MeasKind::Gnss,
+        MeasKind::Zupt,
+        MeasKind::Nhc,
+        MeasKind::Baro,
+        MeasKind::Odometer,
+        MeasKind::Magnetometer,
+        MeasKind::DualAntenna,
+        MeasKind::BodyVelocity,
+    ];
     /// Index `0 … COUNT−1`.
     pub fn index(self) -> usize {
         match self {
             MeasKind::Gnss => 0,
             MeasKind::Zupt => 1,
             MeasKind::Nhc => 2,
+            MeasKind::Baro => 3,
+            MeasKind::Odometer => 4,
+            MeasKind::Magnetometer => 5,
+            MeasKind::DualAntenna => 6,
+            MeasKind::BodyVelocity => 7,
         }
     }
     /// Name (CSV `kind` column).
@@ -55,6 +81,11 @@ impl MeasKind {
             MeasKind::Gnss => "gnss",
             MeasKind::Zupt => "zupt",
             MeasKind::Nhc => "nhc",
+            MeasKind::Baro => "baro",
+            MeasKind::Odometer => "odometer",
+            MeasKind::Magnetometer => "magnetometer",
+            MeasKind::DualAntenna => "dual_antenna",
+            MeasKind::BodyVelocity => "body_velocity",
         }
     }
 }
@@ -158,7 +189,7 @@ pub struct GnssMeasurement {
     pub lever_arm_b_m: Vec3,
 }
 
-fn finite(v: impl IntoIterator<Item = f64>) -> bool {
+pub(super) fn finite(v: impl IntoIterator<Item = f64>) -> bool {
     v.into_iter().all(f64::is_finite)
 }
 
@@ -326,7 +357,7 @@ impl Measurement for Nhc {
     }
 }
 
-fn set3<const R: usize, const C: usize>(
+pub(super) fn set3<const R: usize, const C: usize>(
     m: &mut nalgebra::SMatrix<f64, R, C>,
     r0: usize,
     c0: usize,

@@ -181,6 +181,14 @@ pub fn columns(layout: &StateLayout, gnss: &GnssConfig) -> (Vec<String>, Vec<u32
             MeasKind::Gnss => 3,
             MeasKind::Zupt => 3,
             MeasKind::Nhc => 2,
+            MeasKind::Baro => 1,
+            // speed + the two vehicle-frame NHC rows; 1 when the odometer's NHC is off (the
+            // column keeps the larger dof)
+            MeasKind::Odometer => 3,
+            MeasKind::Magnetometer => 3,
+            // azimuth + elevation; 1 heading-only (the column keeps the larger dof)
+            MeasKind::DualAntenna => 2,
+            MeasKind::BodyVelocity => 3,
             _ => 0,
         });
     }
