@@ -142,6 +142,7 @@ fn odometer(t: &Truth, nhc: bool) -> Odometer {
         c_b_v,
         lever_arm_b_m: l,
         nhc_sigma_mps: nhc.then_some(0.1),
+        nhc_v_mps: [0.0; 2],
     }
 }
 
@@ -587,6 +588,14 @@ fn non_finite_and_degenerate_inputs_are_refused() {
     err(eval(
         &Odometer {
             nhc_sigma_mps: Some(nan),
+            ..o
+        },
+        &t,
+        &z,
+    ));
+    err(eval(
+        &Odometer {
+            nhc_v_mps: [0.0, nan],
             ..o
         },
         &t,

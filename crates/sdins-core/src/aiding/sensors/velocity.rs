@@ -114,8 +114,9 @@ fn put_row(
 ///   and gyro scale rows of [`vehicle_velocity_jacobian`]) and `H_s = −v̂_x^v`;
 ///   `R = σ²` (`sigma_mps`).
 /// * With `nhc_sigma_mps = Some(σ_n)`, rows 1, 2: the constraint that the point does not
-///   slip sideways or leave the road, `z = 0`, `ν = v̂_y^v`, `v̂_z^v`, `H` the y, z rows of
-///   the Jacobian, `R = σ_n²` each.
+///   slip sideways or leave the road, `z = nhc_v_mps` (zero on a vehicle: the model is
+///   `v_y^v, v_z^v` white with σ_n, and a simulation draws that violation into `z`),
+///   `ν = v̂_y^v − z_y`, `v̂_z^v − z_z`, `H` the y, z rows of the Jacobian, `R = σ_n²` each.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Odometer {
     /// time of validity \[s\]
@@ -130,6 +131,9 @@ pub struct Odometer {
     pub lever_arm_b_m: Vec3,
     /// σ of the lateral and vertical constraint \[m/s\] (None: speed only)
     pub nhc_sigma_mps: Option<f64>,
+    /// the lateral and vertical velocity taken as measured by the constraint \[m/s\]:
+    /// zero on a vehicle; a simulation puts the drawn violation here
+    pub nhc_v_mps: [f64; 2],
 }
 
 impl Measurement for Odometer {
@@ -143,8 +147,12 @@ impl Measurement for Odometer {
         true
     }
     fn evaluate(&self, at: &MeasPoint<'_>, out: &mut MeasModel) -> Result<(), MeasError> {
-        let ok = finite([self.t_s, self.speed_mps])
-            && positive(self.sigma_mps)
+        let ok = finite([
+            self.t_s,
+            self.speed_mps,
+            self.nhc_v_mps[0],
+            self.nhc_v_mps[1],
+        ]) && positive(self.sigma_mps)
             && finite(self.c_b_v.iter().chain(self.lever_arm_b_m.iter()).copied())
             && self.nhc_sigma_mps.is_none_or(positive);
         if !ok {
@@ -162,7 +170,7 @@ impl Measurement for Odometer {
         out.r[(0, 0)] = self.sigma_mps * self.sigma_mps;
         if let Some(s) = self.nhc_sigma_mps {
             for row in 1..3 {
-                out.nu[row] = vv.v_v_mps[row];
+                out.nu[row] = vv.v_v_mps[row] - self.nhc_v_mps[row - 1];
                 put_row(out, row, row, 1.0, &vv, at)?;
                 out.r[(row, row)] = s * s;
             }

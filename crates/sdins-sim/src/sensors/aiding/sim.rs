@@ -10,6 +10,10 @@
 //!   evaluated at the truth and the true sensor parameters, plus white noise: the models
 //!   agree with the simulation by construction, and the Monte Carlo tests check that
 //!   the filter's covariance agrees with the errors it makes.
+//! * The odometer's non-holonomic rows: the trajectory moves without sideslip, so the
+//!   lateral and vertical velocity at the axle is zero in the truth; the constraint's σ
+//!   models a white violation, which the simulator draws into the measured values
+//!   (`nhc_v_mps`) so that the model holds.
 //! * Sensor parameters: the barometer bias is a first-order Gauss–Markov process drawn
 //!   from its steady state and advanced exactly between consecutive instants (IMU
 //!   samples and measurement epochs: `b ← e^{−Δ/τ} b + σ√(1 − e^{−2Δ/τ}) w`); the odometer
@@ -237,6 +241,7 @@ impl AidingSimulator {
         if let Some(c) = self.cfg.odometer.clone() {
             while let Some(t) = self.clocks[1].next_in(a.t_s, b.t_s) {
                 let w = normal(&mut self.rngs[1]);
+                let w_nhc = [normal(&mut self.rngs[1]), normal(&mut self.rngs[1])];
                 if c.in_outage(t) {
                     continue;
                 }
@@ -261,6 +266,8 @@ impl AidingSimulator {
                     c_b_v: self.c_odo,
                     lever_arm_b_m: l,
                     nhc_sigma_mps: (c.nhc_sigma_mps > 0.0).then_some(c.nhc_sigma_mps),
+                    // the violation the constraint's σ models, drawn
+                    nhc_v_mps: [c.nhc_sigma_mps * w_nhc[0], c.nhc_sigma_mps * w_nhc[1]],
                 }));
             }
         }
