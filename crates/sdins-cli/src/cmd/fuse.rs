@@ -120,16 +120,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
     report(&out, &args, &req, &outcome, &plot)?;
     let mut toml = run_toml(&args, &outcome);
     super::fuse_args::health_toml(&mut toml, &outcome.health);
+    super::fuse_args::measurements_toml(&mut toml, &outcome.measurements);
     crate::report::write_run_toml(&out, toml)?;
     let mut s = summary(&args, &outcome);
     s["health"] = super::fuse_args::health_json(&outcome.health);
+    s["measurements"] = super::fuse_args::measurements_json(&outcome.measurements);
     if args.json {
         outln!("{s:#}");
     } else {
         let r = outcome.rms_forward.unwrap_or_default();
         outln!(
-            "sdins fuse {name}: {} fixes, {} rejected; RMS position N/E/D {:.3}/{:.3}/{:.3} m, velocity {:.4}/{:.4}/{:.4} m/s; wrote {}",
-            outcome.fixes, outcome.rejected, r[0], r[1], r[2], r[3], r[4], r[5],
+            "sdins fuse {name}: {} fixes, {} rejected{}; RMS position N/E/D {:.3}/{:.3}/{:.3} m, velocity {:.4}/{:.4}/{:.4} m/s; wrote {}",
+            outcome.fixes, outcome.rejected,
+            super::fuse_args::measurements_text(&outcome.measurements),
+            r[0], r[1], r[2], r[3], r[4], r[5],
             out.display()
         );
     }

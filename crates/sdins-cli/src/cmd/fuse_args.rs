@@ -4,8 +4,11 @@
 //! (`sdins_sim::fusion::request::FuseRequest`).
 
 use crate::error::CliError;
+use sdins_core::aiding::meas::MeasKind;
 use sdins_sim::fusion::health::HealthVerdict;
-use sdins_sim::fusion::request::{FilesData, FuseData, FuseRequest, FuseRunError, ScenarioData};
+use sdins_sim::fusion::request::{
+    FilesData, FuseData, FuseRequest, FuseRunError, KindTally, ScenarioData,
+};
 use sdins_sim::scenario::Scenario;
 use std::path::PathBuf;
 
@@ -363,5 +366,54 @@ pub fn health_end(args: &Args, h: &HealthVerdict, out: &std::path::Path) -> Resu
             "the solution failed its health checks (above); the outputs are written in {} (exit 3; --health warn accepts the result)",
             out.display()
         ))),
+    }
+}
+
+/// The measurement tallies in run.toml (`[measurements.KIND]` applied/rejected/late) and
+/// the `--json` summary, and their one-line text (kinds other than GNSS).
+pub fn measurements_toml(f: &mut toml::Table, m: &[KindTally]) {
+    let mut t = toml::Table::new();
+    for k in m {
+        let mut e = toml::Table::new();
+        e.insert("applied".into(), (k.applied as i64).into());
+        e.insert("rejected".into(), (k.rejected as i64).into());
+        e.insert("late".into(), (k.late as i64).into());
+        t.insert(k.kind.name().into(), e.into());
+    }
+    f.insert("measurements".into(), t.into());
+}
+
+/// The tallies as JSON (`{"odometer": {"applied": …, "rejected": …, "late": …}, …}`).
+pub fn measurements_json(m: &[KindTally]) -> serde_json::Value {
+    let mut o = serde_json::Map::new();
+    for k in m {
+        o.insert(
+            k.kind.name().into(),
+            serde_json::json!({"applied": k.applied, "rejected": k.rejected, "late": k.late}),
+        );
+    }
+    o.into()
+}
+
+/// `"; odometer 3000 (2 rejected), zupt 240"`: the kinds other than GNSS, empty without.
+pub fn measurements_text(m: &[KindTally]) -> String {
+    let parts: Vec<String> = m
+        .iter()
+        .filter(|k| k.kind != MeasKind::Gnss)
+        .map(|k| {
+            let mut s = format!("{} {}", k.kind.name(), k.applied);
+            if k.rejected > 0 {
+                s.push_str(&format!(" ({} rejected)", k.rejected));
+            }
+            if k.late > 0 {
+                s.push_str(&format!(" ({} late)", k.late));
+            }
+            s
+        })
+        .collect();
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!("; {}", parts.join(", "))
     }
 }

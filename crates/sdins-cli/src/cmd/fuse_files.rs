@@ -142,6 +142,7 @@ pub fn run(args: &Args, req: &FuseRequest) -> Result<(), CliError> {
     }
     let mut toml = run_toml(args, d, r);
     super::fuse_args::health_toml(&mut toml, &o.health);
+    super::fuse_args::measurements_toml(&mut toml, &o.measurements);
     crate::report::write_run_toml(&out, toml)?;
     for rep in &r.inputs {
         eprintln!("{}", rep.summary());
@@ -155,9 +156,15 @@ pub fn run(args: &Args, req: &FuseRequest) -> Result<(), CliError> {
     if args.json {
         let mut s = summary(args, d, &o, r, last.as_ref());
         s["health"] = super::fuse_args::health_json(&o.health);
+        s["measurements"] = super::fuse_args::measurements_json(&o.measurements);
         outln!("{s:#}");
     } else {
-        print(d, r, &out);
+        print(
+            d,
+            r,
+            &out,
+            &super::fuse_args::measurements_text(&o.measurements),
+        );
     }
     super::fuse_args::health_end(args, &o.health, &out)
 }
@@ -293,9 +300,9 @@ fn run_toml(args: &Args, d: &FilesData, r: &FilesResult) -> toml::Table {
     f
 }
 
-fn print(d: &FilesData, r: &FilesResult, out: &Path) {
+fn print(d: &FilesData, r: &FilesResult, out: &Path, other: &str) {
     outln!(
-        "sdins fuse {} + {}: {} IMU samples ({}), {} fixes used ({} outside the IMU record skipped), {} rejected; wrote {}",
+        "sdins fuse {} + {}: {} IMU samples ({}), {} fixes used ({} outside the IMU record skipped), {} rejected{other}; wrote {}",
         d.imu.0.display(),
         d.gnss.0.display(),
         r.imu_samples,

@@ -27,6 +27,7 @@ use crate::nav::options::apply_grade;
 use crate::scenario::Scenario;
 use sdins_core::aiding::ekf::{UpdateReport, CHI2_999, DEFAULT_MAX_LATENCY_S};
 use sdins_core::aiding::layout::StateLayout;
+use sdins_core::aiding::meas::MeasKind;
 use sdins_core::math::Vec3;
 use sdins_core::nav::AlgorithmSpec;
 use std::path::PathBuf;
@@ -253,6 +254,22 @@ pub struct FuseOutcome {
     pub details: FuseDetails,
     /// can the solution be trusted? ([`super::health`])
     pub health: HealthVerdict,
+    /// every measurement kind that occurred (GNSS, ZUPT, NHC, the aiding sensors), in
+    /// [`MeasKind::ALL`] order
+    pub measurements: Vec<KindTally>,
+}
+
+/// What happened to the measurements of one kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KindTally {
+    /// the kind
+    pub kind: MeasKind,
+    /// applied (including forced after the reset policy)
+    pub applied: u64,
+    /// rejected by the gate
+    pub rejected: u64,
+    /// refused as late
+    pub late: u64,
 }
 
 fn bad(name: &str, flag: &str, msg: impl std::fmt::Display) -> FuseRunError {
@@ -332,8 +349,28 @@ pub fn fuse(
         req.health_max_sigma_m,
     )?;
     let mut monitor = HealthMonitor::new(req.health_max_sigma_m.unwrap_or(DEFAULT_MAX_SIGMA_H_M));
+    let mut tally: Vec<KindTally> = MeasKind::ALL
+        .iter()
+        .map(|&kind| KindTally {
+            kind,
+            applied: 0,
+            rejected: 0,
+            late: 0,
+        })
+        .collect();
     let mut watch = |ev: FuseOutput<'_>| {
         monitor.observe(&ev);
+        if let FuseOutput::Update(u) = &ev {
+            if let Some(t) = tally.get_mut(u.kind.index()) {
+                if u.late {
+                    t.late += 1;
+                } else if u.accepted {
+                    t.applied += 1;
+                } else {
+                    t.rejected += 1;
+                }
+            }
+        }
         observe(ev);
     };
     let mut o = match &req.data {
@@ -341,6 +378,10 @@ pub fn fuse(
         FuseData::Files(d) => fuse_files_request(req, d, cancel, &mut watch),
     }?;
     o.health = monitor.verdict();
+    o.measurements = tally
+        .into_iter()
+        .filter(|t| t.applied + t.rejected + t.late > 0)
+        .collect();
     Ok(o)
 }
 
@@ -459,6 +500,7 @@ fn fuse_scenario_request(
             gnss_rate_hz: gnss.rate_hz,
         },
         health: HealthVerdict::default(),
+        measurements: Vec::new(),
     })
 }
 
@@ -567,5 +609,6 @@ fn fuse_files_request(
         rms_smoothed: rms(&r.smoothed),
         details: FuseDetails::Files(r),
         health: HealthVerdict::default(),
+        measurements: Vec::new(),
     })
 }

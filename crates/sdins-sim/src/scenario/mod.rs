@@ -361,6 +361,8 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "moored-ship", summary: "disturbed base: moored ship at 40N, roll/pitch sway ±5 deg, 0.5 m heave, 0.2 m surge, marine grade", toml: include_str!("../../scenarios/moored-ship.toml") },
     Builtin { name: "rocking-car", summary: "disturbed base: parked car rocking ±0.8/0.5 deg at 1.373/1.827 Hz with 1 cm heave, aviation grade", toml: include_str!("../../scenarios/rocking-car.toml") },
     Builtin { name: "calibration", summary: "12-position turntable calibration: 300 s dwells, 10 s rotations, tactical grade, 100 Hz (sdins calibrate)", toml: include_str!("../../scenarios/calibration.toml") },
+    Builtin { name: "car-odometer", summary: "car with stops and turns: odometer + NHC at the rear axle, 1 Hz GNSS with a 60 s outage, road vibration while moving (5 min, 100 Hz; try --zupt-detector)", toml: include_str!("../../scenarios/car-odometer.toml") },
+    Builtin { name: "aircraft-sensors", summary: "aircraft at 3 km: barometer, magnetometer, dual-antenna heading, 1 Hz GNSS with a 60 s outage in a turn (100 Hz)", toml: include_str!("../../scenarios/aircraft-sensors.toml") },
     Builtin { name: "route-demo", summary: "route through 4 waypoints at 45N 10E: two fly-by turns, 50 to 60 m/s, 200 m climb, geodesic legs (230 s, 100 Hz)", toml: include_str!("../../scenarios/route-demo.toml") },
 ];
 
