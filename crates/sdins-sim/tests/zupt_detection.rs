@@ -1,5 +1,5 @@
-//! Zero-velocity detection on a car with stops (docs/validation.md §"Zero-velocity
-//! detection"): the fusion loop's stationarity detector, per IMU epoch against the truth,
+//! Zero-velocity detection on a car with stops
+//! (docs/validation.md §"Zero-velocity detection"): the fusion loop's stationarity detector, per IMU epoch against the truth,
 //! at tactical and consumer grade, with road vibration (0.32 m/s² RMS per axis, 2–45 Hz)
 //! only while the car moves; and the fusion loop with `--zupt-detector` never applies a
 //! ZUPT while the truth moves faster than 0.5 m/s.

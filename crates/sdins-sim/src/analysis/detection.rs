@@ -1,7 +1,7 @@
 //! Zero-velocity detection rates of a scenario: the fusion loop's stationarity detector
 //! ([`crate::fusion::detector`]) run on the scenario's IMU samples (the run's errors) and
-//! compared with the truth, counted per IMU epoch (docs/validation.md §"Zero-velocity
-//! detection").
+//! compared with the truth, counted per IMU epoch
+//! (docs/validation.md §"Zero-velocity detection").
 //!
 //! An epoch is at rest when the truth's speed is below 1 mm/s. Epochs within ±W samples
 //! (the detector window) of a truth transition are excluded: there the window mixes rest

@@ -42,7 +42,8 @@ use sdins_core::aiding::error_model::{
 };
 use sdins_core::aiding::layout::{BlockKind, Cov, StateLayout, XVec};
 use sdins_core::aiding::linalg::MAX_ROWS;
-use sdins_core::aiding::meas::MeasKind;
+use sdins_core::aiding::meas::{MeasKind, Measurement};
+use sdins_core::aiding::sensors::AidingMeas;
 use sdins_core::align::coarse::{align as coarse_align, CoarseMethod, StaticMean};
 use sdins_core::align::Site;
 use sdins_core::coning::Increment;
@@ -175,6 +176,19 @@ pub struct RecordOptions {
     pub every_s: Option<f64>,
     /// largest latency of a measurement \[s\]
     pub max_latency_s: f64,
+    /// the aiding sensors' measurements and the filter's model of them
+    pub aiding: AidingRecord,
+}
+
+/// Recorded measurements of the aiding sensors (barometer, odometer, magnetometer, dual
+/// antenna, body velocity) and the sensor settings that give the filter's states and
+/// priors ([`crate::sensors::aiding::add_blocks`]).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct AidingRecord {
+    /// the sensors' settings (which blocks, their priors)
+    pub config: crate::sensors::aiding::AidingConfig,
+    /// the measurements, times of validity on the IMU file's clock, in time order
+    pub meas: Vec<AidingMeas>,
 }
 
 impl Default for RecordOptions {
@@ -192,6 +206,7 @@ impl Default for RecordOptions {
             scale_factors: None,
             every_s: None,
             max_latency_s: DEFAULT_MAX_LATENCY_S,
+            aiding: AidingRecord::default(),
         }
     }
 }
@@ -343,10 +358,12 @@ fn opt_err(name: &'static str, msg: impl Into<String>) -> FuseError {
 struct RecordStream<'a> {
     incs: &'a [Increment],
     fixes: &'a [GnssFix],
+    aid: &'a [AidingMeas],
     t_start_s: f64,
     dt_s: f64,
     i: usize,
     f: usize,
+    a: usize,
 }
 
 impl Iterator for RecordStream<'_> {
@@ -360,6 +377,16 @@ impl Iterator for RecordStream<'_> {
                 return Some(Event::Gnss {
                     fix: *fix,
                     arrival_s: fix.t_s,
+                });
+            }
+        }
+        if let Some(m) = self.aid.get(self.a) {
+            let t = m.t_valid_s();
+            if t <= t_end + 1e-6 {
+                self.a += 1;
+                return Some(Event::Meas {
+                    meas: *m,
+                    arrival_s: t,
                 });
             }
         }
@@ -417,6 +444,12 @@ pub fn fuse_records(
             }
         }
     }
+    opts.aiding
+        .config
+        .validate()
+        .map_err(|e| opt_err("aiding", e.to_string()))?;
+    let layout = crate::sensors::aiding::add_blocks(&opts.aiding.config, layout, &mut p0n)
+        .map_err(|e| opt_err("aiding", e.to_string()))?;
     let mut est0 = XVec::zeros();
     for i in 0..3 {
         est0[I_BA + i] = model.accel_bias0_mps2[i];
@@ -449,13 +482,22 @@ pub fn fuse_records(
     while first < fixes.len() && fixes[first].t_s - t_start <= 1e-9 {
         first += 1;
     }
+    // aiding measurements before the navigation start are not used
+    let a0 = opts
+        .aiding
+        .meas
+        .iter()
+        .position(|m| m.t_valid_s() - t_start > 1e-9)
+        .unwrap_or(opts.aiding.meas.len());
     let mut stream = RecordStream {
         incs: samples,
         fixes: &fixes[first.min(fixes.len())..],
+        aid: &opts.aiding.meas[a0..],
         t_start_s: t_start,
         dt_s: dt,
         i: 0,
         f: 0,
+        a: 0,
     };
     let start = Start {
         t_start_s: t_start,
@@ -800,6 +842,16 @@ pub fn record_from_scenario(
     gnss: &crate::sensors::gnss::GnssConfig,
     run: u64,
 ) -> Result<(ImuData, Vec<GnssFix>), FuseError> {
+    record_from_scenario_with_aiding(scn, gnss, run).map(|(i, f, _)| (i, f))
+}
+
+/// [`record_from_scenario`] with the scenario's aiding sensors simulated too (their
+/// measurements in time order on the same clock).
+pub fn record_from_scenario_with_aiding(
+    scn: &crate::scenario::Scenario,
+    gnss: &crate::sensors::gnss::GnssConfig,
+    run: u64,
+) -> Result<(ImuData, Vec<GnssFix>, AidingRecord), FuseError> {
     use crate::truth::{TruthGenerator, TruthSample};
     let earth = scn.nav.earth.model();
     let dt = scn.imu.dt_s();
@@ -822,11 +874,23 @@ pub fn record_from_scenario(
     );
     let mut incs = Vec::with_capacity(n);
     let mut fixes = Vec::new();
+    let mut asim = scn
+        .aiding
+        .any()
+        .then(|| crate::sensors::aiding::AidingSimulator::new(&scn.aiding, earth, run));
+    let mut aid = Vec::new();
+    let mut step_out = Vec::new();
     for ts in generator {
         incs.push(sensor.apply(&ts.inc, dt));
         gsim.step(&scn.trajectory, &prev, &ts, &mut fixes);
+        if let Some(a) = asim.as_mut() {
+            a.step(&scn.trajectory, &prev, &ts, &mut step_out);
+            aid.append(&mut step_out);
+        }
         prev = ts;
     }
+    // per sample the sensors come in table order: sort by time of validity (stable)
+    aid.sort_by(|a: &AidingMeas, b: &AidingMeas| a.t_valid_s().total_cmp(&b.t_valid_s()));
     Ok((
         ImuData {
             format: crate::io::imu_file::ImuFormat::Sdins,
@@ -838,6 +902,10 @@ pub fn record_from_scenario(
             warnings: Vec::new(),
         },
         fixes,
+        AidingRecord {
+            config: scn.aiding.clone(),
+            meas: aid,
+        },
     ))
 }
 
