@@ -7,8 +7,10 @@
 pub mod engine;
 pub mod files;
 pub mod health;
+pub mod kfgins_yaml;
 pub mod records;
 pub mod request;
 pub mod scenario_stream;
+pub mod sensor_model;
 pub mod simulated;
 pub mod smoother;
