@@ -544,6 +544,7 @@ def fuse_files(
     gps_week: Optional[int] = None,
     gnss_sigma: Optional[str] = None,
     undulation_m: Optional[float] = None,
+    sensor_model: Optional[str] = None,
 ) -> Dict[str, Any]:
     """INS/GNSS filter (and smoother) on recorded files (``sdins fuse --imu --gnss``).
 
@@ -554,11 +555,15 @@ def fuse_files(
     ``undulation_m`` supply what such files lack. The result's ``inputs`` maps ``imu``,
     ``gnss``, ``reference`` to what each map did (time base, clock origin, offset).
 
-    The IMU's error model comes from ``grade`` (a preset) or ``navego_params`` (a NaveGo
-    ``imuN_params.txt``); the initial state from ``init`` (``"lat_deg,lon_deg,h_m,v_n,v_e,
+    The IMU's error model comes from ``grade`` (a preset), ``navego_params`` (a NaveGo
+    ``imuN_params.txt``) or ``sensor_model`` (your own sensor-model TOML, or a KF-GINS
+    ``kf-gins.yaml`` by its extension ``.yaml``/``.yml``; docs/own-data.md "Your sensor
+    model": it may also give the lever arm, the scale-factor σ and the initial attitude
+    and σ); exactly one of the three. The initial state from ``init`` (``"lat_deg,lon_deg,h_m,v_n,v_e,
     v_d,roll_deg,pitch_deg,yaw_deg"``), ``attitude_deg`` (roll, pitch, yaw with the first
     fix's position and velocity; σ ``attitude_sigma_deg``, default 1, 1, 2°), ``static_s``
-    (coarse alignment at rest), or, with NaveGo parameters, their ``ini_align``. Defaults
+    (coarse alignment at rest), or, with NaveGo parameters, their ``ini_align`` (with a
+    sensor model, its initial attitude). Defaults
     are the library's (``RecordOptions::default()``: songlee-complete N = 2, covariance
     10 Hz, χ² 99.9 % gate). Returns a dict: ``forward`` (and with ``smooth`` ``smoothed``)
     with per navigation update ``t_s`` (IMU clock) [s], ``lat_rad``, ``lon_rad``, ``h_m``,
@@ -583,4 +588,5 @@ def fuse_files(
         truth, smooth, algo, samples, cov_rate_hz, gate, nhc_sigma_mps, gnss_offset_s,
         scale_factors_ppm, every_s, max_latency_s, imu_columns, gnss_columns, truth_columns,
         None if profile is None else str(profile), gps_week, gnss_sigma, undulation_m,
+        None if sensor_model is None else str(sensor_model),
     )

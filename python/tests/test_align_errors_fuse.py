@@ -313,3 +313,46 @@ def test_fuse_files_column_maps_equal_cli(cli, tmp_path):
     with pytest.raises(sdins.SdinsError, match="imu_columns.*reflection"):
         sdins.fuse_files(str(imu), str(gnss), imu_columns=RATE_MAP.replace("z:-z", "z:+z"),
                          gnss_columns=FIX_MAP, gnss_sigma="1,1,2", grade="tactical", init=init)
+
+
+def test_fuse_files_sensor_model(cli, tmp_path):
+    """``sensor_model=``: your own sensor-model TOML (docs/own-data.md "Your sensor
+    model"); a bad key is an error naming it and its line; on NaveGo's data the result
+    equals the CLI's ``--sensor-model`` run."""
+    import os
+    import pathlib
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[imu]\ngyro_arw_dpsh = [0.1, 0.1, 0.1]\ngyro_arw = [1, 1, 1]\n")
+    with pytest.raises(sdins.SdinsError, match=r"bad\.toml:3:.*gyro_arw"):
+        sdins.fuse_files(str(tmp_path / "imu.csv"), str(tmp_path / "gnss.csv"),
+                         sensor_model=str(bad), attitude_deg=[0, 0, 0])
+    base = os.environ.get("SDINS_SHARED_DATA")
+    d = (pathlib.Path(base) if base else
+         pathlib.Path(__file__).resolve().parents[2] / ".." / "shared" / "data") / "csv" / "navego"
+    if not d.is_dir():
+        pytest.skip(f"{d} not found")
+    model = tmp_path / "adis.toml"
+    model.write_text(
+        "[imu]\ngyro_arw_dpsh = [2, 2, 2]\naccel_vrw_mpsph = [0.2, 0.2, 0.2]\n"
+        "gyro_bias_dph = [10800, 10800, 10800]\naccel_bias_ug = [50000, 50000, 50000]\n"
+        "gyro_bias_turn_on_dph = [624, 624, 624]\naccel_bias_turn_on_ug = [2900, 2900, 2900]\n"
+        "gyro_bias_instability_dph = [23.3, 23.3, 23.3]\ngyro_bias_instability_tau_s = [189, 189, 189]\n"
+        "[initial]\nattitude_deg = [0, 0, -15]\nattitude_sigma_deg = [1, 1, 2]\n"
+    )
+    args = dict(imu=str(d / "imu1.csv"), gnss=str(d / "gnss.csv"), truth=str(d / "ref.csv"),
+                sensor_model=str(model), samples=1)
+    code, out, err = cli(
+        "fuse", "--imu", args["imu"], "--gnss", args["gnss"], "--truth", args["truth"],
+        "--sensor-model", str(model), "--samples", "1", "--health", "warn", "--json",
+        "--out", str(tmp_path / "n"),
+    )
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.fuse_files(**args)
+    assert r["fixes_used"] == js["fixes_used"] and r["rejected"] == js["rejected"]
+    names = ["roll", "pitch", "yaw", "v_N", "v_E", "v_D", "N", "E", "D"]
+    for i, n in enumerate(names):
+        want = js["forward_vs_truth"][n]["rmse"]
+        got = r["forward_rmse"][i]
+        assert (np.degrees(got) if i < 3 else got) == want, n

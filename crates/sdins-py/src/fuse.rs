@@ -312,7 +312,7 @@ impl Track {
     lever_arm_m=None, truth=None, smooth=None, algo=None, samples=None, cov_rate_hz=None,
     gate=None, nhc_sigma_mps=None, gnss_offset_s=None, scale_factors_ppm=None, every_s=None,
     max_latency_s=None, imu_columns=None, gnss_columns=None, truth_columns=None, profile=None,
-    gps_week=None, gnss_sigma=None, undulation_m=None))]
+    gps_week=None, gnss_sigma=None, undulation_m=None, sensor_model=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse_files<'py>(
     py: Python<'py>,
@@ -345,6 +345,7 @@ pub fn fuse_files<'py>(
     gps_week: Option<u32>,
     gnss_sigma: Option<String>,
     undulation_m: Option<f64>,
+    sensor_model: Option<std::path::PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     // the same maps as the CLI's --imu-columns, …; messages name the Python arguments
     let columns = sdins_sim::fusion::files::ColumnOptions {
@@ -363,6 +364,7 @@ pub fn fuse_files<'py>(
         gnss: (gnss, gnss_format.unwrap_or("auto").parse().map_err(err)?),
         gnss_offset_s: gnss_offset_s.unwrap_or(0.0),
         navego_params,
+        sensor_model,
         init: init.map(str::to_string),
         attitude_deg,
         attitude_sigma_deg,

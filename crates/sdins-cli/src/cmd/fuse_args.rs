@@ -36,13 +36,19 @@ pub struct Args {
     /// t_imu − t_gnss [s] when the two files' clocks differ by a constant
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub gnss_offset_s: f64,
-    /// IMU grade preset (marine, aviation, intermediate, tactical, consumer): on a scenario
-    /// the simulated IMU errors and the filter's model, on recorded data the filter's model
+    /// IMU grade preset (ideal, marine, aviation, intermediate, tactical, consumer): on a
+    /// scenario the simulated IMU errors and the filter's model, on recorded data the
+    /// filter's model
     #[arg(long)]
     pub grade: Option<String>,
     /// the filter's IMU model from a NaveGo imuN_params.txt (static bias known, ±10 % residual)
     #[arg(long)]
     pub navego_params: Option<PathBuf>,
+    /// recorded data: the filter's IMU model (and optionally lever arm, scale-factor σ,
+    /// initial attitude and σ) from your own file: sdins TOML, or KF-GINS kf-gins.yaml when
+    /// the name ends in .yaml/.yml (docs/own-data.md "Your sensor model")
+    #[arg(long, value_name = "FILE")]
+    pub sensor_model: Option<PathBuf>,
     /// initial state lat_deg,lon_deg,h_m,v_n,v_e,v_d,roll_deg,pitch_deg,yaw_deg at the IMU record's start
     #[arg(long, allow_hyphen_values = true)]
     pub init: Option<String>,
@@ -228,6 +234,7 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
                 gnss: (gnss, a.gnss_format.parse().map_err(CliError::bad)?),
                 gnss_offset_s: a.gnss_offset_s,
                 navego_params: a.navego_params.clone(),
+                sensor_model: a.sensor_model.clone(),
                 init: a.init.clone(),
                 attitude_deg: opt_triple("--attitude-deg", &a.attitude_deg)?,
                 attitude_sigma_deg: opt_triple("--attitude-sigma-deg", &a.attitude_sigma_deg)?,
@@ -240,6 +247,7 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
         (None, Some(name)) => {
             for (flag, given) in [
                 ("--navego-params", a.navego_params.is_some()),
+                ("--sensor-model", a.sensor_model.is_some()),
                 ("--init", a.init.is_some()),
                 ("--attitude-deg", a.attitude_deg.is_some()),
                 ("--static-s", a.static_s.is_some()),

@@ -257,6 +257,7 @@ fn summary(
         "algo": args.algo,
         "samples": o.algo.samples,
         "grade": args.grade,
+        "sensor_model": d.sensor_model.as_ref().map(|p| p.display().to_string()),
         "states": o.layout.n(),
         "nav_updates": o.nav_updates,
         "t_start_s": r.summary.t_start_s,
@@ -285,6 +286,13 @@ fn run_toml(args: &Args, d: &FilesData, r: &FilesResult) -> toml::Table {
     f.insert("smooth".into(), args.smooth.into());
     if let Some(g) = &args.grade {
         f.insert("grade".into(), g.clone().into());
+    }
+    if let Some(p) = &d.navego_params {
+        f.insert("navego_params".into(), p.display().to_string().into());
+    }
+    if let Some(m) = &r.sensor_model {
+        // the model the filter used, in SI units (docs/own-data.md "Your sensor model")
+        f.insert("sensor_model".into(), m.to_toml().into());
     }
     if let Some(e) = args.every_s {
         f.insert("every_s".into(), e.into());

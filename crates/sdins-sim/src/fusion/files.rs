@@ -9,6 +9,7 @@ use crate::fusion::records::{
     fuse_records, RecordEvent, RecordInit, RecordModel, RecordOptions, RecordSummary,
     TruthComparison,
 };
+use crate::fusion::sensor_model::{read_sensor_model, SensorModel};
 use crate::fusion::simulated::{FuseError, InitSigma};
 use crate::io::columns::{ColumnsError, InputKind, MapOrigin};
 use crate::io::gnss_columns::{read_gnss_columns, GnssColumns, GnssSigma};
@@ -37,6 +38,9 @@ pub enum SensorModelSource {
     Model(Box<ImuErrorModel>),
     /// a NaveGo `imuN_params.txt`
     NavegoParams(PathBuf),
+    /// a sensor-model file (sdins TOML or KF-GINS YAML, [`crate::fusion::sensor_model`]),
+    /// already read
+    File(Box<SensorModel>),
 }
 
 /// Where the initial state comes from.
@@ -55,19 +59,49 @@ pub enum InitSource {
 }
 
 impl SensorModelSource {
-    /// From the two user options (a grade preset name, a NaveGo parameter file): exactly
-    /// one must be given. The message names the option (`--grade`, `--navego-params`).
-    pub fn from_options(grade: Option<&str>, navego_params: Option<&Path>) -> Result<Self, String> {
-        match (grade, navego_params) {
-            (Some(_), Some(_)) => Err("give either --grade or --navego-params, not both".into()),
-            (None, Some(p)) => Ok(SensorModelSource::NavegoParams(p.to_path_buf())),
-            (Some(g), None) => crate::sensors::imu_error::presets::preset(g)
+    /// From the three user options (a grade preset name, a NaveGo parameter file, a
+    /// sensor-model file): exactly one must be given. The message names the options
+    /// (`--grade`, `--navego-params`, `--sensor-model`). A sensor-model file is read here.
+    pub fn from_options(
+        grade: Option<&str>,
+        navego_params: Option<&Path>,
+        sensor_model: Option<&Path>,
+    ) -> Result<Self, String> {
+        let given: Vec<&str> = [
+            ("--grade", grade.is_some()),
+            ("--navego-params", navego_params.is_some()),
+            ("--sensor-model", sensor_model.is_some()),
+        ]
+        .iter()
+        .filter(|(_, g)| *g)
+        .map(|(n, _)| *n)
+        .collect();
+        if given.len() > 1 {
+            return Err(format!(
+                "give either {} or {}, not both (each sets the filter's IMU model)",
+                given[0], given[1]
+            ));
+        }
+        match (grade, navego_params, sensor_model) {
+            (None, Some(p), None) => Ok(SensorModelSource::NavegoParams(p.to_path_buf())),
+            (Some(g), None, None) => crate::sensors::imu_error::presets::preset(g)
                 .map(|m| SensorModelSource::Model(Box::new(m)))
                 .map_err(|e| format!("--grade: {e}")),
-            (None, None) => Err(
-                "the filter needs the IMU's error model: give --grade NAME or --navego-params FILE"
+            (None, None, Some(p)) => read_sensor_model(p)
+                .map(|m| SensorModelSource::File(Box::new(m)))
+                .map_err(|e| format!("--sensor-model: {e}")),
+            _ => Err(
+                "the filter needs the IMU's error model: give --grade NAME, --navego-params FILE or --sensor-model FILE"
                     .into(),
             ),
+        }
+    }
+
+    /// The sensor-model file, if that is the source.
+    pub fn file(&self) -> Option<&SensorModel> {
+        match self {
+            SensorModelSource::File(m) => Some(m),
+            _ => None,
         }
     }
 }
@@ -317,6 +351,8 @@ pub struct FilesResult {
     pub smoothed: Option<TruthComparison>,
     /// what the column maps did (time base, clock origin, offsets), IMU first
     pub inputs: Vec<InputReport>,
+    /// the sensor-model file used, if that was the source (for run.toml)
+    pub sensor_model: Option<SensorModel>,
 }
 
 /// Run it; `observe` sees every forward and smoothed point and every update, with the
@@ -378,6 +414,7 @@ pub fn fuse_files(
             navego = Some(prm);
             m
         }
+        SensorModelSource::File(m) => m.model,
     };
     let init = match input.init {
         InitSource::Given(state, sigma) => RecordInit::Given { state, sigma },
@@ -453,6 +490,7 @@ pub fn fuse_files(
         forward: fwd,
         smoothed: smo,
         inputs,
+        sensor_model: input.sensor.file().cloned(),
     })
 }
 

@@ -17,9 +17,10 @@ use crate::fusion::detector::DetectorSettings;
 use crate::fusion::files::{fuse_files, FilesError, FilesInput, FilesResult};
 use crate::fusion::files::{InitSource, InputColumns, SensorModelSource};
 use crate::fusion::records::{RecordEvent, RecordOptions, RecordPoint, TruthComparison};
+use crate::fusion::sensor_model::SensorModel;
 use crate::fusion::simulated::{
     fuse_scenario, FuseEpoch, FuseError, FuseEvent, FuseOptions, FuseSummary, InMotionInit,
-    ScaleFactorPrior,
+    InitSigma, ScaleFactorPrior,
 };
 use crate::io::gnss_file::{GnssFormat, GnssReadOptions, ImuClock};
 use crate::io::imu_file::ImuFormat;
@@ -69,6 +70,11 @@ pub struct FilesData {
     pub gnss_offset_s: f64,
     /// NaveGo IMU parameters (the filter's model; excludes `grade`)
     pub navego_params: Option<PathBuf>,
+    /// a sensor-model file, sdins TOML or KF-GINS YAML by its extension `.yaml`/`.yml`
+    /// (the filter's model, and optionally the lever arm, scale-factor σ and initial
+    /// attitude and σ; excludes `grade` and `navego_params`;
+    /// [`crate::fusion::sensor_model`])
+    pub sensor_model: Option<PathBuf>,
     /// initial state: the `--init` text
     pub init: Option<String>,
     /// initial attitude roll, pitch, yaw \[deg\] (position and velocity from the first fix)
@@ -147,13 +153,13 @@ impl FuseRequest {
 }
 
 impl FuseRequest {
-    /// Check the options shared by both modes (the rest is checked when it runs).
+    /// Check the options shared by both modes and, on files, the file options (the
+    /// sensor model is read; the data files are read when it runs).
     pub fn check(&self) -> Result<(), FuseRunError> {
-        let samples = match &self.data {
-            FuseData::Scenario(d) => d.scenario.nav.samples,
-            FuseData::Files(_) => 2,
-        };
-        common(self, samples).map(|_| ())
+        match &self.data {
+            FuseData::Scenario(d) => common(self, d.scenario.nav.samples).map(|_| ()),
+            FuseData::Files(d) => files_input(self, d).map(|_| ()),
+        }
     }
 }
 
@@ -539,16 +545,34 @@ pub fn files_input(
     if !d.gnss_offset_s.is_finite() {
         return Err(bad("gnss_offset_s", "--gnss-offset-s", "must be finite"));
     }
-    let sensor = SensorModelSource::from_options(req.grade.as_deref(), d.navego_params.as_deref())
-        .map_err(FuseRunError::Option)?;
-    let init = InitSource::from_options(
-        d.init.as_deref(),
-        d.attitude_deg,
-        d.attitude_sigma_deg,
-        d.static_s,
-        d.navego_params.is_some(),
+    let sensor = SensorModelSource::from_options(
+        req.grade.as_deref(),
+        d.navego_params.as_deref(),
+        d.sensor_model.as_deref(),
     )
     .map_err(FuseRunError::Option)?;
+    let file_model = sensor.file();
+    let init = init_source(d, file_model)?;
+    let lever_arm_b_m = match (d.lever_arm_m, file_model.and_then(|m| m.lever_arm_b_m)) {
+        (Some(_), Some(_)) => {
+            return Err(bad(
+                "lever_arm_m",
+                "--lever-arm-m",
+                "the sensor model (--sensor-model) gives the lever arm too: give one",
+            ))
+        }
+        (a, b) => a.or(b).unwrap_or([0.0; 3]),
+    };
+    let scale_factors = match (req.scale_factors, file_model.and_then(|m| m.scale_sigma)) {
+        (Some(_), Some(_)) => {
+            return Err(bad(
+                "scale_factors",
+                "--scale-factors-ppm",
+                "the sensor model (--sensor-model) gives the scale-factor σ too: give one",
+            ))
+        }
+        (a, b) => a.or(b),
+    };
     let input = FilesInput {
         imu: d.imu.clone(),
         gnss: d.gnss.clone(),
@@ -570,16 +594,72 @@ pub fn files_input(
         algo,
         cov_rate_hz: req.cov_rate_hz,
         gate_chi2: req.gate.then_some(CHI2_999),
-        lever_arm_b_m: d.lever_arm_m.unwrap_or([0.0; 3]),
+        lever_arm_b_m,
         nhc_sigma_mps: req.nhc_sigma_mps,
         zupt_detector: req.zupt_detector,
         smooth: req.smooth,
-        scale_factors: req.scale_factors,
+        scale_factors,
         every_s: req.every_s,
         max_latency_s: req.max_latency_s.unwrap_or(DEFAULT_MAX_LATENCY_S),
         ..RecordOptions::default()
     };
     Ok((input, opts))
+}
+
+/// The initial state of a files request: the options, completed by a sensor-model file
+/// (its attitude σ for `--attitude-deg` without `--attitude-sigma-deg`, its initial σ for
+/// `--init`, its attitude when none of `--init`, `--attitude-deg`, `--static-s` is given).
+fn init_source(d: &FilesData, file: Option<&SensorModel>) -> Result<InitSource, FuseRunError> {
+    let Some(m) = file else {
+        return InitSource::from_options(
+            d.init.as_deref(),
+            d.attitude_deg,
+            d.attitude_sigma_deg,
+            d.static_s,
+            d.navego_params.is_some(),
+        )
+        .map_err(FuseRunError::Option);
+    };
+    let s = m.initial_sigma;
+    if let Some(a) = s.att_rpy_rad {
+        if a.iter().any(|x| x.to_degrees() > 10.0) {
+            return Err(FuseRunError::Option(format!(
+                "--sensor-model {}: the initial attitude σ must be <= 10 deg (the linearised filter's limit)",
+                m.file.display()
+            )));
+        }
+    }
+    let none = d.init.is_none() && d.attitude_deg.is_none() && d.static_s.is_none();
+    if none {
+        if let Some(att) = m.attitude_rpy_rad {
+            let sig =
+                s.att_rpy_rad
+                    .unwrap_or([1f64.to_radians(), 1f64.to_radians(), 2f64.to_radians()]);
+            return Ok(InitSource::FirstFix(att, sig));
+        }
+    }
+    let att_sigma_deg = d
+        .attitude_sigma_deg
+        .or(s.att_rpy_rad.map(|a| a.map(f64::to_degrees)));
+    let init = InitSource::from_options(
+        d.init.as_deref(),
+        d.attitude_deg,
+        att_sigma_deg,
+        d.static_s,
+        false,
+    )
+    .map_err(FuseRunError::Option)?;
+    Ok(match init {
+        InitSource::Given(st, def) => InitSource::Given(
+            st,
+            InitSigma {
+                pos_ned_m: s.pos_ned_m.unwrap_or(def.pos_ned_m),
+                vel_ned_mps: s.vel_ned_mps.unwrap_or(def.vel_ned_mps),
+                att_rad: s.att_rpy_rad.unwrap_or(def.att_rad),
+            },
+        ),
+        other => other,
+    })
 }
 
 fn fuse_files_request(
