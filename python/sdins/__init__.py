@@ -545,8 +545,18 @@ def fuse_files(
     gnss_sigma: Optional[str] = None,
     undulation_m: Optional[float] = None,
     sensor_model: Optional[str] = None,
+    aiding: Optional[str] = None,
+    zupt_sigma_mps: Optional[float] = None,
+    zupt_window_s: Optional[float] = None,
+    zupt_false_alarm: Optional[float] = None,
 ) -> Dict[str, Any]:
     """INS/GNSS filter (and smoother) on recorded files (``sdins fuse --imu --gnss``).
+
+    ``aiding`` names the aiding sensors' TOML (barometer, odometer, magnetometer, dual
+    antenna, body velocity records and settings; docs/own-data.md "Aiding sensors", the
+    CLI's ``--aiding``). ``zupt_sigma_mps`` applies zero-velocity updates whenever the IMU's
+    stationarity detector declares rest (``--zupt-detector``; window ``zupt_window_s``,
+    default 0.5 s, false-alarm rate ``zupt_false_alarm``, default 1e-3).
 
     One's own files are read through column maps (docs/own-data.md), the strings of the
     CLI's ``--imu-columns``/``--gnss-columns``/``--truth-columns`` (e.g. ``imu_columns=
@@ -589,4 +599,6 @@ def fuse_files(
         scale_factors_ppm, every_s, max_latency_s, imu_columns, gnss_columns, truth_columns,
         None if profile is None else str(profile), gps_week, gnss_sigma, undulation_m,
         None if sensor_model is None else str(sensor_model),
+        None if aiding is None else str(aiding),
+        zupt_sigma_mps, zupt_window_s, zupt_false_alarm,
     )

@@ -312,7 +312,8 @@ impl Track {
     lever_arm_m=None, truth=None, smooth=None, algo=None, samples=None, cov_rate_hz=None,
     gate=None, nhc_sigma_mps=None, gnss_offset_s=None, scale_factors_ppm=None, every_s=None,
     max_latency_s=None, imu_columns=None, gnss_columns=None, truth_columns=None, profile=None,
-    gps_week=None, gnss_sigma=None, undulation_m=None, sensor_model=None))]
+    gps_week=None, gnss_sigma=None, undulation_m=None, sensor_model=None, aiding=None,
+    zupt_sigma_mps=None, zupt_window_s=None, zupt_false_alarm=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse_files<'py>(
     py: Python<'py>,
@@ -346,6 +347,10 @@ pub fn fuse_files<'py>(
     gnss_sigma: Option<String>,
     undulation_m: Option<f64>,
     sensor_model: Option<std::path::PathBuf>,
+    aiding: Option<std::path::PathBuf>,
+    zupt_sigma_mps: Option<f64>,
+    zupt_window_s: Option<f64>,
+    zupt_false_alarm: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     // the same maps as the CLI's --imu-columns, …; messages name the Python arguments
     let columns = sdins_sim::fusion::files::ColumnOptions {
@@ -372,6 +377,7 @@ pub fn fuse_files<'py>(
         lever_arm_m,
         truth,
         columns,
+        aiding,
     }));
     if let Some(a) = algo {
         req.algo = a.to_string();
@@ -380,6 +386,17 @@ pub fn fuse_files<'py>(
     req.cov_rate_hz = cov_rate_hz.unwrap_or(req.cov_rate_hz);
     req.gate = gate.unwrap_or(req.gate);
     req.nhc_sigma_mps = nhc_sigma_mps;
+    // on recorded data a ZUPT can only come from the stationarity detector
+    if let Some(sigma) = zupt_sigma_mps {
+        let d = sdins_sim::fusion::detector::DetectorSettings::default();
+        req.zupt_detector = Some((
+            sigma,
+            sdins_sim::fusion::detector::DetectorSettings {
+                window_s: zupt_window_s.unwrap_or(d.window_s),
+                false_alarm: zupt_false_alarm.unwrap_or(d.false_alarm),
+            },
+        ));
+    }
     req.smooth = smooth.unwrap_or(false);
     req.scale_factors = scale_factors_ppm.map(|(a, g)| ScaleFactorPrior::uniform(a, g));
     req.grade = grade.map(str::to_string);

@@ -8,7 +8,7 @@ use sdins_core::aiding::ekf::UpdateReport;
 use sdins_core::nav::NavState;
 use sdins_sim::cancel::CancelToken;
 use sdins_sim::fusion::files::{fuse_files, FilesInput, InitSource, SensorModelSource};
-use sdins_sim::fusion::records::{record_from_scenario, RecordEvent, RecordOptions};
+use sdins_sim::fusion::records::{record_from_scenario_with_aiding, RecordEvent, RecordOptions};
 use sdins_sim::fusion::simulated::{
     fuse_scenario, FuseEvent, FuseOptions, InitSigma, ScaleFactorPrior,
 };
@@ -21,6 +21,52 @@ use std::fmt::Write as _;
 /// A manoeuvring drive at 128 Hz (a dyadic sample period: the file's sample times are
 /// exact, so the reader's mean interval is the scenario's `1/128 s` to the bit).
 fn scenario() -> Scenario {
+    scenario_with("")
+}
+
+/// The aiding sensors of the two-path test: dyadic rates, so that every time of validity
+/// is exact in binary and in the file's decimals (the odometer without NHC rows: their
+/// simulated violation has no place in a record, where the constraint is zero).
+const AIDING: &str = "[baro]\nrate_hz = 1.0\n[odometer]\nrate_hz = 8.0\n[magnetometer]\nrate_hz = 4.0\n[dual_antenna]\nrate_hz = 2.0\nbaseline_b_m = [0.5, 1.5, 0.0]\n[body_velocity]\nrate_hz = 8.0\nlever_arm_b_m = [1.0, 0.0, 0.5]\n";
+
+/// The sensors' settings as an aiding TOML for the records written by [`write_aiding`].
+const AIDING_FILES: &str = "[baro]\nfile = \"baro.csv\"\n[odometer]\nfile = \"odo.csv\"\n[magnetometer]\nfile = \"mag.csv\"\n[dual_antenna]\nfile = \"dual.csv\"\ncolumns = \"t_s=t_s,az_rad=az_rad,el_rad=el_rad\"\nbaseline_b_m = [0.5, 1.5, 0.0]\n[body_velocity]\nfile = \"dvl.csv\"\nlever_arm_b_m = [1.0, 0.0, 0.5]\ncolumns = \"t_ms=time,v_x_mps=vx,v_y_mps=vy,v_z_mps=vz\"\n";
+
+/// Each aiding sensor's record in `dir` (the body-velocity record in milliseconds under
+/// its own header, read through a column map).
+fn write_aiding(dir: &std::path::Path, meas: &[sdins_core::aiding::sensors::AidingMeas]) {
+    use sdins_core::aiding::sensors::AidingMeas as A;
+    let mut f: [String; 5] = [
+        "t_s,h_m\n".into(),
+        "t_s,speed_mps\n".into(),
+        "t_s,m_x_ut,m_y_ut,m_z_ut\n".into(),
+        "t_s,az_rad,el_rad\n".into(),
+        "time,vx,vy,vz\n".into(),
+    ];
+    for m in meas {
+        match m {
+            A::Baro(b) => writeln!(f[0], "{},{}", b.t_s, b.h_baro_m),
+            A::Odometer(o) => writeln!(f[1], "{},{}", o.t_s, o.speed_mps),
+            A::Magnetometer(g) => {
+                let v = g.m_b_ut;
+                writeln!(f[2], "{},{},{},{}", g.t_s, v.x, v.y, v.z)
+            }
+            A::DualAntenna(d) => writeln!(f[3], "{},{},{}", d.t_s, d.az_rad, d.el_rad),
+            A::BodyVelocity(b) => {
+                let v = b.v_v_mps;
+                writeln!(f[4], "{},{},{},{}", b.t_s * 1e3, v.x, v.y, v.z)
+            }
+            _ => Ok(()),
+        }
+        .unwrap();
+    }
+    for (name, text) in ["baro", "odo", "mag", "dual", "dvl"].iter().zip(&f) {
+        std::fs::write(dir.join(format!("{name}.csv")), text).unwrap();
+    }
+    std::fs::write(dir.join("aiding.toml"), AIDING_FILES).unwrap();
+}
+
+fn scenario_with(aiding: &str) -> Scenario {
     let mut segs = String::new();
     for (kind, extra) in [
         ("accelerate", "accel_mps2 = 1.0"),
@@ -37,7 +83,7 @@ fn scenario() -> Scenario {
         .unwrap();
     }
     let toml = format!(
-        "name = \"two-paths\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nh_m = 100.0\nspeed_mps = 10.0\nyaw_deg = 30.0\n[imu]\nrate_hz = 128.0\nseed = 11\ngrade = \"tactical\"\n[nav]\nsamples = 2\n{segs}{segs}"
+        "name = \"two-paths\"\n[start]\nlat_deg = 37.5\nlon_deg = 127.0\nh_m = 100.0\nspeed_mps = 10.0\nyaw_deg = 30.0\n[imu]\nrate_hz = 128.0\nseed = 11\ngrade = \"tactical\"\n[nav]\nsamples = 2\n{aiding}{segs}{segs}"
     );
     Scenario::from_toml(&toml, "two-paths.toml").unwrap()
 }
@@ -63,12 +109,16 @@ fn bits(s: &NavState) -> Vec<u64> {
 
 #[test]
 fn scenario_in_memory_and_through_files_give_bit_identical_estimates() {
-    let scn = scenario();
     let gnss = GnssConfig::default();
     let run = 4;
     let dir = std::env::temp_dir().join(format!("sdins-two-paths-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    for sf in [None, Some(ScaleFactorPrior::uniform(300.0, 300.0))] {
+    for (sf, aiding) in [
+        (None, false),
+        (Some(ScaleFactorPrior::uniform(300.0, 300.0)), false),
+        (None, true),
+    ] {
+        let scn = scenario_with(if aiding { AIDING } else { "" });
         let every = 0.25;
         // in memory
         let opts = FuseOptions {
@@ -105,8 +155,11 @@ fn scenario_in_memory_and_through_files_give_bit_identical_estimates() {
             },
         )
         .unwrap();
-        // to files: the same run's IMU record and fixes
-        let (imu, fixes) = record_from_scenario(&scn, &gnss, run).unwrap();
+        // to files: the same run's IMU record and fixes (and the aiding sensors' records)
+        let (imu, fixes, rec) = record_from_scenario_with_aiding(&scn, &gnss, run).unwrap();
+        if aiding {
+            write_aiding(&dir, &rec.meas);
+        }
         let mut text =
             String::from("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n");
         for (k, i) in imu.increments.iter().enumerate() {
@@ -157,6 +210,7 @@ fn scenario_in_memory_and_through_files_give_bit_identical_estimates() {
             truth: None,
             check_after_s: 30.0,
             columns: Default::default(),
+            aiding: aiding.then(|| dir.join("aiding.toml")),
         };
         let ropts = RecordOptions {
             algo: opts.algo,
@@ -196,6 +250,18 @@ fn scenario_in_memory_and_through_files_give_bit_identical_estimates() {
             "{}",
             a.rows.len()
         );
+        if aiding {
+            // every aiding kind took part
+            for k in [
+                "baro",
+                "odometer",
+                "magnetometer",
+                "dual_antenna",
+                "body_velocity",
+            ] {
+                assert!(b.updates.iter().any(|u| u.kind.name() == k), "{k}");
+            }
+        }
         println!(
             "scale factors {}: {} rows, {} smoothed rows, {} updates ({} fixes)",
             sf.is_some(),

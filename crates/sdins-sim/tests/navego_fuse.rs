@@ -34,6 +34,7 @@ fn run(d: &Path, imu: &str) -> ([f64; 9], [f64; 9], [f64; 9], [f64; 9]) {
         truth: Some(d.join("ref.csv")),
         check_after_s: 30.0,
         columns: Default::default(),
+        aiding: None,
     };
     let opts = RecordOptions {
         algo: AlgorithmSpec::new(AlgorithmKind::SongLeeComplete, 1),

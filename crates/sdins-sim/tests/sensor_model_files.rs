@@ -74,6 +74,7 @@ fn request(d: &Path, navego: Option<PathBuf>, model: Option<PathBuf>) -> FuseReq
         lever_arm_m: None,
         truth: Some(d.join("ref.csv")),
         columns: Default::default(),
+        aiding: None,
     }));
     req.samples = Some(1);
     req

@@ -49,6 +49,11 @@ pub struct Args {
     /// the name ends in .yaml/.yml (docs/own-data.md "Your sensor model")
     #[arg(long, value_name = "FILE")]
     pub sensor_model: Option<PathBuf>,
+    /// recorded data: the aiding sensors' TOML (barometer, odometer, magnetometer, dual
+    /// antenna, body velocity: each record, its column map and the sensor's settings;
+    /// docs/own-data.md "Aiding sensors")
+    #[arg(long, value_name = "FILE")]
+    pub aiding: Option<PathBuf>,
     /// initial state lat_deg,lon_deg,h_m,v_n,v_e,v_d,roll_deg,pitch_deg,yaw_deg at the IMU record's start
     #[arg(long, allow_hyphen_values = true)]
     pub init: Option<String>,
@@ -242,12 +247,14 @@ pub fn request(a: &Args) -> Result<FuseRequest, CliError> {
                 lever_arm_m: opt_triple("--lever-arm-m", &a.lever_arm_m)?,
                 truth: a.truth.clone(),
                 columns: a.columns.resolve()?,
+                aiding: a.aiding.clone(),
             })
         }
         (None, Some(name)) => {
             for (flag, given) in [
                 ("--navego-params", a.navego_params.is_some()),
                 ("--sensor-model", a.sensor_model.is_some()),
+                ("--aiding", a.aiding.is_some()),
                 ("--init", a.init.is_some()),
                 ("--attitude-deg", a.attitude_deg.is_some()),
                 ("--static-s", a.static_s.is_some()),

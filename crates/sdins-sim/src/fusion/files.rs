@@ -169,6 +169,8 @@ pub struct FilesInput {
     pub check_after_s: f64,
     /// column maps of the IMU and GNSS files (each `None`: the file's fixed format)
     pub columns: InputColumns,
+    /// the aiding sensors' TOML file (docs/own-data.md §"Aiding sensors"), if any
+    pub aiding: Option<PathBuf>,
 }
 
 /// Column maps of a fused run's files (`crate::io::columns`; docs/own-data.md).
@@ -321,6 +323,9 @@ pub enum FilesError {
     /// the filter or an option
     #[error(transparent)]
     Fuse(#[from] FuseError),
+    /// the aiding sensors' files
+    #[error(transparent)]
+    Aiding(#[from] crate::io::aiding_file::AidingFileError),
 }
 
 /// What a fused run on files did.
@@ -468,6 +473,30 @@ pub fn fuse_files(
         truth.map(|t| TruthComparison::new(opts.earth, t, t_check))
     } else {
         None
+    };
+    // the aiding sensors' records, on the IMU map's clock (or the fixed format's seconds)
+    let aided;
+    let opts = match &input.aiding {
+        Some(p) => {
+            let spec = crate::io::aiding_file::read_aiding_spec(p)?;
+            let clock = inputs.first().map_or(
+                RunClock {
+                    scale: ClockScale::File,
+                    origin_s: 0,
+                },
+                |r| r.clock,
+            );
+            let meas = crate::io::aiding_file::read_aiding_records(&spec, &clock)?;
+            aided = RecordOptions {
+                aiding: crate::fusion::records::AidingRecord {
+                    config: spec.config,
+                    meas,
+                },
+                ..opts.clone()
+            };
+            &aided
+        }
+        None => opts,
     };
     let summary = fuse_records(&imu, &clip.fixes, &model, &init, opts, cancel, |ev| {
         let err = match ev {

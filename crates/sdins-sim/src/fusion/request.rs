@@ -90,6 +90,8 @@ pub struct FilesData {
     /// column maps of the IMU and GNSS files (docs/own-data.md; each `None`: the file's
     /// format)
     pub columns: InputColumns,
+    /// the aiding sensors' TOML file (docs/own-data.md §"Aiding sensors")
+    pub aiding: Option<PathBuf>,
 }
 
 /// A fusion request.
@@ -589,6 +591,7 @@ pub fn files_input(
         truth: d.truth.clone(),
         check_after_s: 30.0,
         columns: d.columns.clone(),
+        aiding: d.aiding.clone(),
     };
     let opts = RecordOptions {
         algo,

@@ -14,7 +14,8 @@
 //! Units ([`UNITS`]): angle `_rad`/`_deg`; angular rate `_radps` (`_rps`)/`_dps`/`_dph`;
 //! specific force `_mps2`/`_g`/`_mg` (g = [`G0`] unless the profile gives another);
 //! time `_s`/`_ms`/`_us`/`_ns`; length `_m`; speed `_mps`; increments `_rad_inc`/`_deg_inc`
-//! (angle) and `_mps_inc` (velocity). The sdins header spellings `dtheta_x_rad` and
+//! (angle) and `_mps_inc` (velocity); magnetic field `_ut`/`_nt`/`_gauss` (aiding files, in µT).
+//! The sdins header spellings `dtheta_x_rad` and
 //! `dv_x_mps` are increments too.
 
 use sdins_core::math::{c_b_n_from_euler, Euler, Mat3};
@@ -48,6 +49,8 @@ pub enum Dim {
     Speed,
     /// a count without unit (the GPS week)
     Count,
+    /// magnetic flux density (µT is the base: `to_si` gives µT)
+    Field,
 }
 
 /// One unit suffix: its spelling, what it measures and its factor to SI.
@@ -83,7 +86,7 @@ const fn t(suffix: &'static str, exp: u32) -> Unit {
 }
 
 /// Every unit suffix (one list for every input kind and for sensor-model files).
-pub const UNITS: [Unit; 19] = [
+pub const UNITS: [Unit; 22] = [
     t("s", 0),
     t("ms", 3),
     t("us", 6),
@@ -103,6 +106,9 @@ pub const UNITS: [Unit; 19] = [
     u("m", Dim::Length, 1.0),
     u("mps", Dim::Speed, 1.0),
     u("", Dim::Count, 1.0),
+    u("ut", Dim::Field, 1.0),
+    u("nt", Dim::Field, 1e-3),
+    u("gauss", Dim::Field, 100.0),
 ];
 
 /// Which kind of input a map is for.
@@ -115,6 +121,9 @@ pub enum InputKind {
     Gnss,
     /// reference (truth) trajectory
     Reference,
+    /// an aiding sensor's record (barometer, odometer, magnetometer, dual antenna, body
+    /// velocity)
+    Aiding,
 }
 
 impl InputKind {
@@ -124,6 +133,7 @@ impl InputKind {
             InputKind::Imu => "imu",
             InputKind::Gnss => "gnss",
             InputKind::Reference => "reference",
+            InputKind::Aiding => "aiding",
         }
     }
 }
@@ -174,6 +184,20 @@ fn quantities(kind: InputKind) -> &'static [(&'static str, &'static [Dim])] {
             ("sigma_ve", SPD),
             ("sigma_vd", SPD),
             ("sigma_vu", SPD),
+        ],
+        InputKind::Aiding => &[
+            TIME,
+            WEEK,
+            ("h", LEN),
+            ("speed", SPD),
+            ("v_x", SPD),
+            ("v_y", SPD),
+            ("v_z", SPD),
+            ("m_x", &[Dim::Field]),
+            ("m_y", &[Dim::Field]),
+            ("m_z", &[Dim::Field]),
+            ("az", ANG),
+            ("el", ANG),
         ],
         InputKind::Reference => &[
             TIME,

@@ -6,6 +6,7 @@
 //! RINEX GNSS observations and ephemerides ([`rinex`]). Readers never import the scenario format: the scenario
 //! loader calls them.
 
+pub mod aiding_file;
 pub mod columns;
 pub mod gnss_columns;
 pub mod gnss_file;
