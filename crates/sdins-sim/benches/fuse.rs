@@ -11,7 +11,8 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode};
 use sdins_sim::cancel::CancelToken;
 use sdins_sim::fusion::records::{
-    fuse_records, record_from_scenario, RecordEvent, RecordInit, RecordModel, RecordOptions,
+    fuse_records, record_from_scenario, record_from_scenario_with_aiding, RecordEvent, RecordInit,
+    RecordModel, RecordOptions,
 };
 use sdins_sim::fusion::simulated::InitSigma;
 use sdins_sim::scenario::Scenario;
@@ -89,6 +90,43 @@ fn fuse(c: &mut Criterion) {
             })
         });
     }
+    // the same hour with a 10 Hz odometer (speed and NHC rows) and a 1 Hz barometer
+    let scn_aid = Scenario::from_toml(
+        &format!(
+            "{}\n[odometer]\nrate_hz = 10.0\nnhc_sigma_mps = 0.1\n[baro]\nrate_hz = 1.0\n",
+            include_str!("../../../bench/scenarios/drive-1h-200hz.toml")
+        ),
+        "drive-1h-200hz-aided.toml",
+    )
+    .unwrap();
+    let (imu_a, fixes_a, aiding) =
+        record_from_scenario_with_aiding(&scn_aid, &GnssConfig::default(), 0).unwrap();
+    let opts = RecordOptions {
+        smooth: true,
+        cov_rate_hz: 1.0,
+        aiding,
+        ..Default::default()
+    };
+    g.bench_function("forward+smoother/cov_1hz/odometer_10hz_baro_1hz", |b| {
+        b.iter(|| {
+            let mut n = 0u64;
+            fuse_records(
+                &imu_a,
+                &fixes_a,
+                &model,
+                &init,
+                &opts,
+                &CancelToken::new(),
+                |ev| {
+                    if let RecordEvent::Smoothed(p) = ev {
+                        n += black_box(p.t_s) as u64 & 1;
+                    }
+                },
+            )
+            .unwrap();
+            n
+        })
+    });
     g.finish();
 
     // text parsing of the same hour (sdins increment CSV, 720 000 rows)
