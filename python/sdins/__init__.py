@@ -436,9 +436,13 @@ def fuse(
     grade: Optional[str] = None,
     every_s: Optional[float] = None,
     max_latency_s: Optional[float] = None,
+    zupt_detector: Optional[bool] = None,
 ) -> FuseResult:
     """Loosely coupled INS/GNSS filter on a scenario (``sdins fuse``, the same library
-    call); the scenario's ``[gnss]`` table sets the receiver.
+    call); the scenario's ``[gnss]`` table sets the receiver, its aiding-sensor tables
+    (``[baro]``, ``[odometer]``, …) the other sensors. ``zupt_detector`` True applies the
+    ``zupt_sigma_mps`` ZUPTs when the IMU's stationarity detector declares rest instead of
+    when the truth is at rest (``--zupt-detector``).
 
     Every parameter defaults to the library's: ``algo`` songlee-complete, ``samples`` the
     scenario's N (as the CLI), ``run`` 0 (IMU/GNSS/initial-error streams), ``cov_rate_hz``
@@ -461,7 +465,7 @@ def fuse(
         _sdins.fuse(
             _scenario(scenario), algo, samples, run, cov_rate_hz, gate, exact_start,
             zupt_sigma_mps, nhc_sigma_mps, until_s, smooth, in_motion, scale_factors_ppm,
-            grade, every_s, max_latency_s,
+            grade, every_s, max_latency_s, zupt_detector,
         )
     )
 

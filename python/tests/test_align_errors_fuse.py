@@ -356,3 +356,50 @@ def test_fuse_files_sensor_model(cli, tmp_path):
         want = js["forward_vs_truth"][n]["rmse"]
         got = r["forward_rmse"][i]
         assert (np.degrees(got) if i < 3 else got) == want, n
+
+
+def test_fuse_files_aiding_and_zupt_detector(cli, tmp_path):
+    """``aiding=`` (docs/own-data.md "Aiding sensors") and the ZUPT detector on recorded
+    data equal the CLI's ``--aiding --zupt-detector`` run; a bad aiding table is an error
+    naming it."""
+    imu, gnss, _ = _rate_logger(cli, tmp_path)
+    init = "37.5,127,0,10,0,0,0,0,0"
+    # an odometer on the IMU's clock (GPS seconds of week): the drive's 10 m/s at 10 Hz
+    sow0 = 345600.0
+    rows = ["time,v"] + [f"{sow0 + k / 10.0!r},10.0" for k in range(1, 300)]
+    (tmp_path / "odo.csv").write_text("\n".join(rows) + "\n")
+    aid = tmp_path / "aiding.toml"
+    aid.write_text('[odometer]\nfile = "odo.csv"\ncolumns = "t_s=time,speed_mps=v,time=gps-sow"\n'
+                   "sigma_mps = 0.1\n")
+    code, out, err = cli(
+        "fuse", "--imu", str(imu), "--gnss", str(gnss), "--imu-columns", RATE_MAP,
+        "--gnss-columns", FIX_MAP, "--gnss-sigma", "1,1,2", "--grade", "tactical",
+        "--init", init, "--json", "--health", "warn", "--aiding", str(aid),
+        "--zupt-detector", "--zupt-sigma-mps", "0.01", "--out", str(tmp_path / "o"))
+    assert code == 0, err
+    js = json.loads(out)
+    r = sdins.fuse_files(str(imu), str(gnss), imu_columns=RATE_MAP, gnss_columns=FIX_MAP,
+                         gnss_sigma="1,1,2", grade="tactical", init=init, aiding=str(aid),
+                         zupt_sigma_mps=0.01)
+    assert r["fixes_used"] == js["fixes_used"]
+    assert js["measurements"]["odometer"]["applied"] > 250
+    # the innovations carry the odometer updates too
+    assert sum(1 for k in r["innovations"]["kind"] if k == "odometer") == \
+        sum(js["measurements"]["odometer"][k] for k in ("applied", "rejected", "late"))
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[wheel]\nfile = "odo.csv"\n')
+    with pytest.raises(sdins.SdinsError, match=r"unknown table `\[wheel\]`"):
+        sdins.fuse_files(str(imu), str(gnss), imu_columns=RATE_MAP, gnss_columns=FIX_MAP,
+                         gnss_sigma="1,1,2", grade="tactical", init=init, aiding=str(bad))
+
+
+def test_fuse_scenario_aiding_sensors_and_zupt_detector():
+    """A scenario's aiding sensors are fused from Python as from the CLI; the ZUPT from the
+    stationarity detector needs its σ."""
+    scn = sdins.Scenario.builtin("car-odometer")
+    r = sdins.fuse(scn, zupt_sigma_mps=0.01, zupt_detector=True, until_s=60.0)
+    kinds = set(r.innovations["kind"])
+    assert {"gnss", "odometer", "zupt"} <= kinds, kinds
+    assert r.health["ok"], r.health
+    with pytest.raises(sdins.SdinsError, match="zupt_detector needs zupt_sigma_mps"):
+        sdins.fuse(scn, zupt_detector=True, until_s=10.0)

@@ -80,7 +80,7 @@ fn scenario_request(
 #[pyo3(signature = (scenario, algo=None, samples=None, run=None, cov_rate_hz=None,
     gate=None, exact_start=None, zupt_sigma_mps=None, nhc_sigma_mps=None, until_s=None,
     smooth=None, in_motion=None, scale_factors_ppm=None, grade=None, every_s=None,
-    max_latency_s=None))]
+    max_latency_s=None, zupt_detector=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fuse<'py>(
     py: Python<'py>,
@@ -100,8 +100,9 @@ pub fn fuse<'py>(
     grade: Option<&str>,
     every_s: Option<f64>,
     max_latency_s: Option<f64>,
+    zupt_detector: Option<bool>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let req = scenario_request(
+    let mut req = scenario_request(
         scenario,
         algo,
         samples,
@@ -119,6 +120,16 @@ pub fn fuse<'py>(
         every_s,
         max_latency_s,
     )?;
+    // the detector trigger takes the ZUPT σ from the truth trigger
+    if zupt_detector.unwrap_or(false) {
+        if let FuseData::Scenario(d) = &mut req.data {
+            let sigma = d.zupt_sigma_mps.take().ok_or_else(|| {
+                err("zupt_detector needs zupt_sigma_mps (the ZUPT's σ)")
+            })?;
+            req.zupt_detector = Some((sigma, Default::default()));
+        }
+        req.check().map_err(run_err)?;
+    }
     #[derive(Default)]
     struct Ep {
         t: Vec<f64>,

@@ -399,6 +399,83 @@ impl Iterator for RecordStream<'_> {
     }
 }
 
+/// False-alarm rate per window of the static-window check: strong evidence of motion
+/// only (over a 600 s window of 1 s windows the chance of refusing a record at rest is
+/// 6e-4).
+pub const STATIC_CHECK_ALPHA: f64 = 1e-6;
+
+/// `--static-s`: refuse a window that moves. The stationarity detector
+/// ([`crate::fusion::detector`], 1 s windows or the nearest supported size that fits) with
+/// the coarse attitude's earth rate, the known biases removed and the prior bias σ's as
+/// the residual ones, at [`STATIC_CHECK_ALPHA`] per window over the disjoint windows of
+/// the static interval. Without a noise model (an ideal IMU) or with residual biases
+/// that would decide the test, there is nothing to judge by and the window is accepted.
+#[allow(clippy::too_many_arguments)]
+fn static_window_check(
+    imu: &ImuData,
+    m_samples: usize,
+    model: &RecordModel,
+    c_b_n: &Mat3,
+    site: &Site,
+    earth: &EarthModel,
+    lat_rad: f64,
+) -> Result<(), FuseError> {
+    use crate::fusion::detector::{AnyDetector, DetectorSettings, WINDOWS};
+    let dt = imu.dt_s;
+    let max3 = |v: &Vec3| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    // the largest supported window of at most 1 s that fits the interval
+    let Some(w) = WINDOWS
+        .iter()
+        .copied()
+        .filter(|w| (*w as f64) * dt <= 1.0 + 1e-9 && *w <= m_samples)
+        .max()
+    else {
+        return Ok(());
+    };
+    let settings = DetectorSettings {
+        window_s: w as f64 * dt,
+        false_alarm: STATIC_CHECK_ALPHA,
+    };
+    let Ok(mut det) = AnyDetector::new(
+        &settings,
+        max3(&model.noise.vrw_mps_per_sqrt_s),
+        max3(&model.noise.arw_rad_per_sqrt_s),
+        dt,
+        site.g_mps2,
+        max3(&model.accel_bias_sigma_mps2),
+        max3(&model.gyro_bias_sigma_rps),
+    ) else {
+        return Ok(());
+    };
+    if det
+        .set_estimates(
+            &model.accel_bias0_mps2,
+            &model.gyro_bias0_rps,
+            c_b_n,
+            &earth.omega_ie_n(lat_rad),
+        )
+        .is_err()
+    {
+        return Ok(());
+    }
+    for (k, inc) in imu.increments[..m_samples].iter().enumerate() {
+        // the disjoint windows: the report of every W-th sample
+        if let Ok(Some(false)) = det.push(inc) {
+            if (k + 1) % w == 0 {
+                let t1 = imu.t0_s + dt * k as f64;
+                return Err(opt_err(
+                    "static_window_s",
+                    format!(
+                        "the IMU moves in the static window: the {:.2} s ending at t = {t1} s is declared moving by the stationarity detector (false-alarm rate {STATIC_CHECK_ALPHA:e} per window); shorten --static-s or give the attitude (--attitude-deg, --init)",
+                        w as f64 * dt
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Run the filter (and the smoother) over recorded data. `fixes` must be on the IMU
 /// clock and in time order (the readers guarantee it); fixes outside the record are
 /// ignored (clip them first with `gnss_file::clip_to_imu_span` to count them).
@@ -647,6 +724,7 @@ fn initial(
             let site = Site::from_earth(&earth, f0.lat_rad, f0.h_m);
             let c = coarse_align(CoarseMethod::TwoStep, &mean, &site)
                 .map_err(|e| opt_err("static_window_s", format!("coarse alignment: {e}")))?;
+            static_window_check(imu, m_samples, model, &c, &site, &earth, f0.lat_rad)?;
             let (mut st, pp) = from_fix(&earth, &fixes[..1], c, lever)?;
             st.v_n_mps = Vec3::zeros();
             p0.fixed_view_mut::<3, 3>(I_POS, I_POS)
