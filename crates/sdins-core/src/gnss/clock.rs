@@ -231,12 +231,13 @@ mod tests {
     /// own confidence; 4 s.e. with 11 dof is a two-sided 0.2 % test), and the standard
     /// error is small enough (< 12 %) that a wrong term would show.
     #[test]
+    #[allow(clippy::needless_range_loop)] // `r` is both the stream and the column
     fn allan_variance_of_the_simulated_phase_matches_the_model() {
         use rand::SeedableRng;
         use rand_distr::{Distribution, StandardNormal};
         let m = ClockModel::TCXO;
         let dt = 0.01;
-        let n = 60_000;
+        const N: usize = 60_000;
         let taus = [1usize, 10, 100, 1000]; // τ = 0.01, 0.1, 1, 10 s
         let runs = 12;
         let mut est = [[0.0; 12]; 4];
@@ -244,7 +245,7 @@ mod tests {
             let mut rng = rand_chacha::ChaCha20Rng::seed_from_u64(29);
             rng.set_stream(r as u64);
             let mut s = ClockState::default();
-            let mut x = alloc_free_vec(n);
+            let mut x = [0.0_f64; N]; // no_std: a fixed array, not a Vec
             for xi in x.iter_mut() {
                 let w = [
                     StandardNormal.sample(&mut rng),
@@ -270,11 +271,5 @@ mod tests {
                 "τ = {tau} s: Allan variance {mean:.3e} ± {se:.1e}, model {th:.3e}"
             );
         }
-    }
-
-    /// A fixed-capacity phase buffer (the crate is `no_std`; tests keep to arrays).
-    fn alloc_free_vec(n: usize) -> [f64; 60_000] {
-        assert!(n == 60_000);
-        [0.0; 60_000]
     }
 }

@@ -200,9 +200,8 @@ impl RawGnssTable {
             ));
         }
         for p in &self.sky_mask_az_el_deg {
-            if !(p[0].is_finite() && (0.0..=360.0).contains(&p[0]))
-                || !(p[1].is_finite() && (0.0..=90.0).contains(&p[1]))
-            {
+            let ok = (0.0..=360.0).contains(&p[0]) && (0.0..=90.0).contains(&p[1]);
+            if !ok {
                 return Err(bad(
                     "sky_mask_az_el_deg",
                     format!("points are [az in 0…360, el in 0…90], got {p:?}"),
@@ -373,5 +372,62 @@ impl RawGnssConfig {
             }
         }
         p[0][1]
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// The re-epoched nominal sets fly the same orbits: every set gives the same satellite
+    /// position at the same instant (to a micrometre), across a week boundary too.
+    #[test]
+    fn reepoched_nominal_sets_are_the_same_orbits() {
+        for t0 in [
+            GpsTime::new(2304, 208_800.0),
+            GpsTime::new(2304, 604_800.0 - 3600.0),
+        ] {
+            let e = nominal_for(t0, 5.0 * 3600.0);
+            assert_eq!(e.len(), 24 * 4);
+            for k in 1..4 {
+                for i in 0..24 {
+                    let (a, b) = (&e[i], &e[24 * k + i]);
+                    assert_eq!(a.prn, b.prn);
+                    let t = b.toe.add_s(-1234.5);
+                    let d = a.state(&t).unwrap().r_sat_e_m - b.state(&t).unwrap().r_sat_e_m;
+                    assert!(d.norm() < 1e-6, "set {k} G{:02}: {}", a.prn, d.norm());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sky_mask_is_piecewise_linear_and_wraps() {
+        let table = RawGnssTable {
+            sky_mask_az_el_deg: vec![[90.0, 40.0], [350.0, 20.0], [10.0, 30.0]],
+            ..RawGnssTable::default()
+        };
+        let c = RawGnssConfig {
+            table,
+            start: GpsTime::new(2304, 0.0),
+            ephemerides: Vec::new(),
+            klobuchar: KLOBUCHAR_DEFAULT,
+            nominal: true,
+        };
+        assert!((c.sky_mask_el_deg(10.0) - 30.0).abs() < 1e-12);
+        assert!((c.sky_mask_el_deg(50.0) - 35.0).abs() < 1e-12);
+        assert!((c.sky_mask_el_deg(220.0) - 30.0).abs() < 1e-12); // 90 → 350 halfway
+        assert!((c.sky_mask_el_deg(0.0) - 25.0).abs() < 1e-12); // 350 → 10 across north
+        assert!((c.sky_mask_el_deg(355.0) - 22.5).abs() < 1e-12);
+        assert_eq!(
+            parse_gpst("2304 208800"),
+            Some(GpsTime::new(2304, 208_800.0))
+        );
+        assert_eq!(
+            parse_gpst("2024-03-05 10:00:00"),
+            Some(GpsTime::from_calendar(2024, 3, 5, 10, 0, 0.0))
+        );
+        assert_eq!(parse_gpst("2024-13-05 10:00:00"), None);
     }
 }
