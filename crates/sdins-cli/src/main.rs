@@ -64,6 +64,8 @@ enum Command {
     Merge(cmd::merge::Args),
     /// GNSS single-point positioning and Doppler velocity from RINEX observation and navigation files.
     Spp(cmd::spp::Args),
+    /// Raw GNSS simulation: a scenario's [raw_gnss] measurements as RINEX 3.04 observation and navigation files.
+    GnssSim(cmd::gnss_sim::Args),
 }
 
 fn main() -> ExitCode {
@@ -108,5 +110,6 @@ fn dispatch(command: Command) -> Result<(), error::CliError> {
         Command::Merge(a) => cmd::merge::run(a),
         Command::Fuse(a) => cmd::fuse::run(*a),
         Command::Spp(a) => cmd::spp::run(a),
+        Command::GnssSim(a) => cmd::gnss_sim::run(a),
     }
 }

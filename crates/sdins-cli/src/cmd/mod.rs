@@ -12,6 +12,7 @@ pub mod fuse_files;
 pub mod fuse_mc;
 pub mod fuse_out;
 pub mod fuse_report;
+pub mod gnss_sim;
 pub mod merge;
 pub mod montecarlo;
 pub mod nav;

@@ -16,6 +16,7 @@
 //! navigation frame), `_m`, `_mps`, `_s`, `_sps` (seconds per second), `_rad`.
 
 mod atmosphere;
+mod clock;
 mod doppler;
 mod ephemeris;
 mod geometry;
@@ -29,6 +30,7 @@ pub use atmosphere::{
     saastamoinen_slant_m, saastamoinen_zenith_m, KlobucharCoefficients, TropoZenith,
     KLOBUCHAR_DEFAULT, STANDARD_HUMIDITY,
 };
+pub use clock::{ClockModel, ClockNoise, ClockState};
 pub use doppler::{solve_velocity, DopplerSatellite, VelocityOptions, VelocitySolution};
 pub use ephemeris::{select_ephemeris, GpsEphemeris, SatState, DEFAULT_VALIDITY_S};
 pub use geometry::{

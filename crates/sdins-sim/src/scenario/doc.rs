@@ -59,6 +59,7 @@ pub(super) struct FileDoc {
     pub(super) magnetometer: Option<S<crate::sensors::aiding::MagnetometerConfig>>,
     pub(super) dual_antenna: Option<S<crate::sensors::aiding::DualAntennaConfig>>,
     pub(super) body_velocity: Option<S<crate::sensors::aiding::BodyVelocityConfig>>,
+    pub(super) raw_gnss: Option<S<crate::sensors::raw_gnss::RawGnssTable>>,
     pub(super) calibration: Option<S<CalibrationDoc>>,
     pub(super) body_motion: Option<S<BodyMotionDoc>>,
     #[serde(default)]

@@ -173,6 +173,7 @@ pub fn scenario_from_reference(
         trajectory,
         gnss: None,
         aiding: Default::default(),
+        raw_gnss: None,
         source_toml: format!(
             "# sdins truth --from-reference {} --rate-hz {}\n",
             path.display(),

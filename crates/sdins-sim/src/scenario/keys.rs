@@ -23,6 +23,7 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
             "magnetometer",
             "dual_antenna",
             "body_velocity",
+            "raw_gnss",
             "calibration",
             "body_motion",
             "command",
@@ -108,6 +109,7 @@ pub const ACCEPTED_KEYS: &[(&str, &[&str])] = &[
         ],
     ),
     GNSS_KEYS,
+    RAW_GNSS_KEYS,
     (
         "baro",
         &[
@@ -222,6 +224,37 @@ pub(super) const GNSS_KEYS: (&str, &[&str]) = (
         "outliers_t_s_ned_m",
         "latency_s",
         "latency_modelled",
+        "seed",
+    ],
+);
+
+// ---- [raw_gnss] (raw GNSS measurement simulation) ----
+/// Keys of the `[raw_gnss]` table (`crate::sensors::raw_gnss::RawGnssTable`).
+pub(super) const RAW_GNSS_KEYS: (&str, &[&str]) = (
+    "raw_gnss",
+    &[
+        "rate_hz",
+        "start_gpst",
+        "nav_file",
+        "klobuchar_alpha",
+        "klobuchar_beta",
+        "mask_deg",
+        "sky_mask_az_el_deg",
+        "prns",
+        "sigma_pr_m",
+        "sigma_rr_mps",
+        "h0_s",
+        "h_m2_per_s",
+        "iono_scale",
+        "iono_resid_frac",
+        "iono_resid_tau_s",
+        "tropo_resid_zenith_m",
+        "tropo_resid_tau_s",
+        "sis_ura_scale",
+        "lever_arm_b_m",
+        "clock_jump_t_s_ms",
+        "outliers_t_s_prn_m",
+        "outages_s",
         "seed",
     ],
 );

@@ -190,6 +190,8 @@ pub struct Scenario {
     /// aiding sensors (`[baro]`, `[odometer]`, `[magnetometer]`, `[dual_antenna]`,
     /// `[body_velocity]`)
     pub aiding: crate::sensors::aiding::AidingConfig,
+    /// raw GNSS measurement simulation (`[raw_gnss]`, satellites loaded), if any
+    pub raw_gnss: Option<crate::sensors::raw_gnss::RawGnssConfig>,
     /// the scenario text exactly as it was read (provenance: `run.toml` records this, not
     /// the file as it may be later)
     pub source_toml: String,
@@ -213,6 +215,25 @@ impl Scenario {
             h0_m: self.start.h_m,
             substeps: self.nav.substeps,
         }
+    }
+
+    /// The raw GNSS measurements of run `run` of the `[raw_gnss]` table over the whole
+    /// trajectory (`crate::sensors::raw_gnss::simulate`).
+    pub fn simulate_raw_gnss(
+        &self,
+        run: u64,
+    ) -> Result<crate::sensors::raw_gnss::RawGnssRecord, crate::sensors::raw_gnss::RawGnssError>
+    {
+        let cfg = self
+            .raw_gnss
+            .as_ref()
+            .ok_or(crate::sensors::raw_gnss::RawGnssError::NoTable)?;
+        Ok(crate::sensors::raw_gnss::simulate(
+            &self.trajectory,
+            self.truth_config(),
+            cfg,
+            run,
+        ))
     }
 
     /// Read and validate a scenario file.

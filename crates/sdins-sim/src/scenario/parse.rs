@@ -794,6 +794,32 @@ impl Scenario {
         };
         // aiding-sensor tables
         let aiding = parse_aiding(&cx, &doc)?;
+        // [raw_gnss]: validated, satellites loaded (nav_file relative to the scenario)
+        let raw_gnss = match &doc.raw_gnss {
+            None => None,
+            Some(t) => {
+                let nav = match &t.get_ref().nav_file {
+                    None => None,
+                    Some(f) => {
+                        let base = Path::new(file).parent().unwrap_or(Path::new(""));
+                        match crate::io::rinex::read_nav(&base.join(f)) {
+                            Ok(n) => Some((n.ephemerides, n.klobuchar)),
+                            Err(e) => return cx.err(t.span(), "raw_gnss.nav_file", e.to_string()),
+                        }
+                    }
+                };
+                match crate::sensors::raw_gnss::RawGnssConfig::resolve(
+                    t.get_ref(),
+                    nav,
+                    trajectory.duration_s,
+                ) {
+                    Ok(c) => Some(c),
+                    Err(crate::sensors::raw_gnss::RawGnssConfigError::Invalid { key, what }) => {
+                        return cx.err(t.span(), &format!("raw_gnss.{key}"), what);
+                    }
+                }
+            }
+        };
         Ok(Scenario {
             name: doc.name.unwrap_or_else(|| {
                 Path::new(file)
@@ -807,6 +833,7 @@ impl Scenario {
             trajectory,
             gnss,
             aiding,
+            raw_gnss,
             source_toml: text.to_string(),
             mounting,
             vibration: vib_reports,

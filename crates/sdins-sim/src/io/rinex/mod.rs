@@ -20,6 +20,7 @@
 mod error;
 mod nav;
 mod obs;
+mod raw_out;
 mod text;
 mod write;
 
