@@ -123,9 +123,10 @@ pub fn fuse<'py>(
     // the detector trigger takes the ZUPT σ from the truth trigger
     if zupt_detector.unwrap_or(false) {
         if let FuseData::Scenario(d) = &mut req.data {
-            let sigma = d.zupt_sigma_mps.take().ok_or_else(|| {
-                err("zupt_detector needs zupt_sigma_mps (the ZUPT's σ)")
-            })?;
+            let sigma = d
+                .zupt_sigma_mps
+                .take()
+                .ok_or_else(|| err("zupt_detector needs zupt_sigma_mps (the ZUPT's σ)"))?;
             req.zupt_detector = Some((sigma, Default::default()));
         }
         req.check().map_err(run_err)?;

@@ -18,12 +18,6 @@ use sdins_sim::scenario::Scenario;
 use sdins_sim::sensors::gnss::GnssConfig;
 use std::fmt::Write as _;
 
-/// A manoeuvring drive at 128 Hz (a dyadic sample period: the file's sample times are
-/// exact, so the reader's mean interval is the scenario's `1/128 s` to the bit).
-fn scenario() -> Scenario {
-    scenario_with("")
-}
-
 /// The aiding sensors of the two-path test: dyadic rates, so that every time of validity
 /// is exact in binary and in the file's decimals (the odometer without NHC rows: their
 /// simulated violation has no place in a record, where the constraint is zero).
@@ -66,6 +60,9 @@ fn write_aiding(dir: &std::path::Path, meas: &[sdins_core::aiding::sensors::Aidi
     std::fs::write(dir.join("aiding.toml"), AIDING_FILES).unwrap();
 }
 
+/// A manoeuvring drive at 128 Hz (a dyadic sample period: the file's sample times are
+/// exact, so the reader's mean interval is the scenario's `1/128 s` to the bit), with the
+/// sensor tables `aiding`.
 fn scenario_with(aiding: &str) -> Scenario {
     let mut segs = String::new();
     for (kind, extra) in [
