@@ -76,6 +76,11 @@ const RULES: &[Rule] = &[
         "my-cal.toml",
         Before("test -f my-cal.toml || sdins scenarios calibration > my-cal.toml"),
     ),
+    // a street canyon: 60 s at 10 m/s with a sky mask (docs/scenarios.md `[raw_gnss]`)
+    rule(
+        "canyon.toml",
+        Before("test -f canyon.toml || printf '%s\\n' 'name = \"canyon\"' '[start]' 'lat_deg = 45.0' 'lon_deg = 10.0' 'speed_mps = 10.0' '[imu]' 'rate_hz = 100.0' '[[segment]]' 'type = \"cruise\"' 'duration_s = 60.0' '[raw_gnss]' 'sky_mask_az_el_deg = [[0.0, 15.0], [80.0, 60.0], [100.0, 60.0], [180.0, 15.0], [260.0, 60.0], [280.0, 60.0]]' > canyon.toml"),
+    ),
     rule(
         "--imu cal-imu/imu.csv",
         Before("test -f cal-imu/imu.csv || sdins truth calibration --out cal-imu --every 100 --quiet"),
