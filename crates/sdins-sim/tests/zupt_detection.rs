@@ -63,17 +63,9 @@ fn rates(grades: &[&str], cycles: u32, cruise_s: f64) {
         let scn = car(grade, cycles, cruise_s);
         // the prediction from the threshold and the vibration level
         let (noise, s_ba, s_bg, ..) = noise_from_model(&scn.imu.model);
-        let max3 = |v: &sdins_core::math::Vec3| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        let det = AnyDetector::new(
-            &settings,
-            max3(&noise.vrw_mps_per_sqrt_s),
-            max3(&noise.arw_rad_per_sqrt_s),
-            scn.imu.dt_s(),
-            9.8,
-            max3(&s_ba),
-            max3(&s_bg),
-        )
-        .unwrap();
+        let det =
+            AnyDetector::from_filter_noise(&settings, &noise, scn.imu.dt_s(), 9.8, &s_ba, &s_bg)
+                .unwrap();
         let alpha = det
             .probability_declared_moving(&MotionModel::default())
             .unwrap();

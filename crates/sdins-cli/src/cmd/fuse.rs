@@ -161,10 +161,11 @@ fn report(
         &FuseReportData {
             title: format!("sdins fuse: {name}"),
             intro: format!(
-                "Scenario {name} run {run}: {} GNSS fixes ({} rejected, {} late), algorithm {} N = {}, covariance at {} Hz{}; errors against the exact truth.",
+                "Scenario {name} run {run}: {} GNSS fixes ({} rejected, {} late){}, algorithm {} N = {}, covariance at {} Hz{}; errors against the exact truth.",
                 o.fixes,
                 o.rejected,
                 o.late,
+                super::fuse_args::measurements_text(&o.measurements),
                 args.algo,
                 o.algo.samples,
                 args.cov_rate_hz,

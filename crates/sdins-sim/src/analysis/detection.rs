@@ -14,7 +14,6 @@ use crate::fusion::simulated::noise_from_model;
 use crate::scenario::Scenario;
 use crate::sensors::imu_error::ImuErrorState;
 use crate::truth::TruthGenerator;
-use sdins_core::math::Vec3;
 
 /// Speed below which the truth is at rest \[m/s\].
 pub const REST_SPEED_MPS: f64 = 1e-3;
@@ -71,17 +70,15 @@ pub fn detection_rates(
     let earth = scn.nav.earth.model();
     let dt = scn.imu.dt_s();
     let (noise, s_ba, s_bg, known_ba, known_bg) = noise_from_model(&scn.imu.model);
-    let max3 = |v: &Vec3| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
     let gen = TruthGenerator::new(&scn.trajectory, scn.truth_config());
     let init = gen.initial_state();
-    let mut det = AnyDetector::new(
+    let mut det = AnyDetector::from_filter_noise(
         settings,
-        max3(&noise.vrw_mps_per_sqrt_s),
-        max3(&noise.arw_rad_per_sqrt_s),
+        &noise,
         dt,
         earth.gravity(init.lat_rad, init.h_m),
-        max3(&s_ba),
-        max3(&s_bg),
+        &s_ba,
+        &s_bg,
     )?;
     let omega_ie_n = earth.omega_ie_n(init.lat_rad);
     det.set_estimates(&known_ba, &known_bg, &init.c_b_n, &omega_ie_n)

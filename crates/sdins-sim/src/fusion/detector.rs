@@ -188,6 +188,30 @@ impl AnyDetector {
     }
 }
 
+impl AnyDetector {
+    /// [`AnyDetector::new`] from the filter's white noise and the residual-bias σ's per
+    /// axis, each taken at its largest axis (the test is isotropic).
+    pub fn from_filter_noise(
+        settings: &DetectorSettings,
+        noise: &sdins_core::aiding::ekf::NoiseModel,
+        dt_s: f64,
+        g_mps2: f64,
+        sigma_accel_bias_mps2: &Vec3,
+        sigma_gyro_bias_rps: &Vec3,
+    ) -> Result<Self, DetectorError> {
+        let max3 = |v: &Vec3| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        Self::new(
+            settings,
+            max3(&noise.vrw_mps_per_sqrt_s),
+            max3(&noise.arw_rad_per_sqrt_s),
+            dt_s,
+            g_mps2,
+            max3(sigma_accel_bias_mps2),
+            max3(sigma_gyro_bias_rps),
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]

@@ -545,22 +545,9 @@ fn build_detector(
     cfg: &EngineConfig,
     start: &Start,
 ) -> Result<AnyDetector, EngineError> {
-    let max3 = |v: &Vec3| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-    let sd = |o: usize| {
-        (0..3).fold(0.0f64, |a, i| {
-            a.max(start.p0[(o + i, o + i)].max(0.0).sqrt())
-        })
-    };
+    let sd = |o: usize| Vec3::from_fn(|i, _| start.p0[(o + i, o + i)].max(0.0).sqrt());
     let g = cfg.earth.gravity(start.state.lat_rad, start.state.h_m);
-    let mut d = AnyDetector::new(
-        ds,
-        max3(&cfg.noise.vrw_mps_per_sqrt_s),
-        max3(&cfg.noise.arw_rad_per_sqrt_s),
-        cfg.dt_s,
-        g,
-        sd(9),
-        sd(12),
-    )?;
+    let mut d = AnyDetector::from_filter_noise(ds, &cfg.noise, cfg.dt_s, g, &sd(9), &sd(12))?;
     let b_a = Vec3::new(start.est0[9], start.est0[10], start.est0[11]);
     let b_g = Vec3::new(start.est0[12], start.est0[13], start.est0[14]);
     d.set_estimates(

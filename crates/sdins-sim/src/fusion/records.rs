@@ -422,7 +422,6 @@ fn static_window_check(
 ) -> Result<(), FuseError> {
     use crate::fusion::detector::{AnyDetector, DetectorSettings, WINDOWS};
     let dt = imu.dt_s;
-    let max3 = |v: &Vec3| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
     // the largest supported window of at most 1 s that fits the interval
     let Some(w) = WINDOWS
         .iter()
@@ -436,14 +435,13 @@ fn static_window_check(
         window_s: w as f64 * dt,
         false_alarm: STATIC_CHECK_ALPHA,
     };
-    let Ok(mut det) = AnyDetector::new(
+    let Ok(mut det) = AnyDetector::from_filter_noise(
         &settings,
-        max3(&model.noise.vrw_mps_per_sqrt_s),
-        max3(&model.noise.arw_rad_per_sqrt_s),
+        &model.noise,
         dt,
         site.g_mps2,
-        max3(&model.accel_bias_sigma_mps2),
-        max3(&model.gyro_bias_sigma_rps),
+        &model.accel_bias_sigma_mps2,
+        &model.gyro_bias_sigma_rps,
     ) else {
         return Ok(());
     };

@@ -106,7 +106,8 @@ struct Point {
 /// The aiding-sensor simulator of one run.
 #[derive(Clone, Debug)]
 pub struct AidingSimulator {
-    cfg: AidingConfig,
+    /// shared, so that a step borrows it without cloning its outage lists per sample
+    cfg: std::sync::Arc<AidingConfig>,
     earth: EarthModel,
     clocks: [Clock; 5],
     rngs: [ChaCha20Rng; 5],
@@ -160,7 +161,7 @@ impl AidingSimulator {
             )
         });
         Self {
-            cfg: cfg.clone(),
+            cfg: std::sync::Arc::new(cfg.clone()),
             earth,
             clocks: core::array::from_fn(|i| Clock::new(rate[i])),
             rngs,
@@ -222,7 +223,8 @@ impl AidingSimulator {
         b: &TruthSample,
         out: &mut Vec<AidingMeas>,
     ) {
-        if let Some(c) = self.cfg.baro.clone() {
+        let cfg = std::sync::Arc::clone(&self.cfg);
+        if let Some(c) = cfg.baro.as_ref() {
             while let Some(t) = self.clocks[0].next_in(a.t_s, b.t_s) {
                 self.advance_bias(t);
                 let w = normal(&mut self.rngs[0]);
@@ -238,7 +240,7 @@ impl AidingSimulator {
             }
             self.advance_bias(b.t_s);
         }
-        if let Some(c) = self.cfg.odometer.clone() {
+        if let Some(c) = cfg.odometer.as_ref() {
             while let Some(t) = self.clocks[1].next_in(a.t_s, b.t_s) {
                 let w = normal(&mut self.rngs[1]);
                 let w_nhc = [normal(&mut self.rngs[1]), normal(&mut self.rngs[1])];
@@ -271,7 +273,7 @@ impl AidingSimulator {
                 }));
             }
         }
-        if let Some(c) = self.cfg.magnetometer.clone() {
+        if let Some(c) = cfg.magnetometer.as_ref() {
             while let Some(t) = self.clocks[2].next_in(a.t_s, b.t_s) {
                 let w = Vec3::from_fn(|_, _| normal(&mut self.rngs[2]));
                 if c.in_outage(t) {
@@ -287,7 +289,7 @@ impl AidingSimulator {
                 }));
             }
         }
-        if let Some(c) = self.cfg.dual_antenna.clone() {
+        if let Some(c) = cfg.dual_antenna.as_ref() {
             while let Some(t) = self.clocks[3].next_in(a.t_s, b.t_s) {
                 let w = [normal(&mut self.rngs[3]), normal(&mut self.rngs[3])];
                 if c.in_outage(t) {
@@ -309,7 +311,7 @@ impl AidingSimulator {
                 }));
             }
         }
-        if let Some(c) = self.cfg.body_velocity.clone() {
+        if let Some(c) = cfg.body_velocity.as_ref() {
             while let Some(t) = self.clocks[4].next_in(a.t_s, b.t_s) {
                 let w = Vec3::from_fn(|_, _| normal(&mut self.rngs[4]));
                 if c.in_outage(t) {
